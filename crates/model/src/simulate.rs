@@ -1,0 +1,668 @@
+//! Flight → contact → flight, integrated with events at every phase and stick/slip switch.
+
+use crate::effects::{Context, Loads, Observation, Phase};
+use crate::integrator::{Step, Y, find_root};
+use crate::{Model, ModelError, State};
+use serde::{Deserialize, Serialize};
+use std::cell::Cell;
+
+/// Integration settings.
+///
+/// The defaults hold the paper's anchor (e, contact time) to better than 1e-8 relative and conserve
+/// energy of a purely elastic impact to better than 1e-9 relative; events are located to 1e-14 s.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SimOptions {
+    /// Relative tolerance of each step's local error.
+    pub rtol: f64,
+    /// Absolute tolerance of each step's local error, SI units of each component.
+    pub atol: f64,
+    /// Longest step, s (keeps the dense output between frames accurate in long flights).
+    pub max_step_s: f64,
+    /// Longest simulated time to wait for the ball to reach the surface, s.
+    pub max_time_s: f64,
+    /// Most steps allowed in one simulation.
+    pub max_steps: usize,
+}
+
+impl Default for SimOptions {
+    fn default() -> Self {
+        SimOptions {
+            rtol: 1e-10,
+            atol: 1e-12,
+            max_step_s: 2e-3,
+            max_time_s: 10.0,
+            max_steps: 200_000,
+        }
+    }
+}
+
+/// One sampled instant.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Sample {
+    /// Time, s.
+    pub t: f64,
+    /// True state in the local frame.
+    pub state: State,
+    /// What the camera measures (after measurement effects such as camera roll).
+    pub observed: Observation,
+    /// Phase at this instant.
+    pub phase: Phase,
+    /// True if the contact point is sticking (the ball rolls).
+    pub sticking: bool,
+}
+
+/// What happened at a stick/slip switch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SlipEventKind {
+    /// The slip stopped and friction can hold it: rolling starts.
+    StartsSticking,
+    /// Friction can no longer hold the contact point: sliding starts.
+    StartsSliding,
+    /// The slip passed through zero and changed direction.
+    Reverses,
+}
+
+/// A stick/slip switch.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SlipEvent {
+    /// Time, s.
+    pub t: f64,
+    /// What happened.
+    pub kind: SlipEventKind,
+}
+
+/// The outputs of one impact (true local frame).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Impact {
+    /// Time the ball touched the surface, s.
+    pub t_touch: f64,
+    /// Time of maximum compression, s.
+    pub t_max_compression: f64,
+    /// Time the ball left the surface, s.
+    pub t_separation: f64,
+    /// State at touch.
+    pub state_in: State,
+    /// State at separation.
+    pub state_out: State,
+    /// Coefficient of restitution `|v_n,out / v_n,in|` at the contact boundaries.
+    pub restitution: f64,
+    /// Effective friction, the paper's momentum ratio `−Δv_t / Δv_n` over the contact (positive when the
+    /// contact slows the down-slope motion).
+    pub effective_friction: f64,
+    /// Maximum penetration δ_max, m.
+    pub delta_max: f64,
+    /// Normal force at maximum compression, N.
+    pub force_max: f64,
+    /// Penetration left at separation, m (non-zero with a plastic dent or damping in restitution).
+    pub residual_depth: f64,
+    /// Stick/slip switches during the contact.
+    pub slip_events: Vec<SlipEvent>,
+    /// True if the contact point was sticking (rolling) at separation.
+    pub rolling_at_separation: bool,
+}
+
+impl Impact {
+    /// Contact time, s.
+    pub fn contact_time(&self) -> f64 {
+        self.t_separation - self.t_touch
+    }
+    /// Spin at touch, rad/s.
+    pub fn omega_in(&self) -> f64 {
+        self.state_in.omega
+    }
+    /// Spin at separation, rad/s.
+    pub fn omega_out(&self) -> f64 {
+        self.state_out.omega
+    }
+}
+
+/// A simulated shot: the trajectory at the requested times and the impact's outputs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Simulation {
+    /// One sample per requested time, in order.
+    pub samples: Vec<Sample>,
+    /// The impact.
+    pub impact: Impact,
+}
+
+/// Slip speed below which a slip against the sliding direction is taken as rounding, m/s.
+const SLIP_EPS: f64 = 1e-12;
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Friction {
+    /// No friction at all (μ = 0).
+    None,
+    /// Sliding with slip direction σ = ±1.
+    Slip(f64),
+    /// Sticking: the contact point does not slip.
+    Stick,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Mode {
+    phase: Phase,
+    friction: Friction,
+    delta_max: f64,
+    force_max: f64,
+}
+
+/// Quantities the events are made of.
+#[derive(Debug, Clone, Copy, Default)]
+struct Aux {
+    normal: f64,
+    slip: f64,
+    required_friction: f64,
+    friction_limit: f64,
+}
+
+struct Dynamics<'a> {
+    model: &'a Model,
+    incline: f64,
+    sin_b: f64,
+    cos_b: f64,
+    mu: f64,
+    inertia: f64,
+    /// 1/m + R²/I: how fast a tangential contact force changes the slip.
+    slip_mobility: f64,
+}
+
+impl<'a> Dynamics<'a> {
+    fn new(model: &'a Model, incline: f64) -> Self {
+        let inertia = model.inertia();
+        let (m, r) = (model.ball.mass_kg, model.ball.radius_m);
+        Dynamics {
+            model,
+            incline,
+            sin_b: incline.sin(),
+            cos_b: incline.cos(),
+            mu: model.friction_coefficient(),
+            inertia,
+            slip_mobility: 1.0 / m + r * r / inertia,
+        }
+    }
+
+    fn eval(&self, t: f64, y: &Y, mode: &Mode) -> (Y, Aux) {
+        let ball = &self.model.ball;
+        let (m, r) = (ball.mass_kg, ball.radius_m);
+        let state = State::from_array(*y);
+        let slip = state.vx + state.omega * r;
+        let mut ctx = Context {
+            t,
+            state: &state,
+            phase: mode.phase,
+            delta: r - state.y,
+            delta_dot: -state.vy,
+            slip,
+            ball,
+            gravity: self.model.gravity,
+            incline: self.incline,
+            delta_max: mode.delta_max,
+            force_max: mode.force_max,
+            normal_force: 0.0,
+        };
+        let effects = self.model.effects();
+        let normal = if mode.phase.in_contact() {
+            effects.iter().map(|e| e.normal_force(&ctx)).sum()
+        } else {
+            0.0
+        };
+        ctx.normal_force = normal;
+        let mut loads = Loads::default();
+        for e in effects {
+            loads.add(&e.loads(&ctx));
+        }
+        let g = self.model.gravity;
+        let ax_other = g * self.sin_b + (loads.force_x + loads.tangential) / m;
+        let ay = -g * self.cos_b + (loads.force_y + normal) / m;
+        let alpha_other = (loads.torque + r * loads.tangential) / self.inertia;
+        let mut aux = Aux {
+            normal,
+            slip,
+            ..Aux::default()
+        };
+        let friction = if mode.phase.in_contact() {
+            aux.required_friction = -(ax_other + r * alpha_other) / self.slip_mobility;
+            aux.friction_limit = self.mu * normal.max(0.0);
+            match mode.friction {
+                Friction::None => 0.0,
+                Friction::Slip(sigma) => -sigma * aux.friction_limit,
+                Friction::Stick => aux.required_friction,
+            }
+        } else {
+            0.0
+        };
+        let dy = [
+            state.vx,
+            state.vy,
+            state.omega,
+            ax_other + friction / m,
+            ay,
+            alpha_other + r * friction / self.inertia,
+        ];
+        (dy, aux)
+    }
+}
+
+/// Most events active at once.
+const MAX_EVENTS: usize = 3;
+
+/// An event function, falling through zero when the event happens.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Event {
+    Touch,
+    MaxCompression,
+    ForceVanishes,
+    PenetrationVanishes,
+    SlipStops,
+    GripLost,
+}
+
+impl Event {
+    fn value(self, y: &Y, aux: &Aux, mode: &Mode, r: f64) -> f64 {
+        match self {
+            Event::Touch => y[1] - r,
+            Event::MaxCompression => -y[4],
+            Event::ForceVanishes => aux.normal,
+            Event::PenetrationVanishes => r - y[1],
+            Event::SlipStops => match mode.friction {
+                Friction::Slip(sigma) => sigma * aux.slip,
+                _ => 1.0,
+            },
+            Event::GripLost => aux.friction_limit - aux.required_friction.abs(),
+        }
+    }
+
+    fn active(mode: &Mode) -> &'static [Event] {
+        use Event::*;
+        match (mode.phase, mode.friction) {
+            (Phase::Flight, _) => &[Touch],
+            (Phase::Compression, Friction::Slip(_)) => &[MaxCompression, SlipStops],
+            (Phase::Compression, Friction::Stick) => &[MaxCompression, GripLost],
+            (Phase::Compression, Friction::None) => &[MaxCompression],
+            (Phase::Restitution, Friction::Slip(_)) => &[ForceVanishes, PenetrationVanishes, SlipStops],
+            (Phase::Restitution, Friction::Stick) => &[ForceVanishes, PenetrationVanishes, GripLost],
+            (Phase::Restitution, Friction::None) => &[ForceVanishes, PenetrationVanishes],
+        }
+    }
+}
+
+/// Simulates one shot of `model` on a surface inclined by `incline_rad`, from `start` at time `t0` (s),
+/// through the impact, returning the trajectory at `times` (s, ascending, ≥ `t0`) and the impact's outputs.
+///
+/// The ball must start in flight (at or above the surface). The run continues past the last requested time
+/// until the ball has left the surface, so the outputs are always complete.
+pub fn simulate(
+    model: &Model,
+    incline_rad: f64,
+    t0: f64,
+    start: State,
+    times: &[f64],
+    opts: &SimOptions,
+) -> Result<Simulation, ModelError> {
+    let r = model.ball.radius_m;
+    let y0 = start.to_array();
+    if !y0.iter().all(|v| v.is_finite()) || !t0.is_finite() || !incline_rad.is_finite() {
+        return Err(ModelError::BadStart(
+            "the start state, time or incline is not finite".into(),
+        ));
+    }
+    if start.y < r - 1e-9 {
+        return Err(ModelError::BadStart(format!(
+            "the ball starts {:.3e} m inside the surface (y = {} m < R = {} m)",
+            r - start.y,
+            start.y,
+            r
+        )));
+    }
+    if let Some(w) = times.windows(2).find(|w| w[1] < w[0] || w[1].is_nan()) {
+        return Err(ModelError::BadStart(format!(
+            "sample times are not ascending ({} then {})",
+            w[0], w[1]
+        )));
+    }
+    if let Some(&first) = times.first()
+        && (first < t0 || first.is_nan())
+    {
+        return Err(ModelError::BadStart(format!(
+            "sample time {first} s is before the start time {t0} s"
+        )));
+    }
+    if !(model.ball.mass_kg > 0.0 && r > 0.0 && model.inertia() > 0.0) {
+        return Err(ModelError::BadStart(
+            "the ball needs a positive mass, radius and moment of inertia".into(),
+        ));
+    }
+    let mut run = Run::new(model, incline_rad, opts, times);
+    run.go(t0, y0)
+}
+
+/// Simulates a ball released at rest `drop_height_m` (m, measured vertically from the ball's bottom to the
+/// point it hits) above a surface inclined by `incline_rad`; t = 0 at release.
+pub fn simulate_drop(
+    model: &Model,
+    incline_rad: f64,
+    drop_height_m: f64,
+    times: &[f64],
+    opts: &SimOptions,
+) -> Result<Simulation, ModelError> {
+    if !(drop_height_m >= 0.0 && drop_height_m.is_finite()) {
+        return Err(ModelError::BadStart(format!(
+            "drop height {drop_height_m} m must be ≥ 0"
+        )));
+    }
+    let (s, c) = incline_rad.sin_cos();
+    let start = State::flying(-drop_height_m * s, model.ball.radius_m + drop_height_m * c, 0.0, 0.0);
+    simulate(model, incline_rad, 0.0, start, times, opts)
+}
+
+struct Run<'a> {
+    dynamics: Dynamics<'a>,
+    opts: &'a SimOptions,
+    recorder: Recorder<'a>,
+    steps: usize,
+}
+
+/// Collects the requested samples as the integration passes them.
+struct Recorder<'a> {
+    model: &'a Model,
+    times: &'a [f64],
+    samples: Vec<Sample>,
+}
+
+impl Recorder<'_> {
+    fn record(&mut self, t: f64, y: &Y, mode: &Mode) {
+        let state = State::from_array(*y);
+        let mut observed = Observation::from(state);
+        for e in self.model.effects() {
+            e.observe(&mut observed);
+        }
+        self.samples.push(Sample {
+            t,
+            state,
+            observed,
+            phase: mode.phase,
+            sticking: mode.friction == Friction::Stick,
+        });
+    }
+
+    /// Records every requested time not yet recorded up to `t_hi`, with states from `at`.
+    fn record_until(&mut self, t_hi: f64, mode: &Mode, at: impl Fn(f64) -> Y) {
+        while let Some(&t) = self.times.get(self.samples.len()) {
+            if t > t_hi {
+                break;
+            }
+            let y = at(t);
+            self.record(t, &y, mode);
+        }
+    }
+}
+
+impl<'a> Run<'a> {
+    fn new(model: &'a Model, incline: f64, opts: &'a SimOptions, times: &'a [f64]) -> Self {
+        let recorder = Recorder {
+            model,
+            times,
+            samples: Vec::with_capacity(times.len()),
+        };
+        Run {
+            dynamics: Dynamics::new(model, incline),
+            opts,
+            recorder,
+            steps: 0,
+        }
+    }
+
+    fn go(&mut self, t0: f64, y0: Y) -> Result<Simulation, ModelError> {
+        let r = self.dynamics.model.ball.radius_m;
+        let mut mode = Mode {
+            phase: Phase::Flight,
+            friction: Friction::None,
+            delta_max: 0.0,
+            force_max: 0.0,
+        };
+        self.recorder.record_until(t0, &mode, |_| y0);
+        let (mut t, mut y) = (t0, y0);
+        // Touching already, moving in: the contact starts now.
+        let start_in_contact = y0[1] <= r && y0[4] < 0.0;
+        if y0[1] <= r && !start_in_contact {
+            return Err(ModelError::BadStart(
+                "the ball starts on the surface without moving into it".into(),
+            ));
+        }
+        if !start_in_contact {
+            let deadline = t0 + self.opts.max_time_s;
+            (t, y) = self.integrate(t, y, &mut mode, Some(deadline))?;
+            if mode.phase == Phase::Flight {
+                return Err(ModelError::NoImpact {
+                    max_time_s: self.opts.max_time_s,
+                });
+            }
+        } else {
+            mode.phase = Phase::Compression;
+        }
+        // Touch.
+        let (t_touch, state_in) = (t, State::from_array(y));
+        mode.friction = self.initial_friction(t, &y, &mode);
+        let mut slip_events = Vec::new();
+        (t, y) = self.contact(t, y, &mut mode, Phase::Compression, &mut slip_events)?;
+        let t_max = t;
+        // Maximum compression: remember the turning point, then restitution.
+        mode.phase = Phase::Restitution;
+        mode.delta_max = r - y[1];
+        mode.force_max = self.dynamics.eval(t, &y, &mode).1.normal;
+        (t, y) = self.contact(t, y, &mut mode, Phase::Restitution, &mut slip_events)?;
+        let (t_sep, state_out) = (t, State::from_array(y));
+        let rolling = mode.friction == Friction::Stick;
+        mode.phase = Phase::Flight;
+        mode.friction = Friction::None;
+        if let Some(&last) = self.recorder.times.last()
+            && last > t
+        {
+            self.integrate(t, y, &mut mode, Some(last))?;
+        }
+        let dvt = state_out.vx - state_in.vx;
+        let dvn = state_out.vy - state_in.vy;
+        let impact = Impact {
+            t_touch,
+            t_max_compression: t_max,
+            t_separation: t_sep,
+            state_in,
+            state_out,
+            restitution: (state_out.vy / state_in.vy).abs(),
+            effective_friction: -dvt / dvn,
+            delta_max: mode.delta_max,
+            force_max: mode.force_max,
+            residual_depth: (r - state_out.y).max(0.0),
+            slip_events,
+            rolling_at_separation: rolling,
+        };
+        Ok(Simulation {
+            samples: std::mem::take(&mut self.recorder.samples),
+            impact,
+        })
+    }
+
+    fn initial_friction(&self, t: f64, y: &Y, mode: &Mode) -> Friction {
+        if self.dynamics.mu == 0.0 {
+            return Friction::None;
+        }
+        let probe = Mode {
+            friction: Friction::Slip(0.0),
+            ..*mode
+        };
+        let aux = self.dynamics.eval(t, y, &probe).1;
+        if aux.slip != 0.0 {
+            Friction::Slip(aux.slip.signum())
+        } else if aux.required_friction.abs() <= aux.friction_limit {
+            Friction::Stick
+        } else {
+            Friction::Slip(-aux.required_friction.signum())
+        }
+    }
+
+    /// Integrates one contact phase, handling stick/slip switches, until the phase ends.
+    fn contact(
+        &mut self,
+        mut t: f64,
+        mut y: Y,
+        mode: &mut Mode,
+        phase: Phase,
+        slip_events: &mut Vec<SlipEvent>,
+    ) -> Result<(f64, Y), ModelError> {
+        mode.phase = phase;
+        loop {
+            // A slip that already points against the sliding direction (its zero fell on the same instant
+            // as a phase switch) is handled as a slip event right away.
+            if let Friction::Slip(sigma) = mode.friction {
+                let slip = self.dynamics.eval(t, &y, mode).1.slip;
+                if sigma * slip < -SLIP_EPS {
+                    slip_events.push(SlipEvent {
+                        t,
+                        kind: self.slip_stops(t, &mut y, mode),
+                    });
+                }
+            }
+            let before = *mode;
+            (t, y) = self.integrate(t, y, mode, None)?;
+            if mode.phase != before.phase {
+                return Ok((t, y));
+            }
+            // A stick/slip event ended the segment.
+            let kind = match mode.friction {
+                Friction::Slip(_) => self.slip_stops(t, &mut y, mode),
+                Friction::Stick => {
+                    let aux = self.dynamics.eval(t, &y, mode).1;
+                    mode.friction = Friction::Slip(-aux.required_friction.signum());
+                    SlipEventKind::StartsSliding
+                }
+                Friction::None => unreachable!("no stick/slip events without friction"),
+            };
+            slip_events.push(SlipEvent { t, kind });
+        }
+    }
+
+    /// The slip has reached zero: stick if friction can hold the contact point, else slide the other way.
+    fn slip_stops(&self, t: f64, y: &mut Y, mode: &mut Mode) -> SlipEventKind {
+        let Friction::Slip(sigma) = mode.friction else {
+            unreachable!("called while sliding")
+        };
+        let aux = self.dynamics.eval(t, y, mode).1;
+        if aux.required_friction.abs() <= aux.friction_limit {
+            // Remove the residual slip with the tangential impulse that would have done it.
+            let r = self.dynamics.model.ball.radius_m;
+            let j = -aux.slip / self.dynamics.slip_mobility;
+            y[3] += j / self.dynamics.model.ball.mass_kg;
+            y[5] += r * j / self.dynamics.inertia;
+            mode.friction = Friction::Stick;
+            SlipEventKind::StartsSticking
+        } else {
+            mode.friction = Friction::Slip(-sigma);
+            SlipEventKind::Reverses
+        }
+    }
+
+    /// Integrates in the current mode until an event fires (returning its time and state; the phase is
+    /// advanced for phase events) or until `until` is reached.
+    fn integrate(&mut self, mut t: f64, mut y: Y, mode: &mut Mode, until: Option<f64>) -> Result<(f64, Y), ModelError> {
+        let dynamics = &self.dynamics;
+        let r = dynamics.model.ball.radius_m;
+        let events = Event::active(mode);
+        let m = *mode;
+        // The last stage of a step is evaluated at its end: keep its event quantities instead of recomputing.
+        let last_aux = Cell::new(Aux::default());
+        let mut rhs = |tt: f64, yy: &Y| {
+            let (dy, a) = dynamics.eval(tt, yy, &m);
+            last_aux.set(a);
+            dy
+        };
+        let (mut f, aux) = dynamics.eval(t, &y, &m);
+        let values = |y: &Y, aux: &Aux| {
+            let mut g = [0.0; MAX_EVENTS];
+            for (gk, e) in g.iter_mut().zip(events) {
+                *gk = e.value(y, aux, &m, r);
+            }
+            g
+        };
+        let mut g = values(&y, &aux);
+        let scale = dynamics.model.ball.radius_m.max(1e-3) / y[3].hypot(y[4]).max(0.1);
+        let mut h = (1e-3 * scale).min(self.opts.max_step_s);
+        loop {
+            if let Some(end) = until {
+                if t >= end {
+                    return Ok((t, y));
+                }
+                h = h.min(end - t);
+            }
+            self.steps += 1;
+            if self.steps > self.opts.max_steps {
+                return Err(ModelError::TooManySteps {
+                    max_steps: self.opts.max_steps,
+                    t_s: t,
+                    phase: m.phase.name(),
+                });
+            }
+            let step = Step::attempt(&mut rhs, t, &y, &f, h, self.opts.rtol, self.opts.atol);
+            if step.err > 1.0 {
+                h = step.next_h();
+                if h < 1e-15 * t.abs().max(1e-3) || !h.is_finite() {
+                    return Err(ModelError::NonFinite {
+                        t_s: t,
+                        phase: m.phase.name(),
+                    });
+                }
+                continue;
+            }
+            if !step.y1.iter().all(|v| v.is_finite()) {
+                return Err(ModelError::NonFinite {
+                    t_s: t + h,
+                    phase: m.phase.name(),
+                });
+            }
+            let g1 = values(&step.y1, &last_aux.get());
+            // The earliest event whose function falls through zero in this step.
+            let mut hit: Option<(f64, Event)> = None;
+            for (k, ev) in events.iter().enumerate() {
+                if g[k] > 0.0 && g1[k] <= 0.0 {
+                    let gf = |tt: f64| {
+                        let yy = step.at(tt);
+                        let a = dynamics.eval(tt, &yy, &m).1;
+                        ev.value(&yy, &a, &m, r)
+                    };
+                    let te = find_root(gf, t, g[k], t + h, g1[k], 1e-14 * t.abs().max(1e-3));
+                    // Phase events are listed first and win ties, so a slip event at the same instant as
+                    // separation does not hide the separation.
+                    if hit.is_none_or(|(th, _)| te < th - 1e-13 * th.abs().max(1e-3)) {
+                        hit = Some((te, *ev));
+                    }
+                }
+            }
+            if let Some((te, ev)) = hit {
+                // Re-step exactly to the event so its state has the integrator's full accuracy.
+                let he = te - t;
+                let (ye, at) = if he > 0.0 {
+                    let s = Step::attempt(&mut rhs, t, &y, &f, he, self.opts.rtol, self.opts.atol);
+                    (s.y1, Some(s))
+                } else {
+                    (y, None)
+                };
+                if let Some(s) = &at {
+                    self.recorder.record_until(te, &m, |tt| s.at(tt));
+                }
+                match ev {
+                    Event::Touch => mode.phase = Phase::Compression,
+                    Event::MaxCompression => mode.phase = Phase::Restitution,
+                    Event::ForceVanishes | Event::PenetrationVanishes => mode.phase = Phase::Flight,
+                    Event::SlipStops | Event::GripLost => {}
+                }
+                return Ok((te, ye));
+            }
+            self.recorder.record_until(t + h, &m, |tt| step.at(tt));
+            t += h;
+            y = step.y1;
+            f = step.f1;
+            g = g1;
+            h = step.next_h().min(self.opts.max_step_s);
+        }
+    }
+}

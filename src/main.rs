@@ -1,0 +1,45 @@
+//! `bouncelab`: the command line. It parses arguments, wires the pipeline's crates together and reports;
+//! it owns no science. Exit status: 0 on success, 1 on a user error (one line naming the file, frame or
+//! field), 2 on a usage error.
+
+mod cmd;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(
+    name = "bouncelab",
+    version,
+    about = "High-speed video of a ball impact in, physics out."
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Simulate the paper's three surfaces at the paper's drop heights and print COR and contact time.
+    Demo(cmd::demo::Args),
+    /// Simulate one impact with a model file and print its outputs.
+    Simulate(cmd::simulate::Args),
+    /// List the effects a model can use, with their physics and parameters.
+    Effects(cmd::effects::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Demo(a) => cmd::demo::run(a),
+        Command::Simulate(a) => cmd::simulate::run(a),
+        Command::Effects(a) => cmd::effects::run(a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(1)
+        }
+    }
+}
