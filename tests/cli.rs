@@ -119,3 +119,73 @@ fn usage_errors_exit_2() {
     bouncelab().args(["simulate", "--speed"]).assert().code(2);
     bouncelab().arg("frobnicate").assert().code(2);
 }
+
+/// Writes a 30-frame clip of a ball falling onto a surface band, in a session folder.
+fn write_session_with_one_clip(root: &std::path::Path) -> std::path::PathBuf {
+    use bouncelab_track::testutil::{Scene, render};
+    std::fs::write(
+        root.join("session.toml"),
+        "[ball]\ndiameter_m = 0.067\nmass_kg = 0.0567\n[camera]\nfps = 10000\n",
+    )
+    .unwrap();
+    let clip = root.join("shot01");
+    std::fs::create_dir_all(&clip).unwrap();
+    for i in 0..30 {
+        let s = Scene {
+            ball: (100.0 + i as f64, 60.0 + 2.0 * i as f64, 40.0),
+            surface: Some((220.0, 0.0)),
+            band: (150.0, 20.0),
+            seed: i,
+            ..Scene::default()
+        };
+        let img = image::GrayImage::from_raw(256, 256, render(&s)).unwrap();
+        img.save(clip.join(format!("img_{i:05}.png"))).unwrap();
+    }
+    clip
+}
+
+#[test]
+fn track_writes_the_trajectory_columns() {
+    let dir = tempfile::tempdir().unwrap();
+    let clip = write_session_with_one_clip(dir.path());
+    let out = dir.path().join("traj.csv");
+    bouncelab()
+        .args(["track", clip.to_str().unwrap(), "--out", out.to_str().unwrap()])
+        .assert()
+        .success()
+        .stderr(predicate::str::contains("30 frames, ball measured in 30").and(predicate::str::contains("scale")));
+    let text = std::fs::read_to_string(&out).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "frame,t_s,x_px,y_px,r_px,sigma_px,quality,status,x_m,y_m"
+    );
+    let rows: Vec<Vec<String>> = lines.map(|l| l.split(',').map(str::to_string).collect()).collect();
+    assert_eq!(rows.len(), 30);
+    assert!(rows.iter().all(|r| r[7] == "ok"));
+    let x5: f64 = rows[5][2].parse().unwrap();
+    assert!((x5 - 105.0).abs() < 0.1, "{x5}");
+}
+
+#[test]
+fn track_bad_inputs_exit_1_naming_the_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let empty = dir.path().join("empty");
+    std::fs::create_dir_all(&empty).unwrap();
+    bouncelab()
+        .args(["track", empty.to_str().unwrap()])
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("empty"));
+    bouncelab()
+        .args(["track", "/no/such/clip"])
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("/no/such/clip"));
+    let clip = write_session_with_one_clip(dir.path());
+    bouncelab()
+        .args(["track", clip.to_str().unwrap(), "--fps", "-5"])
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("fps"));
+}

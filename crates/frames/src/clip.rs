@@ -1,0 +1,434 @@
+//! A clip folder: listing, ordering, timing, and streaming its frames.
+
+use std::collections::VecDeque;
+use std::path::{Path, PathBuf};
+
+use rayon::prelude::*;
+
+use crate::decode::{FrameFormat, PngDecoder, decode_path};
+use crate::error::{FramesError, Result};
+use crate::pixels::GrayPixels;
+use crate::settings::{FpsSource, Warning, resolve_fps};
+
+/// How to open a clip.
+#[derive(Clone, Debug, Default, PartialEq)]
+#[non_exhaustive]
+pub struct ClipOptions {
+    /// Frame rate override (from the command line), in frames/s; beats `clip.toml` and `session.toml`.
+    pub fps: Option<f64>,
+}
+
+impl ClipOptions {
+    /// Options with this frame-rate override, in frames/s.
+    pub fn with_fps(fps: f64) -> Self {
+        Self { fps: Some(fps) }
+    }
+}
+
+/// How to decode a clip's frames.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct ReadOptions {
+    /// Decoding threads: `None` uses rayon's global pool; `Some(1)` decodes on the calling thread;
+    /// `Some(n)` builds a dedicated pool of `n` threads for this stream.
+    pub threads: Option<usize>,
+    /// Frames decoded ahead and held in memory at most; `None` means 4 × the thread count.
+    pub window: Option<usize>,
+    /// The PNG decoder.
+    pub png_decoder: PngDecoder,
+}
+
+impl ReadOptions {
+    /// Options that decode on `threads` threads (1 = sequential on the caller's thread).
+    pub fn with_threads(threads: usize) -> Self {
+        Self {
+            threads: Some(threads),
+            ..Self::default()
+        }
+    }
+}
+
+/// One frame file of a clip, before decoding.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct FrameFile {
+    /// The file.
+    pub path: PathBuf,
+    /// The last number in its name.
+    pub number: u64,
+    /// Its frame index: `number − first number` (0-based; dropped frames counted).
+    pub index: u64,
+}
+
+/// A run of missing frame numbers (dropped frames).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Gap {
+    /// First missing frame number.
+    pub first: u64,
+    /// Last missing frame number (inclusive).
+    pub last: u64,
+}
+
+impl Gap {
+    /// How many frames are missing.
+    pub fn len(&self) -> u64 {
+        self.last - self.first + 1
+    }
+
+    /// Always false: a gap has at least one missing frame.
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+}
+
+/// One decoded frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Frame {
+    /// Frame index in the clip: 0 for the first file, dropped frames counted (SPEC §3).
+    pub index: u64,
+    /// The number in the file name.
+    pub number: u64,
+    /// Time since the first frame, in seconds: `index / fps`.
+    pub t_s: f64,
+    /// The file it came from.
+    pub path: PathBuf,
+    /// The pixels, gray, at the file's bit depth.
+    pub pixels: GrayPixels,
+}
+
+/// An opened clip folder: its frame files in order, frame rate, dropped frames and size. Nothing is decoded
+/// until frames are read.
+#[derive(Clone, Debug)]
+pub struct Clip {
+    dir: PathBuf,
+    files: Vec<FrameFile>,
+    fps: f64,
+    fps_source: FpsSource,
+    gaps: Vec<Gap>,
+    warnings: Vec<Warning>,
+    size: (u32, u32),
+}
+
+impl Clip {
+    /// Opens a clip folder with default options (fps from `clip.toml`, `session.toml` or the default).
+    pub fn open(dir: impl AsRef<Path>) -> Result<Self> {
+        Self::open_with(dir, &ClipOptions::default())
+    }
+
+    /// Opens a clip folder.
+    ///
+    /// Lists every supported image file (`.png .tif .tiff .bmp .pgm .ppm .pnm .jpg .jpeg`, any case; the
+    /// formats may be mixed) and ignores everything else, including hidden files. Orders them by the last
+    /// number in the file name, finds the dropped frames, resolves the frame rate, and reads the first
+    /// frame's header for the clip's size.
+    pub fn open_with(dir: impl AsRef<Path>, options: &ClipOptions) -> Result<Self> {
+        let dir = dir.as_ref().to_path_buf();
+        let (fps, fps_source, warning) = resolve_fps(&dir, options.fps)?;
+        Self::open_resolved(dir, fps, fps_source, warning.into_iter().collect())
+    }
+
+    pub(crate) fn open_resolved(dir: PathBuf, fps: f64, fps_source: FpsSource, warnings: Vec<Warning>) -> Result<Self> {
+        let files = list_frames(&dir)?;
+        let gaps = gaps(&files);
+        let first = &files[0].path;
+        let size = image::ImageReader::open(first)
+            .and_then(|r| r.with_guessed_format())
+            .map_err(|e| e.to_string())
+            .and_then(|r| r.into_dimensions().map_err(|e| e.to_string()))
+            .map_err(|message| FramesError::Decode {
+                path: first.clone(),
+                index: 0,
+                message,
+            })?;
+        Ok(Self {
+            dir,
+            files,
+            fps,
+            fps_source,
+            gaps,
+            warnings,
+            size,
+        })
+    }
+
+    /// The clip folder.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// The frame files in order.
+    pub fn files(&self) -> &[FrameFile] {
+        &self.files
+    }
+
+    /// Number of frame files (present frames).
+    pub fn len(&self) -> usize {
+        self.files.len()
+    }
+
+    /// Always false: opening fails on a clip without frames.
+    pub fn is_empty(&self) -> bool {
+        self.files.is_empty()
+    }
+
+    /// Frame indices spanned, dropped frames included: last index + 1.
+    pub fn span(&self) -> u64 {
+        self.files.last().map_or(0, |f| f.index + 1)
+    }
+
+    /// Frame rate, in frames/s.
+    pub fn fps(&self) -> f64 {
+        self.fps
+    }
+
+    /// Where the frame rate came from.
+    pub fn fps_source(&self) -> &FpsSource {
+        &self.fps_source
+    }
+
+    /// Dropped frames: runs of missing numbers, in order.
+    pub fn gaps(&self) -> &[Gap] {
+        &self.gaps
+    }
+
+    /// Total number of dropped frames.
+    pub fn dropped(&self) -> u64 {
+        self.gaps.iter().map(Gap::len).sum()
+    }
+
+    /// Warnings found while opening (e.g. the default frame rate was assumed).
+    pub fn warnings(&self) -> &[Warning] {
+        &self.warnings
+    }
+
+    /// Frame size (width, height) in pixels, from the first frame's header.
+    pub fn dimensions(&self) -> (u32, u32) {
+        self.size
+    }
+
+    /// Time of frame index `index`, in seconds.
+    pub fn time_of(&self, index: u64) -> f64 {
+        index as f64 / self.fps
+    }
+
+    /// Decodes the `k`-th frame file (position in [`Clip::files`], not frame index).
+    ///
+    /// Returns `None` past the end; an unreadable, truncated or wrongly sized frame is an error naming the
+    /// file and frame index.
+    pub fn read(&self, k: usize, png_decoder: PngDecoder) -> Option<Result<Frame>> {
+        self.files.get(k).map(|f| self.decode(f, png_decoder))
+    }
+
+    /// Streams the frames in order, decoding a bounded window ahead in parallel on rayon's global pool.
+    pub fn frames(&self) -> FrameStream<'_> {
+        FrameStream::new(self, None, 4 * rayon::current_num_threads(), PngDecoder::default())
+    }
+
+    /// Streams the frames in order with these options (thread count, window, PNG decoder).
+    ///
+    /// Fails only if a dedicated thread pool cannot be started.
+    pub fn frames_with(&self, options: &ReadOptions) -> Result<FrameStream<'_>> {
+        let (pool, threads) = match options.threads {
+            None => (None, rayon::current_num_threads()),
+            Some(n) if n <= 1 => (None, 1),
+            Some(n) => {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(n)
+                    .thread_name(|i| format!("frames-decode-{i}"))
+                    .build()
+                    .map_err(|e| FramesError::ThreadPool {
+                        threads: n,
+                        message: e.to_string(),
+                    })?;
+                (Some(Pool::Own(pool)), n)
+            }
+        };
+        let pool = match (options.threads, pool) {
+            (None, _) => Some(Pool::Global),
+            (_, p) => p,
+        };
+        let window = options.window.unwrap_or(4 * threads).max(1);
+        Ok(FrameStream::new(self, pool, window, options.png_decoder))
+    }
+
+    fn decode(&self, file: &FrameFile, png: PngDecoder) -> Result<Frame> {
+        let pixels = decode_path(&file.path, png).map_err(|message| FramesError::Decode {
+            path: file.path.clone(),
+            index: file.index,
+            message,
+        })?;
+        if pixels.dimensions() != self.size {
+            return Err(FramesError::SizeMismatch {
+                path: file.path.clone(),
+                index: file.index,
+                found: pixels.dimensions(),
+                expected: self.size,
+                first: self.files[0].path.clone(),
+            });
+        }
+        Ok(Frame {
+            index: file.index,
+            number: file.number,
+            t_s: self.time_of(file.index),
+            path: file.path.clone(),
+            pixels,
+        })
+    }
+}
+
+enum Pool {
+    Global,
+    Own(rayon::ThreadPool),
+}
+
+/// An ordered stream of a clip's decoded frames, from [`Clip::frames`] or [`Clip::frames_with`].
+///
+/// Decodes `window` frames at a time in parallel, then hands them out in order, so at most `window`
+/// decoded frames are held in memory whatever the clip's length. A frame that fails to decode yields an
+/// `Err` in its place; the stream goes on with the next frame.
+pub struct FrameStream<'a> {
+    clip: &'a Clip,
+    pool: Option<Pool>,
+    window: usize,
+    png: PngDecoder,
+    next: usize,
+    ready: VecDeque<Result<Frame>>,
+}
+
+impl<'a> FrameStream<'a> {
+    fn new(clip: &'a Clip, pool: Option<Pool>, window: usize, png: PngDecoder) -> Self {
+        Self {
+            clip,
+            pool,
+            window: window.max(1),
+            png,
+            next: 0,
+            ready: VecDeque::new(),
+        }
+    }
+
+    fn refill(&mut self) {
+        let end = (self.next + self.window).min(self.clip.files.len());
+        let batch = &self.clip.files[self.next..end];
+        let (clip, png) = (self.clip, self.png);
+        let decode_all = || batch.par_iter().map(|f| clip.decode(f, png)).collect::<Vec<_>>();
+        let decoded = match &self.pool {
+            None => batch.iter().map(|f| clip.decode(f, png)).collect(),
+            Some(Pool::Global) => decode_all(),
+            Some(Pool::Own(pool)) => pool.install(decode_all),
+        };
+        self.ready.extend(decoded);
+        self.next = end;
+    }
+}
+
+impl Iterator for FrameStream<'_> {
+    type Item = Result<Frame>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.ready.is_empty() && self.next < self.clip.files.len() {
+            self.refill();
+        }
+        self.ready.pop_front()
+    }
+
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        let n = self.ready.len() + self.clip.files.len() - self.next;
+        (n, Some(n))
+    }
+}
+
+impl ExactSizeIterator for FrameStream<'_> {}
+
+/// The last run of ASCII digits in a file stem, as a number: `Ok(None)` if there is none.
+pub(crate) fn last_number(stem: &str) -> std::result::Result<Option<u64>, ()> {
+    let bytes = stem.as_bytes();
+    let Some(end) = bytes.iter().rposition(u8::is_ascii_digit) else {
+        return Ok(None);
+    };
+    let start = bytes[..end]
+        .iter()
+        .rposition(|b| !b.is_ascii_digit())
+        .map_or(0, |i| i + 1);
+    stem[start..=end].parse::<u64>().map(Some).map_err(|_| ())
+}
+
+fn list_frames(dir: &Path) -> Result<Vec<FrameFile>> {
+    if !dir.is_dir() {
+        return Err(FramesError::NotAFolder { path: dir.into() });
+    }
+    let io = |source| FramesError::Io {
+        path: dir.into(),
+        source,
+    };
+    let mut files = Vec::new();
+    for entry in std::fs::read_dir(dir).map_err(io)? {
+        let path = entry.map_err(io)?.path();
+        let Some(name) = path.file_name().and_then(|n| n.to_str()) else {
+            continue;
+        };
+        if name.starts_with('.') || FrameFormat::from_path(&path).is_none() || !path.is_file() {
+            continue;
+        }
+        let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or_default();
+        let number = match last_number(stem) {
+            Ok(Some(n)) => n,
+            Ok(None) => return Err(FramesError::NoNumber { path }),
+            Err(()) => return Err(FramesError::NumberTooLarge { path }),
+        };
+        files.push(FrameFile { path, number, index: 0 });
+    }
+    if files.is_empty() {
+        return Err(FramesError::NoFrames { dir: dir.into() });
+    }
+    files.sort_by(|a, b| a.number.cmp(&b.number).then_with(|| a.path.cmp(&b.path)));
+    if let Some(w) = files.windows(2).find(|w| w[0].number == w[1].number) {
+        return Err(FramesError::DuplicateNumber {
+            number: w[0].number,
+            first: w[0].path.clone(),
+            second: w[1].path.clone(),
+        });
+    }
+    let first = files[0].number;
+    for f in &mut files {
+        f.index = f.number - first;
+    }
+    Ok(files)
+}
+
+fn gaps(files: &[FrameFile]) -> Vec<Gap> {
+    files
+        .windows(2)
+        .filter(|w| w[1].number > w[0].number + 1)
+        .map(|w| Gap {
+            first: w[0].number + 1,
+            last: w[1].number - 1,
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn last_number_of_lab_names() {
+        assert_eq!(last_number("C001H001S0001000123"), Ok(Some(1_000_123)));
+        assert_eq!(last_number("img_00123"), Ok(Some(123)));
+        assert_eq!(last_number("7"), Ok(Some(7)));
+        assert_eq!(last_number("shot2_frame_0042_final"), Ok(Some(42)));
+        assert_eq!(last_number("thumb"), Ok(None));
+        assert_eq!(last_number("x99999999999999999999999"), Err(()));
+        assert_eq!(last_number("x000000000000000000000000012"), Ok(Some(12)));
+    }
+
+    #[test]
+    fn gaps_are_runs_of_missing_numbers() {
+        let f = |n| FrameFile {
+            path: PathBuf::new(),
+            number: n,
+            index: 0,
+        };
+        let files: Vec<_> = [3, 4, 7, 8, 10].into_iter().map(f).collect();
+        assert_eq!(gaps(&files), vec![Gap { first: 5, last: 6 }, Gap { first: 9, last: 9 }]);
+    }
+}

@@ -1,0 +1,348 @@
+//! A whole clip: find the ball, track it through every frame, measure the scale and the surface line, and
+//! put the centres in the local frame (SPEC §3).
+//!
+//! Frames are decoded in parallel by the frames crate's stream while this thread tracks them in order, so
+//! tracking hides behind decoding. When the ball's size in pixels is not known, the ball is told from other
+//! round things (screw heads, fixtures, a second ball at rest) by its motion: it is the circle that moved
+//! between two frames.
+
+use crate::hough::{CircleDetection, detect_circles};
+use crate::plane::{Pixel, Plane};
+use crate::surface::SurfaceLine;
+use crate::tracker::{BallFix, Status, TrackOptions, Tracker};
+use bouncelab_frames::{Clip, FramesError, GrayPixels, ReadOptions};
+use serde::Serialize;
+use std::time::Instant;
+
+/// Errors of clip tracking.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum TrackError {
+    /// Reading a frame failed.
+    #[error(transparent)]
+    Frames(#[from] FramesError),
+    /// The ball was not found anywhere in the clip.
+    #[error("{clip}: no ball found in any frame (looked for circles of radius {min_radius:.0}–{max_radius:.0} px)")]
+    NoBall {
+        clip: String,
+        min_radius: f64,
+        max_radius: f64,
+    },
+}
+
+/// Options of [`track_clip`].
+#[derive(Debug, Clone)]
+pub struct ClipTracking {
+    /// Ball diameter, m (sets the scale).
+    pub ball_diameter_m: f64,
+    /// Approximate scale, m/px, if known (narrows the search); found from the ball's motion otherwise.
+    pub scale_hint_m_per_px: Option<f64>,
+    /// True if down-slope is −x in the image (SPEC §2.7 `downslope = "-x"`).
+    pub downslope_negative_x: bool,
+    /// Frame decoding.
+    pub read: ReadOptions,
+    /// Tracker settings.
+    pub tracker: TrackOptions,
+}
+
+impl Default for ClipTracking {
+    fn default() -> Self {
+        ClipTracking {
+            ball_diameter_m: 0.067,
+            scale_hint_m_per_px: None,
+            downslope_negative_x: false,
+            read: ReadOptions::default(),
+            tracker: TrackOptions::default(),
+        }
+    }
+}
+
+/// The clip's scale from the ball's radius in free flight.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Scale {
+    /// Metres per pixel.
+    pub m_per_px: f64,
+    /// Its standard error, m/px.
+    pub sigma_m_per_px: f64,
+    /// Mean free-flight radius, px.
+    pub radius_px: f64,
+    /// Frames it was measured on.
+    pub frames: usize,
+}
+
+/// One frame of a trajectory in pixels and in the local frame (the `trajectories/<clip>.csv` row).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct TrajectoryRow {
+    /// Frame index.
+    pub frame: usize,
+    /// Time, s.
+    pub t_s: f64,
+    /// Centre x, px.
+    pub x_px: f64,
+    /// Centre y, px.
+    pub y_px: f64,
+    /// Radius, px.
+    pub r_px: f64,
+    /// Standard error of each centre coordinate, px.
+    pub sigma_px: f64,
+    /// Quality 0–1.
+    pub quality: f64,
+    /// Status name.
+    pub status: &'static str,
+    /// Along the surface, down-slope, m (origin at the contact column).
+    pub x_m: f64,
+    /// Above the surface line, m.
+    pub y_m: f64,
+}
+
+/// A tracked clip.
+#[derive(Debug, Clone)]
+pub struct Track {
+    /// One fix per decoded frame, in order.
+    pub fixes: Vec<BallFix>,
+    /// The surface line, if found.
+    pub surface: Option<SurfaceLine>,
+    /// The scale, if the ball was measured in free flight.
+    pub scale: Option<Scale>,
+    /// Things a person should know, each naming its frame.
+    pub warnings: Vec<String>,
+    /// Seconds spent decoding (wall time waiting for frames) and tracking.
+    pub seconds_waiting: f64,
+    /// Seconds spent tracking.
+    pub seconds_tracking: f64,
+    /// True if down-slope is −x in the image.
+    pub downslope_negative_x: bool,
+}
+
+impl Track {
+    /// The rows of `trajectories/<clip>.csv`: pixels, and the local frame where the scale is known. The
+    /// local frame's axes follow the image (the camera is taken as aligned with the surface, as in the
+    /// paper; the surface line's tilt, reported separately, says how far that holds); its origin is on the
+    /// surface line below the lowest measured centre.
+    pub fn rows(&self) -> Vec<TrajectoryRow> {
+        let lowest = self
+            .fixes
+            .iter()
+            .filter(|f| f.status.measured())
+            .max_by(|a, b| a.y_px.total_cmp(&b.y_px))
+            .map(|f| f.x_px);
+        let origin = match (lowest, &self.surface) {
+            (Some(x), Some(line)) => Some((x, line.y_at(x))),
+            _ => None,
+        };
+        let sign = if self.downslope_negative_x { -1.0 } else { 1.0 };
+        self.fixes
+            .iter()
+            .map(|f| {
+                let (x_m, y_m) = match (origin, &self.scale) {
+                    (Some((x0, y0)), Some(s)) if f.status.measured() => {
+                        (sign * (f.x_px - x0) * s.m_per_px, (y0 - f.y_px) * s.m_per_px)
+                    }
+                    _ => (f64::NAN, f64::NAN),
+                };
+                TrajectoryRow {
+                    frame: f.frame,
+                    t_s: f.t_s,
+                    x_px: f.x_px,
+                    y_px: f.y_px,
+                    r_px: f.r_px,
+                    sigma_px: f.sigma_px,
+                    quality: f.quality,
+                    status: f.status.name(),
+                    x_m,
+                    y_m,
+                }
+            })
+            .collect()
+    }
+}
+
+fn with_plane<R>(px: &GrayPixels, f: impl FnOnce(PlaneRef<'_>) -> R) -> R {
+    let (w, h) = (px.width() as usize, px.height() as usize);
+    match px {
+        GrayPixels::U8(img) => f(PlaneRef::U8(Plane::new(img.as_raw(), w, h))),
+        GrayPixels::U16(img) => f(PlaneRef::U16(Plane::new(img.as_raw(), w, h))),
+    }
+}
+
+/// A plane of either bit depth.
+enum PlaneRef<'a> {
+    U8(Plane<'a, u8>),
+    U16(Plane<'a, u16>),
+}
+
+macro_rules! on_plane {
+    ($p:expr, $v:ident => $body:expr) => {
+        match $p {
+            PlaneRef::U8($v) => $body,
+            PlaneRef::U16($v) => $body,
+        }
+    };
+}
+
+/// The ball seen at (t, x, y): s, px, px.
+type Sighting = (f64, f64, f64);
+
+/// What acquisition learnt: the ball's radius range in px, and two positions (t, x, y) if it moved.
+struct Acquired {
+    radius: (f64, f64),
+    seed: Option<(Sighting, Sighting)>,
+}
+
+/// The ball's radius range in px, told from other circles by its motion between two frames.
+fn acquire(clip: &Clip, opts: &ClipTracking, warnings: &mut Vec<String>) -> Result<Option<Acquired>, TrackError> {
+    if let Some(scale) = opts.scale_hint_m_per_px {
+        let r = opts.ball_diameter_m / (2.0 * scale);
+        return Ok(Some(Acquired {
+            radius: (0.8 * r, 1.2 * r),
+            seed: None,
+        }));
+    }
+    let n = clip.len();
+    let (w, h) = clip.dimensions();
+    let det = CircleDetection {
+        min_radius: 8.0,
+        max_radius: w.min(h) as f64 / 2.0,
+        ..CircleDetection::default()
+    };
+    let circles_in = |k: usize| -> Result<Vec<crate::Circle>, TrackError> {
+        let frame = clip.read(k, opts.read.png_decoder).expect("index in range")?;
+        Ok(with_plane(
+            &frame.pixels,
+            |p| on_plane!(p, p => detect_circles(&p, &det)),
+        ))
+    };
+    let gap = 10.min(n.saturating_sub(1)).max(1);
+    let mut k = 0;
+    let mut fallback = None;
+    while k + gap < n && k <= n / 2 {
+        let (a, b) = (circles_in(k)?, circles_in(k + gap)?);
+        let good = |c: &&crate::Circle| c.support > 0.5;
+        let mut best: Option<(f64, crate::Circle, crate::Circle)> = None; // (support, here, there)
+        for ca in a.iter().filter(good) {
+            for cb in b.iter().filter(good) {
+                let same_size = (ca.r - cb.r).abs() <= 0.05 * ca.r + 1.0;
+                let moved = (ca.x - cb.x).hypot(ca.y - cb.y);
+                if same_size && moved > 1.5 && moved < 0.5 * w as f64 && best.is_none_or(|(s, _, _)| ca.support > s) {
+                    best = Some((ca.support, *ca, *cb));
+                }
+            }
+        }
+        if let Some((_, ca, cb)) = best {
+            let r = 0.5 * (ca.r + cb.r);
+            // `k` counts files; time follows frame indices, which count dropped frames too.
+            let t = |pos: usize| clip.time_of(clip.files()[pos].index);
+            let seed = ((t(k), ca.x, ca.y), (t(k + gap), cb.x, cb.y));
+            return Ok(Some(Acquired {
+                radius: (0.85 * r, 1.15 * r),
+                seed: Some(seed),
+            }));
+        }
+        if fallback.is_none() {
+            fallback = a.iter().find(|c| c.support > 0.6).map(|c| c.r);
+        }
+        k += gap;
+    }
+    if let Some(r) = fallback {
+        warnings.push(format!(
+            "could not tell the ball by its motion; tracking the clearest circle (radius {r:.1} px) — give the scale to be sure"
+        ));
+        return Ok(Some(Acquired {
+            radius: (0.85 * r, 1.15 * r),
+            seed: None,
+        }));
+    }
+    Ok(None)
+}
+
+/// Tracks the ball through `clip`. `progress` is called with (frames done, frames total).
+pub fn track_clip(
+    clip: &Clip,
+    opts: &ClipTracking,
+    mut progress: impl FnMut(usize, usize),
+) -> Result<Track, TrackError> {
+    let mut warnings = Vec::new();
+    let acquired = acquire(clip, opts, &mut warnings)?;
+    let Some(Acquired { radius, seed }) = acquired else {
+        let (w, h) = clip.dimensions();
+        return Err(TrackError::NoBall {
+            clip: clip.dir().display().to_string(),
+            min_radius: 8.0,
+            max_radius: w.min(h) as f64 / 2.0,
+        });
+    };
+    let mut tracker = Tracker::new(TrackOptions {
+        radius_px: Some(radius),
+        ..opts.tracker.clone()
+    });
+    if let Some((a, b)) = seed {
+        tracker.seed(a, b);
+    }
+    let mut fixes = Vec::with_capacity(clip.len());
+    let (mut waiting, mut tracking) = (0.0, 0.0);
+    let total = clip.len();
+    let mut t_wait = Instant::now();
+    for frame in clip.frames_with(&opts.read)? {
+        let frame = frame?;
+        let t_track = Instant::now();
+        waiting += (t_track - t_wait).as_secs_f64();
+        let fix = with_plane(
+            &frame.pixels,
+            |p| on_plane!(p, p => observe(&mut tracker, frame.index as usize, frame.t_s, &p)),
+        );
+        fixes.push(fix);
+        t_wait = Instant::now();
+        tracking += (t_wait - t_track).as_secs_f64();
+        progress(fixes.len(), total);
+    }
+    warnings.extend(tracker.warnings().iter().cloned());
+    let measured = fixes.iter().filter(|f| f.status.measured()).count();
+    if measured == 0 {
+        return Err(TrackError::NoBall {
+            clip: clip.dir().display().to_string(),
+            min_radius: radius.0,
+            max_radius: radius.1,
+        });
+    }
+    let absent = fixes.iter().filter(|f| f.status == Status::Absent).count();
+    if absent > 0 {
+        warnings.push(format!("ball not found in {absent} of {} frames", fixes.len()));
+    }
+    let scale = scale_from(&fixes, tracker.surface(), opts.ball_diameter_m);
+    Ok(Track {
+        fixes,
+        surface: tracker.surface().copied(),
+        scale,
+        warnings,
+        seconds_waiting: waiting,
+        seconds_tracking: tracking,
+        downslope_negative_x: opts.downslope_negative_x,
+    })
+}
+
+fn observe<P: Pixel>(tracker: &mut Tracker, frame: usize, t_s: f64, p: &Plane<P>) -> BallFix {
+    tracker.observe(frame, t_s, p)
+}
+
+/// m/px from the mean radius of frames where the whole ball is clear of the surface and the border.
+fn scale_from(fixes: &[BallFix], surface: Option<&SurfaceLine>, diameter: f64) -> Option<Scale> {
+    let radii: Vec<f64> = fixes
+        .iter()
+        .filter(|f| f.status == Status::Ok)
+        .filter(|f| surface.is_none_or(|l| f.y_px + f.r_px < l.y_at(f.x_px) - 3.0))
+        .map(|f| f.r_px)
+        .collect();
+    if radii.len() < 3 {
+        return None;
+    }
+    let n = radii.len() as f64;
+    let mean = radii.iter().sum::<f64>() / n;
+    let sd = (radii.iter().map(|r| (r - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+    let m_per_px = diameter / (2.0 * mean);
+    Some(Scale {
+        m_per_px,
+        sigma_m_per_px: m_per_px * (sd / n.sqrt()) / mean,
+        radius_px: mean,
+        frames: radii.len(),
+    })
+}

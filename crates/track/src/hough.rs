@@ -1,0 +1,288 @@
+//! Circle candidates in a whole frame by gradient voting (the Hough transform the paper used, in the
+//! gradient form): every strong edge pixel votes for the centres lying along its gradient line at every
+//! radius of the range; the ball's centre collects the votes of its whole rim.
+//!
+//! Cost: O(pixels) for the gradient plus O(edges × radius range) votes, on an image downsampled so that
+//! the smallest radius is still ≥ 12 px; ≈ 1–3 ms for a 512×512 frame. Used once per clip and after a loss.
+
+use crate::plane::{Pixel, Plane};
+
+/// Options of [`detect_circles`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct CircleDetection {
+    /// Smallest radius to look for, px.
+    pub min_radius: f64,
+    /// Largest radius to look for, px.
+    pub max_radius: f64,
+    /// Fraction of the pixels, the strongest gradients, that vote (default 0.06).
+    pub edge_fraction: f64,
+    /// Most candidates returned (default 8).
+    pub max_candidates: usize,
+}
+
+impl Default for CircleDetection {
+    fn default() -> Self {
+        CircleDetection {
+            min_radius: 10.0,
+            max_radius: 200.0,
+            edge_fraction: 0.06,
+            max_candidates: 8,
+        }
+    }
+}
+
+/// A circle candidate.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Circle {
+    /// Centre x, px.
+    pub x: f64,
+    /// Centre y, px.
+    pub y: f64,
+    /// Radius, px.
+    pub r: f64,
+    /// Fraction of the circle's in-frame circumference with a radial edge on it (0–1).
+    pub support: f64,
+}
+
+/// Gradient field of a (downsampled) image.
+struct Gradients {
+    w: usize,
+    h: usize,
+    gx: Vec<f32>,
+    gy: Vec<f32>,
+    mag: Vec<f32>,
+}
+
+fn downsample<P: Pixel>(img: &Plane<P>, f: usize) -> (Vec<f32>, usize, usize) {
+    let (w, h) = (img.width / f, img.height / f);
+    let mut out = vec![0.0f32; w * h];
+    let norm = 1.0 / (f * f) as f32;
+    for y in 0..h {
+        for x in 0..w {
+            let mut s = 0.0;
+            for dy in 0..f {
+                for dx in 0..f {
+                    s += img.at(x * f + dx, y * f + dy);
+                }
+            }
+            out[y * w + x] = s * norm;
+        }
+    }
+    (out, w, h)
+}
+
+fn sobel(p: &[f32], w: usize, h: usize) -> Gradients {
+    let mut g = Gradients {
+        w,
+        h,
+        gx: vec![0.0; w * h],
+        gy: vec![0.0; w * h],
+        mag: vec![0.0; w * h],
+    };
+    for y in 1..h.saturating_sub(1) {
+        for x in 1..w - 1 {
+            let i = y * w + x;
+            let (a, b, c) = (p[i - w - 1], p[i - w], p[i - w + 1]);
+            let (d, f) = (p[i - 1], p[i + 1]);
+            let (e, k, l) = (p[i + w - 1], p[i + w], p[i + w + 1]);
+            let gx = (c + 2.0 * f + l) - (a + 2.0 * d + e);
+            let gy = (e + 2.0 * k + l) - (a + 2.0 * b + c);
+            g.gx[i] = gx;
+            g.gy[i] = gy;
+            g.mag[i] = gx.hypot(gy);
+        }
+    }
+    g
+}
+
+/// Circle candidates in `img`, best supported first.
+pub fn detect_circles<P: Pixel>(img: &Plane<P>, opts: &CircleDetection) -> Vec<Circle> {
+    if img.width < 8 || img.height < 8 || !(opts.max_radius >= opts.min_radius && opts.min_radius > 0.0) {
+        return Vec::new();
+    }
+    // Downsample while the smallest radius stays ≥ 12 px: fewer votes, less texture noise.
+    let mut f = 1;
+    while opts.min_radius / (2 * f) as f64 >= 12.0 && f < 8 {
+        f *= 2;
+    }
+    let (p, w, h) = downsample(img, f);
+    let g = sobel(&p, w, h);
+    let edges = strong_edges(&g, opts.edge_fraction);
+    if edges.is_empty() {
+        return Vec::new();
+    }
+    let (rmin, rmax) = (opts.min_radius / f as f64, opts.max_radius / f as f64);
+    // Vote along both directions of the gradient (the ball may be brighter or darker than what is behind).
+    let mut acc = vec![0.0f32; w * h];
+    for &i in &edges {
+        let (x, y) = ((i % w) as f64, (i / w) as f64);
+        let m = g.mag[i] as f64;
+        let (ux, uy) = (g.gx[i] as f64 / m, g.gy[i] as f64 / m);
+        for sign in [-1.0, 1.0] {
+            let mut r = rmin;
+            while r <= rmax {
+                let cx = (x + sign * r * ux).round();
+                let cy = (y + sign * r * uy).round();
+                if cx >= 0.0 && cy >= 0.0 && (cx as usize) < w && (cy as usize) < h {
+                    acc[cy as usize * w + cx as usize] += 1.0;
+                }
+                r += 1.0;
+            }
+        }
+    }
+    let acc = box3(&acc, w, h);
+    let peaks = local_maxima(&acc, w, h, (rmin * 0.5).max(2.0) as usize, opts.max_candidates * 3);
+    let mut out: Vec<Circle> = peaks
+        .into_iter()
+        .filter_map(|(cx, cy)| radius_at(&g, &edges, cx, cy, rmin, rmax))
+        .map(|(cx, cy, r, support)| Circle {
+            x: (cx + 0.5) * f as f64 - 0.5,
+            y: (cy + 0.5) * f as f64 - 0.5,
+            r: r * f as f64,
+            support,
+        })
+        .collect();
+    out.sort_by(|a, b| b.support.total_cmp(&a.support));
+    out.truncate(opts.max_candidates);
+    out
+}
+
+/// Indices of the strongest `fraction` of gradient magnitudes that are also local maxima across the edge.
+fn strong_edges(g: &Gradients, fraction: f64) -> Vec<usize> {
+    let mut mags: Vec<f32> = g.mag.iter().copied().filter(|m| *m > 0.0).collect();
+    if mags.is_empty() {
+        return Vec::new();
+    }
+    let k = ((mags.len() as f64 * (1.0 - fraction.clamp(0.001, 1.0))) as usize).min(mags.len() - 1);
+    let (_, thr, _) = mags.select_nth_unstable_by(k, f32::total_cmp);
+    let thr = thr.max(1e-3);
+    let w = g.w;
+    let mut out = Vec::new();
+    for y in 1..g.h.saturating_sub(1) {
+        for x in 1..w - 1 {
+            let i = y * w + x;
+            let m = g.mag[i];
+            if m < thr {
+                continue;
+            }
+            // Non-maximum suppression across the edge, gradient direction quantised to 45°.
+            let (ax, ay) = (g.gx[i].abs(), g.gy[i].abs());
+            let (di, dj) = if ax > 2.414 * ay {
+                (1isize, 0isize)
+            } else if ay > 2.414 * ax {
+                (0, 1)
+            } else if (g.gx[i] > 0.0) == (g.gy[i] > 0.0) {
+                (1, 1)
+            } else {
+                (1, -1)
+            };
+            let off = dj * w as isize + di;
+            let (a, b) = (g.mag[(i as isize + off) as usize], g.mag[(i as isize - off) as usize]);
+            if m >= a && m >= b {
+                out.push(i);
+            }
+        }
+    }
+    out
+}
+
+fn box3(a: &[f32], w: usize, h: usize) -> Vec<f32> {
+    let mut out = vec![0.0; w * h];
+    for y in 1..h.saturating_sub(1) {
+        for x in 1..w - 1 {
+            let mut s = 0.0;
+            for dy in 0..3 {
+                for dx in 0..3 {
+                    s += a[(y + dy - 1) * w + x + dx - 1];
+                }
+            }
+            out[y * w + x] = s;
+        }
+    }
+    out
+}
+
+/// The `n` highest local maxima at least `sep` px apart, with sub-cell centres.
+fn local_maxima(acc: &[f32], w: usize, h: usize, sep: usize, n: usize) -> Vec<(f64, f64)> {
+    let mut cells: Vec<(f32, usize)> = acc
+        .iter()
+        .enumerate()
+        .filter(|(_, v)| **v > 0.0)
+        .map(|(i, v)| (*v, i))
+        .collect();
+    cells.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let mut out: Vec<(usize, usize)> = Vec::new();
+    for (_, i) in cells {
+        if out.len() >= n {
+            break;
+        }
+        let (x, y) = (i % w, i / w);
+        if x == 0 || y == 0 || x + 1 >= w || y + 1 >= h {
+            continue;
+        }
+        if out.iter().all(|&(ox, oy)| ox.abs_diff(x).max(oy.abs_diff(y)) > sep) {
+            out.push((x, y));
+        }
+    }
+    out.into_iter()
+        .map(|(x, y)| {
+            let v = |dx: isize, dy: isize| acc[(y as isize + dy) as usize * w + (x as isize + dx) as usize] as f64;
+            let sub = |m: f64, c: f64, p: f64| {
+                let d = m - 2.0 * c + p;
+                if d < 0.0 {
+                    (0.5 * (m - p) / d).clamp(-0.5, 0.5)
+                } else {
+                    0.0
+                }
+            };
+            (
+                x as f64 + sub(v(-1, 0), v(0, 0), v(1, 0)),
+                y as f64 + sub(v(0, -1), v(0, 0), v(0, 1)),
+            )
+        })
+        .collect()
+}
+
+/// The radius around (cx, cy) best supported by radial edges, and the supported fraction of the in-frame
+/// circumference.
+fn radius_at(g: &Gradients, edges: &[usize], cx: f64, cy: f64, rmin: f64, rmax: f64) -> Option<(f64, f64, f64, f64)> {
+    let bins = (rmax - rmin).ceil() as usize + 3;
+    let mut hist = vec![0.0f64; bins];
+    for &i in edges {
+        let (x, y) = ((i % g.w) as f64 - cx, (i / g.w) as f64 - cy);
+        let d = x.hypot(y);
+        if d < rmin - 1.0 || d > rmax + 1.0 || d == 0.0 {
+            continue;
+        }
+        let m = g.mag[i] as f64;
+        let cos = (x * g.gx[i] as f64 + y * g.gy[i] as f64) / (d * m);
+        if cos.abs() < 0.9 {
+            continue;
+        }
+        let b = (d - rmin + 1.0).round() as usize;
+        if b < bins {
+            hist[b] += 1.0;
+        }
+    }
+    let (best, _) = hist
+        .windows(3)
+        .enumerate()
+        .map(|(i, w)| (i + 1, w[0] + w[1] + w[2]))
+        .max_by(|a, b| a.1.total_cmp(&b.1))?;
+    let r = best as f64 + rmin - 1.0;
+    let count = hist[best - 1] + hist[best] + hist[best + 1];
+    // Expected edge pixels on the in-frame part of the circumference (about one per pixel of arc).
+    let steps = 360;
+    let inside = (0..steps)
+        .filter(|k| {
+            let a = *k as f64 * std::f64::consts::TAU / steps as f64;
+            let (x, y) = (cx + r * a.cos(), cy + r * a.sin());
+            x >= 1.0 && y >= 1.0 && x < (g.w - 1) as f64 && y < (g.h - 1) as f64
+        })
+        .count();
+    if inside < steps / 4 {
+        return None;
+    }
+    let expected = std::f64::consts::TAU * r * inside as f64 / steps as f64;
+    Some((cx, cy, r, (count / expected).min(1.0)))
+}

@@ -1,0 +1,30 @@
+//! Finds the ball in every frame of a high-speed clip and measures its centre to a small fraction of a pixel.
+//!
+//! A gradient-voting Hough transform finds circle candidates in a whole frame (first frame, or after the
+//! ball was lost); from then on each frame costs tens of microseconds: the centre predicted from the
+//! previous frames seeds edge searches along rays, and a robust geometric circle fit (Tukey-weighted
+//! Gauss–Newton) turns the edge points into a centre, a radius and their uncertainty, ignoring the part of
+//! the rim hidden by or pressed into the surface. Frames where the ball is cut by the border, absent or
+//! ambiguous are flagged, never invented. The same crate finds the surface line and its tilt, and turns the
+//! ball's apparent radius in free flight into the clip's scale.
+//!
+//! Everything works on [`Plane`], a borrowed 8- or 16-bit grayscale image, so no frame is copied.
+
+mod clip;
+mod fit;
+mod hough;
+mod plane;
+mod refine;
+mod surface;
+mod tracker;
+
+pub use clip::{ClipTracking, Scale, Track, TrackError, TrajectoryRow, track_clip};
+pub use fit::{CircleFit, fit_circle};
+pub use hough::{Circle, CircleDetection, detect_circles};
+pub use plane::{Pixel, Plane};
+pub use refine::{EdgeSearch, Refined, refine_circle};
+pub use surface::{SurfaceLine, find_surface_line};
+pub use tracker::{BallFix, Status, TrackOptions, Tracker};
+
+#[doc(hidden)]
+pub mod testutil;

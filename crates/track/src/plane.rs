@@ -1,0 +1,68 @@
+//! A borrowed grayscale image of 8- or 16-bit pixels.
+
+/// A pixel type the tracker reads. Values are scaled to 0–255 whatever the bit depth, so thresholds and
+/// contrasts mean the same for 8- and 16-bit clips.
+pub trait Pixel: Copy + Send + Sync + 'static {
+    /// The value on a 0–255 scale.
+    fn level(self) -> f32;
+}
+
+impl Pixel for u8 {
+    #[inline(always)]
+    fn level(self) -> f32 {
+        self as f32
+    }
+}
+
+impl Pixel for u16 {
+    #[inline(always)]
+    fn level(self) -> f32 {
+        self as f32 * (1.0 / 257.0)
+    }
+}
+
+/// A borrowed row-major grayscale image: `data[y * width + x]`, pixel centres at integer coordinates.
+#[derive(Debug, Clone, Copy)]
+pub struct Plane<'a, P> {
+    /// Pixels, row after row.
+    pub data: &'a [P],
+    /// Width, px.
+    pub width: usize,
+    /// Height, px.
+    pub height: usize,
+}
+
+impl<'a, P: Pixel> Plane<'a, P> {
+    /// Wraps `data`.
+    ///
+    /// # Panics
+    /// If `data.len() != width * height`.
+    pub fn new(data: &'a [P], width: usize, height: usize) -> Self {
+        assert_eq!(data.len(), width * height, "plane size");
+        Plane { data, width, height }
+    }
+
+    /// The pixel at integer coordinates (no bounds check beyond the slice's).
+    #[inline(always)]
+    pub fn at(&self, x: usize, y: usize) -> f32 {
+        self.data[y * self.width + x].level()
+    }
+
+    /// Bilinear interpolation at (x, y); `None` outside the image (the last row/column excluded).
+    #[inline(always)]
+    pub fn sample(&self, x: f32, y: f32) -> Option<f32> {
+        if !(x >= 0.0 && y >= 0.0) {
+            return None;
+        }
+        let (x0, y0) = (x as usize, y as usize);
+        if x0 + 1 >= self.width || y0 + 1 >= self.height {
+            return None;
+        }
+        let (fx, fy) = (x - x0 as f32, y - y0 as f32);
+        let i = y0 * self.width + x0;
+        let d = self.data;
+        let top = d[i].level() + fx * (d[i + 1].level() - d[i].level());
+        let bottom = d[i + self.width].level() + fx * (d[i + self.width + 1].level() - d[i + self.width].level());
+        Some(top + fy * (bottom - top))
+    }
+}

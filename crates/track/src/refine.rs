@@ -1,0 +1,183 @@
+//! Sub-pixel centre and radius from edge points found along rays from a first guess.
+//!
+//! Along each of `rays` directions the image is sampled (bilinear) across the expected rim; the edge is the
+//! strongest change of brightness, located to a fraction of a pixel by a parabola through the derivative's
+//! peak. Rays whose rim point lies at or below the surface line are skipped (that part of the ball is
+//! pressed into or hidden by the surface), and so are rays leaving the image. The edge points then go to the
+//! robust circle fit. Cost: rays × samples bilinear reads (128 × 17 ≈ 2,200, ≈ 10 µs) plus the fit.
+
+use crate::fit::{CircleFit, fit_circle};
+use crate::plane::{Pixel, Plane};
+use crate::surface::SurfaceLine;
+
+/// Options of [`refine_circle`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct EdgeSearch {
+    /// Number of rays (default 128).
+    pub rays: usize,
+    /// Half-width of the search across the expected rim, px (default 4).
+    pub half_width: f64,
+    /// Sampling step along a ray, px (default 0.5).
+    pub step: f64,
+    /// Smallest brightness step that counts as an edge, on the 0–255 scale per px (default 2).
+    pub min_contrast: f32,
+    /// Rays whose rim point lies less than this above the surface line are skipped, px (default 2).
+    pub surface_margin: f64,
+}
+
+impl Default for EdgeSearch {
+    fn default() -> Self {
+        EdgeSearch {
+            rays: 128,
+            half_width: 4.0,
+            step: 0.5,
+            min_contrast: 2.0,
+            surface_margin: 2.0,
+        }
+    }
+}
+
+/// A refined circle and what it was made of.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Refined {
+    /// The fit.
+    pub fit: CircleFit,
+    /// Rays that gave an edge point.
+    pub rays_with_edge: usize,
+    /// Rays skipped because they left the image.
+    pub rays_outside: usize,
+    /// Rays skipped because the rim there is at or below the surface line.
+    pub rays_hidden: usize,
+    /// Rays searched.
+    pub rays: usize,
+    /// Median brightness step at the edge points, 0–255 scale per px.
+    pub contrast: f32,
+}
+
+impl Refined {
+    /// A 0–1 quality score: the fraction of rays whose edge point the fit kept, times a contrast factor
+    /// that reaches 1 at 10 levels per px.
+    pub fn quality(&self) -> f64 {
+        let kept = self.fit.inliers as f64 / self.rays as f64;
+        kept * (self.contrast as f64 / 10.0).min(1.0)
+    }
+}
+
+/// Refines the circle (`x`, `y`, `r`) in px: edge points along rays, then a robust fit. Runs twice, the
+/// second time from the first fit with half the search width. `None` when too few edges are found.
+pub fn refine_circle<P: Pixel>(
+    img: &Plane<P>,
+    x: f64,
+    y: f64,
+    r: f64,
+    search: &EdgeSearch,
+    surface: Option<&SurfaceLine>,
+) -> Option<Refined> {
+    let mut fit = refine_once(img, x, y, r, search, search.half_width, surface)?;
+    // A guess far off the rim puts the window astride the wrong places: re-centre until it settles.
+    for _ in 0..3 {
+        let moved = (fit.fit.x - x).hypot(fit.fit.y - y).max((fit.fit.r - r).abs());
+        if moved < 0.25 * search.half_width {
+            break;
+        }
+        let (x, y, r) = (fit.fit.x, fit.fit.y, fit.fit.r);
+        match refine_once(img, x, y, r, search, search.half_width, surface) {
+            Some(f) => fit = f,
+            None => break,
+        }
+    }
+    let narrow = (search.half_width * 0.5).max(2.0);
+    refine_once(img, fit.fit.x, fit.fit.y, fit.fit.r, search, narrow, surface).or(Some(fit))
+}
+
+fn refine_once<P: Pixel>(
+    img: &Plane<P>,
+    x: f64,
+    y: f64,
+    r: f64,
+    search: &EdgeSearch,
+    half_width: f64,
+    surface: Option<&SurfaceLine>,
+) -> Option<Refined> {
+    let n = search.rays.max(8);
+    let samples = ((2.0 * half_width / search.step).round() as usize).max(4) + 1;
+    let mut profile = vec![0.0f32; samples];
+    let mut points = Vec::with_capacity(n);
+    let mut contrasts = Vec::with_capacity(n);
+    let (mut outside, mut hidden) = (0, 0);
+    for k in 0..n {
+        let a = std::f64::consts::TAU * k as f64 / n as f64;
+        let (c, s) = (a.cos(), a.sin());
+        let start = r - half_width;
+        // The search stops short of the surface line: below it is the band, whose own edge must not be
+        // taken for the ball's rim.
+        let mut len = samples;
+        if let Some(line) = surface {
+            let (rx, ry) = (x + r * c, y + r * s);
+            if ry > line.y_at(rx) - search.surface_margin {
+                hidden += 1;
+                continue;
+            }
+            let towards = s - line.slope * c;
+            if towards > 1e-9 {
+                let reach = (line.y_at(x) - search.surface_margin - y) / towards;
+                len = len.min(((reach - start) / search.step).floor().max(0.0) as usize + 1);
+                if len < samples / 2 + 3 {
+                    hidden += 1;
+                    continue;
+                }
+            }
+        }
+        let profile = &mut profile[..len];
+        let mut ok = true;
+        for (j, p) in profile.iter_mut().enumerate() {
+            let d = start + j as f64 * search.step;
+            match img.sample((x + d * c) as f32, (y + d * s) as f32) {
+                Some(v) => *p = v,
+                None => {
+                    ok = false;
+                    break;
+                }
+            }
+        }
+        if !ok {
+            outside += 1;
+            continue;
+        }
+        // Central differences; the edge is the largest |change|.
+        let (mut best, mut best_j) = (0.0f32, 0);
+        for j in 1..len - 1 {
+            let d = (profile[j + 1] - profile[j - 1]).abs();
+            if d > best {
+                best = d;
+                best_j = j;
+            }
+        }
+        let per_px = best / (2.0 * search.step as f32);
+        if per_px < search.min_contrast || best_j < 2 || best_j + 3 > len {
+            continue;
+        }
+        let m = |j: usize| (profile[j + 1] - profile[j - 1]).abs() as f64;
+        let (a0, a1, a2) = (m(best_j - 1), m(best_j), m(best_j + 1));
+        let den = a0 - 2.0 * a1 + a2;
+        let off = if den < 0.0 {
+            (0.5 * (a0 - a2) / den).clamp(-0.5, 0.5)
+        } else {
+            0.0
+        };
+        let d = start + (best_j as f64 + off) * search.step;
+        points.push([x + d * c, y + d * s]);
+        contrasts.push(per_px);
+    }
+    let fit = fit_circle(&points, x, y, r)?;
+    let mid = contrasts.len() / 2;
+    let contrast = *contrasts.select_nth_unstable_by(mid, f32::total_cmp).1;
+    Some(Refined {
+        fit,
+        rays_with_edge: points.len(),
+        rays_outside: outside,
+        rays_hidden: hidden,
+        rays: n,
+        contrast,
+    })
+}

@@ -1,0 +1,119 @@
+//! Small synthetic frames for tests: a shaded disc with sub-pixel centre over a gradient backdrop, an
+//! optional textured surface band that hides the disc below its top edge, distractor discs and noise.
+
+/// What to draw.
+#[derive(Debug, Clone)]
+pub struct Scene {
+    /// Image width and height, px.
+    pub size: (usize, usize),
+    /// Ball centre and radius, px.
+    pub ball: (f64, f64, f64),
+    /// Ball brightness at its centre, 0–255.
+    pub ball_level: f64,
+    /// Backdrop brightness at the top and bottom, 0–255.
+    pub backdrop: (f64, f64),
+    /// Surface line height at the centre column and its slope (dy/dx); `None` for no surface.
+    pub surface: Option<(f64, f64)>,
+    /// Mean brightness of the surface band, 0–255; its texture amplitude.
+    pub band: (f64, f64),
+    /// Other discs (x, y, r, level).
+    pub distractors: Vec<(f64, f64, f64, f64)>,
+    /// Gaussian noise standard deviation, 0–255 scale.
+    pub noise: f64,
+    /// Noise seed.
+    pub seed: u64,
+}
+
+impl Default for Scene {
+    fn default() -> Self {
+        Scene {
+            size: (256, 256),
+            ball: (120.3, 90.7, 40.0),
+            ball_level: 200.0,
+            backdrop: (70.0, 110.0),
+            surface: None,
+            band: (90.0, 25.0),
+            distractors: Vec::new(),
+            noise: 2.0,
+            seed: 1,
+        }
+    }
+}
+
+struct Rng(u64);
+impl Rng {
+    fn uniform(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((self.0 >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    }
+    fn gauss(&mut self) -> f64 {
+        let (u, v) = (self.uniform(), self.uniform());
+        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+    }
+}
+
+/// Fraction of pixel (x, y) covered by the disc, by 8×8 supersampling near the edge.
+fn coverage(x: usize, y: usize, cx: f64, cy: f64, r: f64) -> f64 {
+    let d = (x as f64 - cx).hypot(y as f64 - cy);
+    if d < r - 1.0 {
+        return 1.0;
+    }
+    if d > r + 1.0 {
+        return 0.0;
+    }
+    let mut n = 0;
+    for i in 0..8 {
+        for j in 0..8 {
+            let (sx, sy) = (
+                x as f64 - 0.5 + (i as f64 + 0.5) / 8.0,
+                y as f64 - 0.5 + (j as f64 + 0.5) / 8.0,
+            );
+            if (sx - cx).hypot(sy - cy) <= r {
+                n += 1;
+            }
+        }
+    }
+    n as f64 / 64.0
+}
+
+/// Renders `scene` as 8-bit pixels, row-major.
+pub fn render(scene: &Scene) -> Vec<u8> {
+    let (w, h) = scene.size;
+    let mut rng = Rng(scene.seed.wrapping_add(0x5851F42D4C957F2D));
+    let tex: Vec<f64> = (0..w * h).map(|_| rng.gauss()).collect();
+    let (cx, cy, r) = scene.ball;
+    let xc = (w as f64 - 1.0) / 2.0;
+    let mut out = vec![0u8; w * h];
+    for y in 0..h {
+        for x in 0..w {
+            let t = y as f64 / (h - 1) as f64;
+            let mut v = scene.backdrop.0 + (scene.backdrop.1 - scene.backdrop.0) * t;
+            for &(dx, dy, dr, level) in &scene.distractors {
+                let c = coverage(x, y, dx, dy, dr);
+                v = v * (1.0 - c) + level * c;
+            }
+            // Shaded ball: brighter towards the upper left.
+            let c = coverage(x, y, cx, cy, r);
+            if c > 0.0 {
+                let (nx, ny) = ((x as f64 - cx) / r, (y as f64 - cy) / r);
+                let shade = 0.75 + 0.25 * (-0.5 * nx - 0.6 * ny).clamp(-1.0, 1.0);
+                v = v * (1.0 - c) + scene.ball_level * shade * c;
+            }
+            if let Some((y0, slope)) = scene.surface {
+                let edge = y0 + slope * (x as f64 - xc);
+                // Anti-aliased top edge of the band, which hides whatever is behind it.
+                let cov = (y as f64 + 0.5 - edge).clamp(0.0, 1.0);
+                if cov > 0.0 {
+                    let band = scene.band.0 + scene.band.1 * tex[y * w + x] * 0.5;
+                    v = v * (1.0 - cov) + band * cov;
+                }
+            }
+            v += scene.noise * rng.gauss();
+            out[y * w + x] = v.round().clamp(0.0, 255.0) as u8;
+        }
+    }
+    out
+}

@@ -1,0 +1,323 @@
+//! Frame-to-frame tracking: predict, refine around the prediction, re-detect when that fails, and say
+//! what happened in every frame.
+
+use crate::hough::{Circle, CircleDetection, detect_circles};
+use crate::plane::{Pixel, Plane};
+use crate::refine::{EdgeSearch, Refined, refine_circle};
+use crate::surface::{SurfaceLine, find_surface_line};
+use serde::{Deserialize, Serialize};
+
+/// What the tracker could say about the ball in a frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Status {
+    /// Measured.
+    Ok,
+    /// Measured from less than half of its rim (the rest hidden).
+    Occluded,
+    /// Part of the ball is outside the frame; measured from the visible arc.
+    CutByBorder,
+    /// Not found.
+    Absent,
+    /// More than one ball-like circle and nothing to tell which is the ball.
+    Ambiguous,
+}
+
+impl Status {
+    /// Name as written in files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Status::Ok => "ok",
+            Status::Occluded => "occluded",
+            Status::CutByBorder => "cut_by_border",
+            Status::Absent => "absent",
+            Status::Ambiguous => "ambiguous",
+        }
+    }
+
+    /// True if the frame gives a usable centre.
+    pub fn measured(self) -> bool {
+        matches!(self, Status::Ok | Status::Occluded | Status::CutByBorder)
+    }
+}
+
+/// The ball in one frame (NaN coordinates when not measured).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct BallFix {
+    /// Frame index (position in the clip, dropped frames counted).
+    pub frame: usize,
+    /// Time, s.
+    pub t_s: f64,
+    /// Centre x, px.
+    pub x_px: f64,
+    /// Centre y, px (down).
+    pub y_px: f64,
+    /// Radius, px.
+    pub r_px: f64,
+    /// Standard error of each centre coordinate, px.
+    pub sigma_px: f64,
+    /// Standard error of the radius, px.
+    pub sigma_r_px: f64,
+    /// 0–1 quality score (fraction of the rim used × contrast factor).
+    pub quality: f64,
+    /// What happened.
+    pub status: Status,
+}
+
+impl BallFix {
+    fn absent(frame: usize, t_s: f64, status: Status) -> BallFix {
+        BallFix {
+            frame,
+            t_s,
+            x_px: f64::NAN,
+            y_px: f64::NAN,
+            r_px: f64::NAN,
+            sigma_px: f64::NAN,
+            sigma_r_px: f64::NAN,
+            quality: 0.0,
+            status,
+        }
+    }
+}
+
+/// Options of the [`Tracker`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrackOptions {
+    /// Expected ball radius range, px (from the ball's diameter and an approximate scale), or `None` to
+    /// find it (the ball is then the circle that moves).
+    pub radius_px: Option<(f64, f64)>,
+    /// Edge search around the prediction.
+    pub search: EdgeSearch,
+    /// Largest distance between prediction and measurement before the measurement is not trusted, px.
+    pub max_jump_px: f64,
+}
+
+impl Default for TrackOptions {
+    fn default() -> Self {
+        TrackOptions {
+            radius_px: None,
+            search: EdgeSearch::default(),
+            max_jump_px: 4.0,
+        }
+    }
+}
+
+/// Tracks one ball through a clip, frame by frame, in order.
+#[derive(Debug, Clone)]
+pub struct Tracker {
+    opts: TrackOptions,
+    /// Recent measured (t, x, y).
+    history: Vec<(f64, f64, f64)>,
+    /// Radii measured in free flight (the bottom clear of the surface).
+    flight_radii: Vec<f64>,
+    surface: Option<SurfaceLine>,
+    surface_tries: usize,
+    warnings: Vec<String>,
+    /// Distance between the last prediction and its measurement, px.
+    last_innovation: f64,
+}
+
+/// Candidates within this fraction of the best support count as rivals.
+const RIVAL_SUPPORT: f64 = 0.7;
+
+impl Tracker {
+    /// A tracker with no history.
+    pub fn new(opts: TrackOptions) -> Tracker {
+        Tracker {
+            opts,
+            history: Vec::new(),
+            flight_radii: Vec::new(),
+            surface: None,
+            surface_tries: 0,
+            warnings: Vec::new(),
+            last_innovation: 0.0,
+        }
+    }
+
+    /// Starts the track from two known positions of the ball (t in s, x and y in px), e.g. from the
+    /// acquisition that told the ball from static circles by its motion.
+    pub fn seed(&mut self, a: (f64, f64, f64), b: (f64, f64, f64)) {
+        self.history = vec![a, b];
+    }
+
+    /// Uses `line` as the surface instead of finding it.
+    pub fn set_surface(&mut self, line: SurfaceLine) {
+        self.surface = Some(line);
+    }
+
+    /// The surface line, once found.
+    pub fn surface(&self) -> Option<&SurfaceLine> {
+        self.surface.as_ref()
+    }
+
+    /// Things a person should know (a second ball, a lost track), each naming its frame.
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+
+    /// The radius expected from free flight so far, px.
+    pub fn flight_radius(&self) -> Option<f64> {
+        if self.flight_radii.is_empty() {
+            return None;
+        }
+        let mut r = self.flight_radii.clone();
+        let mid = r.len() / 2;
+        Some(*r.select_nth_unstable_by(mid, f64::total_cmp).1)
+    }
+
+    fn predict(&self, t: f64) -> Option<(f64, f64)> {
+        let h = &self.history;
+        match h.len() {
+            0 => None,
+            1 => Some((h[0].1, h[0].2)),
+            2 => {
+                let (a, b) = (h[0], h[1]);
+                let s = (t - b.0) / (b.0 - a.0);
+                Some((b.1 + s * (b.1 - a.1), b.2 + s * (b.2 - a.2)))
+            }
+            n => {
+                // Quadratic through the last three measurements (Lagrange), evaluated at t.
+                let (a, b, c) = (h[n - 3], h[n - 2], h[n - 1]);
+                let l = |ti: f64, tj: f64, tk: f64| (t - tj) * (t - tk) / ((ti - tj) * (ti - tk));
+                let (la, lb, lc) = (l(a.0, b.0, c.0), l(b.0, a.0, c.0), l(c.0, a.0, b.0));
+                Some((la * a.1 + lb * b.1 + lc * c.1, la * a.2 + lb * b.2 + lc * c.2))
+            }
+        }
+    }
+
+    fn expected_radius(&self) -> Option<f64> {
+        self.flight_radius()
+            .or_else(|| self.opts.radius_px.map(|(a, b)| 0.5 * (a + b)))
+    }
+
+    /// Measures the ball in one frame. Frames must come in time order.
+    pub fn observe<P: Pixel>(&mut self, frame: usize, t_s: f64, img: &Plane<P>) -> BallFix {
+        if self.surface.is_none() && self.surface_tries < 5 {
+            self.surface_tries += 1;
+            self.surface = find_surface_line(img);
+        }
+        // 1. Around the prediction.
+        // The window widens when the last prediction missed (a sudden change of motion).
+        let search = EdgeSearch {
+            half_width: self
+                .opts
+                .search
+                .half_width
+                .max((2.0 * self.last_innovation + 2.0).min(12.0)),
+            ..self.opts.search.clone()
+        };
+        let max_jump = self.opts.max_jump_px.max(2.0 * self.last_innovation + 2.0);
+        if let (Some((px, py)), Some(r)) = (self.predict(t_s), self.expected_radius())
+            && let Some(found) = refine_circle(img, px, py, r, &search, self.surface.as_ref())
+            && self.plausible(&found, px, py, r, max_jump)
+        {
+            self.last_innovation = (found.fit.x - px).hypot(found.fit.y - py);
+            return self.accept(frame, t_s, img, found, Status::Ok);
+        }
+        self.last_innovation = 0.0;
+        // 2. Detection in the whole frame.
+        let (lo, hi) = match (self.expected_radius(), self.opts.radius_px) {
+            (Some(r), _) => (0.85 * r, 1.15 * r),
+            (None, Some(range)) => range,
+            (None, None) => (8.0, img.width.min(img.height) as f64 / 2.0),
+        };
+        let det = CircleDetection {
+            min_radius: lo,
+            max_radius: hi,
+            ..CircleDetection::default()
+        };
+        let mut cands: Vec<(Circle, Refined)> = detect_circles(img, &det)
+            .into_iter()
+            .filter(|c| c.support > 0.4)
+            .filter_map(|c| refine_circle(img, c.x, c.y, c.r, &self.opts.search, self.surface.as_ref()).map(|f| (c, f)))
+            .filter(|(_, f)| f.fit.r >= lo * 0.95 && f.fit.r <= hi * 1.05 && f.quality() > 0.3)
+            .collect();
+        if cands.is_empty() {
+            if !self.history.is_empty() && self.history.len() < 1_000_000 {
+                self.warnings.push(format!("frame {frame}: ball lost"));
+            }
+            self.history.clear();
+            return BallFix::absent(frame, t_s, Status::Absent);
+        }
+        cands.sort_by(|a, b| b.1.quality().total_cmp(&a.1.quality()));
+        let best_q = cands[0].1.quality();
+        let rivals = cands.iter().filter(|c| c.1.quality() >= RIVAL_SUPPORT * best_q).count();
+        match self.predict(t_s) {
+            Some((px, py)) => {
+                // Continuity decides: the candidate nearest the track.
+                let d = |c: &(Circle, Refined)| (c.1.fit.x - px).hypot(c.1.fit.y - py);
+                let (i, _) = cands
+                    .iter()
+                    .enumerate()
+                    .min_by(|a, b| d(a.1).total_cmp(&d(b.1)))
+                    .expect("non-empty");
+                let chosen = cands.swap_remove(i);
+                if rivals > 1 {
+                    self.warnings.push(format!(
+                        "frame {frame}: {rivals} ball-like circles; tracking the one at ({:.1}, {:.1}) because it continues the track",
+                        chosen.1.fit.x, chosen.1.fit.y
+                    ));
+                }
+                self.accept(frame, t_s, img, chosen.1, Status::Ok)
+            }
+            None => {
+                let chosen = cands.swap_remove(0);
+                if rivals > 1 {
+                    self.warnings.push(format!(
+                        "frame {frame}: {rivals} ball-like circles and no track yet to tell which is the ball; taking the clearest at ({:.1}, {:.1})",
+                        chosen.1.fit.x, chosen.1.fit.y
+                    ));
+                    let fix = self.accept(frame, t_s, img, chosen.1, Status::Ambiguous);
+                    return BallFix {
+                        status: Status::Ambiguous,
+                        ..fix
+                    };
+                }
+                self.accept(frame, t_s, img, chosen.1, Status::Ok)
+            }
+        }
+    }
+
+    fn plausible(&self, f: &Refined, px: f64, py: f64, r: f64, max_jump: f64) -> bool {
+        let jump = (f.fit.x - px).hypot(f.fit.y - py);
+        jump <= max_jump && (f.fit.r - r).abs() <= 0.06 * r + 1.0 && f.fit.inliers * 3 >= f.rays && f.quality() > 0.2
+    }
+
+    fn accept<P: Pixel>(&mut self, frame: usize, t_s: f64, img: &Plane<P>, f: Refined, mut status: Status) -> BallFix {
+        let fit = f.fit;
+        let (w, h) = (img.width as f64, img.height as f64);
+        if fit.x - fit.r < -0.5 || fit.y - fit.r < -0.5 || fit.x + fit.r > w - 0.5 || fit.y + fit.r > h - 0.5 {
+            status = Status::CutByBorder;
+        } else if status == Status::Ok && fit.inliers * 2 < f.rays {
+            status = Status::Occluded;
+        }
+        // The radius in free flight sets the scale: only frames with the whole rim clear of the surface.
+        let clear = match &self.surface {
+            Some(line) => fit.y + fit.r < line.y_at(fit.x) - 3.0,
+            None => true,
+        };
+        if status == Status::Ok && clear && f.rays_hidden == 0 {
+            self.flight_radii.push(fit.r);
+            if self.flight_radii.len() > 64 {
+                self.flight_radii.remove(0);
+            }
+        }
+        // Seeds from later frames give way to real measurements.
+        self.history.retain(|h| h.0 < t_s);
+        self.history.push((t_s, fit.x, fit.y));
+        if self.history.len() > 3 {
+            self.history.remove(0);
+        }
+        BallFix {
+            frame,
+            t_s,
+            x_px: fit.x,
+            y_px: fit.y,
+            r_px: fit.r,
+            sigma_px: 0.5 * (fit.sigma_x + fit.sigma_y),
+            sigma_r_px: fit.sigma_r,
+            quality: f.quality(),
+            status,
+        }
+    }
+}

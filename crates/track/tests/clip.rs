@@ -1,0 +1,81 @@
+//! Tracking whole clips written to disk: the ball told from a static look-alike by its motion, the scale,
+//! the local frame, and clips with no ball.
+
+use bouncelab_frames::Clip;
+use bouncelab_track::testutil::{Scene, render};
+use bouncelab_track::{ClipTracking, TrackError, track_clip};
+use std::path::Path;
+
+fn path(i: usize) -> (f64, f64) {
+    let t = i as f64 - 20.0;
+    (70.0 + 1.7 * i as f64, 163.0 - 2.6 * t.abs() + 0.02 * t * t)
+}
+
+fn write_clip(dir: &Path, frames: usize, scene: impl Fn(usize) -> Scene) {
+    std::fs::create_dir_all(dir).unwrap();
+    for i in 0..frames {
+        let s = scene(i);
+        let px = render(&s);
+        let img = image::GrayImage::from_raw(s.size.0 as u32, s.size.1 as u32, px).unwrap();
+        img.save(dir.join(format!("C001H001S0001{:06}.png", 1000 + i))).unwrap();
+    }
+}
+
+fn bounce(i: usize) -> Scene {
+    let (x, y) = path(i);
+    Scene {
+        ball: (x, y, 40.0),
+        surface: Some((200.0, 0.0)),
+        band: (150.0, 20.0),
+        // A screw head and a ball-sized round fixture at rest.
+        distractors: vec![(30.0, 215.0, 6.0, 40.0), (215.0, 60.0, 38.0, 190.0)],
+        seed: i as u64,
+        ..Scene::default()
+    }
+}
+
+#[test]
+fn the_moving_circle_is_the_ball_and_the_scale_follows_from_its_radius() {
+    let dir = tempfile::tempdir().unwrap();
+    write_clip(dir.path(), 40, bounce);
+    let clip = Clip::open(dir.path()).unwrap();
+    let track = track_clip(&clip, &ClipTracking::default(), |_, _| {}).unwrap();
+    assert_eq!(track.fixes.len(), 40);
+    for f in &track.fixes {
+        let (x, y) = path(f.frame);
+        assert_eq!(f.status.name(), "ok", "{f:?}");
+        assert!(
+            (f.x_px - x).abs() < 0.1 && (f.y_px - y).abs() < 0.1,
+            "{f:?} vs ({x}, {y})"
+        );
+    }
+    let scale = track.scale.unwrap();
+    assert!(
+        (scale.m_per_px - 0.067 / 80.0).abs() / (0.067 / 80.0) < 0.002,
+        "{scale:?}"
+    );
+    let rows = track.rows();
+    // Local frame: origin on the surface below the lowest centre (frame 20), y up, x down-slope.
+    let lowest = &rows[20];
+    assert!(
+        lowest.x_m.abs() < 1e-12 && (lowest.y_m - 37.0 * scale.m_per_px).abs() < 0.1 * scale.m_per_px,
+        "{lowest:?}"
+    );
+    assert!(rows[0].x_m < 0.0 && rows[39].x_m > 0.0 && rows[0].y_m > lowest.y_m);
+    assert!((rows[0].t_s - 0.0).abs() < 1e-15 && (rows[1].t_s - 1e-4).abs() < 1e-12);
+}
+
+#[test]
+fn a_clip_without_a_ball_is_an_error_naming_it() {
+    let dir = tempfile::tempdir().unwrap();
+    write_clip(dir.path(), 5, |i| Scene {
+        ball: (-500.0, -500.0, 1.0),
+        surface: Some((200.0, 0.0)),
+        seed: i as u64,
+        ..Scene::default()
+    });
+    let clip = Clip::open(dir.path()).unwrap();
+    let err = track_clip(&clip, &ClipTracking::default(), |_, _| {}).unwrap_err();
+    assert!(matches!(err, TrackError::NoBall { .. }), "{err}");
+    assert!(err.to_string().contains(&dir.path().display().to_string()));
+}
