@@ -26,8 +26,6 @@ enum Command {
     Simulate(cmd::simulate::Args),
     /// List the effects a model can use, with their physics and parameters.
     Effects(cmd::effects::Args),
-    /// Render a synthetic session (frames + exact ground truth) from a preset or a scenario file.
-    Render(cmd::render::Args),
     /// Track the ball through one clip folder and write its trajectory (CSV).
     Track(cmd::track::Args),
 }
@@ -38,7 +36,6 @@ fn main() -> ExitCode {
         Command::Demo(a) => cmd::demo::run(a),
         Command::Simulate(a) => cmd::simulate::run(a),
         Command::Effects(a) => cmd::effects::run(a),
-        Command::Render(a) => cmd::render::run(a),
         Command::Track(a) => cmd::track::run(a),
     };
     match result {

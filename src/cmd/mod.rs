@@ -2,7 +2,6 @@
 
 pub mod demo;
 pub mod effects;
-pub mod render;
 pub mod simulate;
 pub mod track;
 
