@@ -29,60 +29,68 @@ const MIN_SCALE: f64 = 0.02;
 /// Fits a circle to `points` (px) starting from (`x`, `y`, `r`). Returns `None` with fewer than 5 usable
 /// points or when the geometry is degenerate (all points on a short arc or a line).
 pub fn fit_circle(points: &[[f64; 2]], x: f64, y: f64, r: f64) -> Option<CircleFit> {
-    if points.len() < 5 {
+    let n = points.len();
+    if n < 5 {
         return None;
     }
     let (mut cx, mut cy, mut cr) = (x, y, r);
-    let mut res = vec![0.0; points.len()];
-    let mut w = vec![1.0; points.len()];
-    let mut scale = f64::INFINITY;
+    // Per point: distance to the centre, residual, weight; one scratch buffer for the median.
+    let mut dist = vec![0.0; n];
+    let mut res = vec![0.0; n];
+    let mut w = vec![1.0; n];
+    let mut scratch = vec![0.0; n];
     let mut last_cov = None;
     for iter in 0..12 {
-        for (ri, p) in res.iter_mut().zip(points) {
-            *ri = (p[0] - cx).hypot(p[1] - cy) - cr;
+        for ((d, ri), p) in dist.iter_mut().zip(res.iter_mut()).zip(points) {
+            let (dx, dy) = (p[0] - cx, p[1] - cy);
+            *d = (dx * dx + dy * dy).sqrt();
+            *ri = *d - cr;
         }
-        // Robust scale from the median absolute residual; re-estimated while the fit settles.
-        if iter < 6 {
-            let mut abs: Vec<f64> = res.iter().map(|v| v.abs()).collect();
-            let mid = abs.len() / 2;
-            let (_, m, _) = abs.select_nth_unstable_by(mid, f64::total_cmp);
-            scale = (1.4826 * *m).max(MIN_SCALE);
+        // Robust scale from the median absolute residual, re-estimated as the fit settles.
+        for (a, ri) in scratch.iter_mut().zip(&res) {
+            *a = ri.abs();
         }
+        let (_, m, _) = scratch.select_nth_unstable_by(n / 2, f64::total_cmp);
+        let scale = (1.4826 * *m).max(MIN_SCALE);
         let c = 4.685 * scale;
-        for (wi, ri) in w.iter_mut().zip(&res) {
-            let u = ri / c;
-            *wi = if u.abs() < 1.0 { (1.0 - u * u).powi(2) } else { 0.0 };
-        }
         // Normal equations of the weighted orthogonal distances.
         let mut a = [[0.0f64; 3]; 3];
         let mut b = [0.0f64; 3];
-        for ((p, ri), wi) in points.iter().zip(&res).zip(&w) {
-            if *wi == 0.0 {
+        for i in 0..n {
+            let u = res[i] / c;
+            w[i] = if u.abs() < 1.0 {
+                (1.0 - u * u) * (1.0 - u * u)
+            } else {
+                0.0
+            };
+            if w[i] == 0.0 {
                 continue;
             }
-            let d = (p[0] - cx).hypot(p[1] - cy).max(1e-9);
-            let j = [-(p[0] - cx) / d, -(p[1] - cy) / d, -1.0];
+            let d = dist[i].max(1e-9);
+            let j = [-(points[i][0] - cx) / d, -(points[i][1] - cy) / d, -1.0];
             for k in 0..3 {
-                b[k] -= wi * j[k] * ri;
-                for l in 0..3 {
-                    a[k][l] += wi * j[k] * j[l];
+                b[k] -= w[i] * j[k] * res[i];
+                for l in k..3 {
+                    a[k][l] += w[i] * j[k] * j[l];
                 }
             }
         }
+        (a[1][0], a[2][0], a[2][1]) = (a[0][1], a[0][2], a[1][2]);
         let inv = invert3(&a)?;
-        let step: Vec<f64> = (0..3).map(|k| (0..3).map(|l| inv[k][l] * b[l]).sum()).collect();
+        let step = [0, 1, 2].map(|k| (0..3).map(|l| inv[k][l] * b[l]).sum::<f64>());
         cx += step[0];
         cy += step[1];
         cr += step[2];
         last_cov = Some(inv);
-        if step.iter().map(|s| s.abs()).fold(0.0, f64::max) < 1e-7 && iter >= 6 {
+        if iter >= 3 && step.iter().all(|s| s.abs() < 1e-6) {
             break;
         }
     }
     let inv = last_cov?;
     let (mut sw, mut swr2, mut inliers) = (0.0, 0.0, 0);
     for (p, wi) in points.iter().zip(&w) {
-        let ri = (p[0] - cx).hypot(p[1] - cy) - cr;
+        let (dx, dy) = (p[0] - cx, p[1] - cy);
+        let ri = (dx * dx + dy * dy).sqrt() - cr;
         if *wi > 0.0 {
             inliers += 1;
             sw += wi;

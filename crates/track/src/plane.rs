@@ -65,4 +65,18 @@ impl<'a, P: Pixel> Plane<'a, P> {
         let bottom = d[i + self.width].level() + fx * (d[i + self.width + 1].level() - d[i + self.width].level());
         Some(top + fy * (bottom - top))
     }
+
+    /// Bilinear interpolation at (x, y) known to lie in [0, width − 1) × [0, height − 1).
+    #[inline(always)]
+    pub fn sample_inside(&self, x: f32, y: f32) -> f32 {
+        let (x0, y0) = (x as usize, y as usize);
+        let (fx, fy) = (x - x0 as f32, y - y0 as f32);
+        let i = y0 * self.width + x0;
+        let d = &self.data[i..i + self.width + 2];
+        let (a, b) = (d[0].level(), d[1].level());
+        let (c, e) = (d[self.width].level(), d[self.width + 1].level());
+        let top = a + fx * (b - a);
+        let bottom = c + fx * (e - c);
+        top + fy * (bottom - top)
+    }
 }

@@ -63,8 +63,9 @@ impl Refined {
     }
 }
 
-/// Refines the circle (`x`, `y`, `r`) in px: edge points along rays, then a robust fit. Runs twice, the
-/// second time from the first fit with half the search width. `None` when too few edges are found.
+/// Refines the circle (`x`, `y`, `r`) in px: edge points along rays, then a robust fit. With a search
+/// wider than ±2 px it runs again from the first fit (re-centred while it moves) with half the width.
+/// `None` when too few edges are found.
 pub fn refine_circle<P: Pixel>(
     img: &Plane<P>,
     x: f64,
@@ -87,6 +88,9 @@ pub fn refine_circle<P: Pixel>(
         }
     }
     let narrow = (search.half_width * 0.5).max(2.0);
+    if narrow >= search.half_width {
+        return Some(fit);
+    }
     refine_once(img, fit.fit.x, fit.fit.y, fit.fit.r, search, narrow, surface).or(Some(fit))
 }
 
@@ -105,9 +109,15 @@ fn refine_once<P: Pixel>(
     let mut points = Vec::with_capacity(n);
     let mut contrasts = Vec::with_capacity(n);
     let (mut outside, mut hidden) = (0, 0);
-    for k in 0..n {
-        let a = std::f64::consts::TAU * k as f64 / n as f64;
-        let (c, s) = (a.cos(), a.sin());
+    // Ray directions by rotating one unit vector: no sin/cos per ray.
+    let (dc, ds) = (std::f64::consts::TAU / n as f64).sin_cos();
+    let (dc, ds) = (ds, dc); // (cos Δ, sin Δ)
+    let (mut c, mut s) = (1.0f64, 0.0f64);
+    let (wmax, hmax) = ((img.width - 1) as f64, (img.height - 1) as f64);
+    for _ in 0..n {
+        let (c0, s0) = (c, s);
+        (c, s) = (c0 * dc - s0 * ds, s0 * dc + c0 * ds);
+        let (c, s) = (c0, s0);
         let start = r - half_width;
         // The search stops short of the surface line: below it is the band, whose own edge must not be
         // taken for the ball's rim.
@@ -128,21 +138,23 @@ fn refine_once<P: Pixel>(
                 }
             }
         }
-        let profile = &mut profile[..len];
-        let mut ok = true;
-        for (j, p) in profile.iter_mut().enumerate() {
-            let d = start + j as f64 * search.step;
-            match img.sample((x + d * c) as f32, (y + d * s) as f32) {
-                Some(v) => *p = v,
-                None => {
-                    ok = false;
-                    break;
-                }
-            }
-        }
-        if !ok {
+        // A straight segment is inside the image when both its ends are.
+        let end = start + (len - 1) as f64 * search.step;
+        let inside = |d: f64| {
+            let (px, py) = (x + d * c, y + d * s);
+            px >= 0.01 && py >= 0.01 && px < wmax - 0.01 && py < hmax - 0.01
+        };
+        if !inside(start) || !inside(end) {
             outside += 1;
             continue;
+        }
+        let profile = &mut profile[..len];
+        let (mut px, mut py) = ((x + start * c) as f32, (y + start * s) as f32);
+        let (sx, sy) = ((search.step * c) as f32, (search.step * s) as f32);
+        for p in profile.iter_mut() {
+            *p = img.sample_inside(px, py);
+            px += sx;
+            py += sy;
         }
         // Central differences; the edge is the largest |change|.
         let (mut best, mut best_j) = (0.0f32, 0);

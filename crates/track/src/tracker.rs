@@ -117,6 +117,9 @@ pub struct Tracker {
     last_innovation: f64,
 }
 
+/// Search half-width around a confident prediction, px.
+const CONFIDENT_HALF_WIDTH: f64 = 2.0;
+
 /// Candidates within this fraction of the best support count as rivals.
 const RIVAL_SUPPORT: f64 = 0.7;
 
@@ -197,13 +200,19 @@ impl Tracker {
             self.surface = find_surface_line(img);
         }
         // 1. Around the prediction.
-        // The window widens when the last prediction missed (a sudden change of motion).
-        let search = EdgeSearch {
-            half_width: self
-                .opts
+        // A confident track needs one narrow pass; the window widens when the last prediction missed (a
+        // sudden change of motion).
+        let confident = self.history.len() >= 3 && self.last_innovation < 0.5;
+        let half_width = if confident {
+            CONFIDENT_HALF_WIDTH
+        } else {
+            self.opts
                 .search
                 .half_width
-                .max((2.0 * self.last_innovation + 2.0).min(12.0)),
+                .max((2.0 * self.last_innovation + 2.0).min(12.0))
+        };
+        let search = EdgeSearch {
+            half_width,
             ..self.opts.search.clone()
         };
         let max_jump = self.opts.max_jump_px.max(2.0 * self.last_innovation + 2.0);
