@@ -26,6 +26,10 @@ enum Command {
     Simulate(cmd::simulate::Args),
     /// List the effects a model can use, with their physics and parameters.
     Effects(cmd::effects::Args),
+    /// Render a synthetic session (frames + exact ground truth) from a preset or a scenario file.
+    Render(cmd::render::Args),
+    /// Measure one shot: velocities in and out, COR, friction, contact time, penetration, with errors.
+    Estimate(cmd::estimate::Args),
     /// Track the ball through one clip folder and write its trajectory (CSV).
     Track(cmd::track::Args),
 }
@@ -36,7 +40,9 @@ fn main() -> ExitCode {
         Command::Demo(a) => cmd::demo::run(a),
         Command::Simulate(a) => cmd::simulate::run(a),
         Command::Effects(a) => cmd::effects::run(a),
+        Command::Render(a) => cmd::render::run(a),
         Command::Track(a) => cmd::track::run(a),
+        Command::Estimate(a) => cmd::estimate::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

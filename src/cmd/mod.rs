@@ -2,6 +2,8 @@
 
 pub mod demo;
 pub mod effects;
+pub mod estimate;
+pub mod render;
 pub mod simulate;
 pub mod track;
 

@@ -54,6 +54,7 @@ fn session_settings(clip_dir: &Path) -> (Option<f64>, bool) {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
+    #[cfg(not(feature = "opencv"))]
     if matches!(a.detector, Detector::Opencv) {
         anyhow::bail!("--detector opencv needs a build with `--features opencv` (not implemented in this build yet)");
     }
@@ -84,8 +85,21 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         ..ClipTracking::default()
     };
     let bar = super::progress_bar(clip.len() as u64, "tracking");
-    let track = track_clip(&clip, &opts, |done, _| bar.set_position(done as u64))
-        .with_context(|| format!("tracking {}", a.clip_dir.display()))?;
+    let progress = |done: usize, _| bar.set_position(done as u64);
+    let track = match a.detector {
+        Detector::Hough => track_clip(&clip, &opts, progress),
+        // OpenCV's HoughCircles on every frame, no refinement: the reference baseline.
+        #[cfg(feature = "opencv")]
+        Detector::Opencv => bouncelab_track::opencv::track_clip_opencv(
+            &clip,
+            &opts,
+            bouncelab_track::opencv::OpencvMethod::Gradient,
+            progress,
+        ),
+        #[cfg(not(feature = "opencv"))]
+        Detector::Opencv => unreachable!("refused above"),
+    }
+    .with_context(|| format!("tracking {}", a.clip_dir.display()))?;
     bar.finish_and_clear();
     for w in &track.warnings {
         eprintln!("warning: {w}");

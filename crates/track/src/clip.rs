@@ -6,8 +6,9 @@
 //! round things (screw heads, fixtures, a second ball at rest) by its motion: it is the circle that moved
 //! between two frames.
 
-use crate::hough::{CircleDetection, detect_circles};
+use crate::hough::CircleDetection;
 use crate::plane::{Pixel, Plane};
+use crate::refine::refined_candidates;
 use crate::surface::SurfaceLine;
 use crate::tracker::{BallFix, Status, TrackOptions, Tracker};
 use bouncelab_frames::{Clip, FramesError, GrayPixels, ReadOptions};
@@ -207,10 +208,11 @@ fn acquire(clip: &Clip, opts: &ClipTracking, warnings: &mut Vec<String>) -> Resu
     };
     let circles_in = |k: usize| -> Result<Vec<crate::Circle>, TrackError> {
         let frame = clip.read(k, opts.read.png_decoder).expect("index in range")?;
-        Ok(with_plane(
+        let found = with_plane(
             &frame.pixels,
-            |p| on_plane!(p, p => detect_circles(&p, &det)),
-        ))
+            |p| on_plane!(p, p => refined_candidates(&p, &det, &opts.tracker.search, None, 0.3)),
+        );
+        Ok(found.into_iter().map(|(c, _)| c).collect())
     };
     let gap = 10.min(n.saturating_sub(1)).max(1);
     let mut k = 0;
@@ -218,16 +220,21 @@ fn acquire(clip: &Clip, opts: &ClipTracking, warnings: &mut Vec<String>) -> Resu
     while k + gap < n && k <= n / 2 {
         let (a, b) = (circles_in(k)?, circles_in(k + gap)?);
         let good = |c: &&crate::Circle| c.support > 0.5;
-        let mut best: Option<(f64, crate::Circle, crate::Circle)> = None; // (support, here, there)
+        // Circles that moved between the two frames, with their positions in both.
+        let mut moving: Vec<(crate::Circle, crate::Circle)> = Vec::new();
         for ca in a.iter().filter(good) {
             for cb in b.iter().filter(good) {
                 let same_size = (ca.r - cb.r).abs() <= 0.05 * ca.r + 1.0;
                 let moved = (ca.x - cb.x).hypot(ca.y - cb.y);
-                if same_size && moved > 1.5 && moved < 0.5 * w as f64 && best.is_none_or(|(s, _, _)| ca.support > s) {
-                    best = Some((ca.support, *ca, *cb));
+                if same_size && moved > 1.5 && moved < 0.5 * w as f64 {
+                    moving.push((*ca, *cb));
                 }
             }
         }
+        let best = moving
+            .iter()
+            .max_by(|p, q| p.0.support.total_cmp(&q.0.support))
+            .map(|(ca, cb)| (ca.support, *ca, *cb));
         if let Some((_, ca, cb)) = best {
             let r = 0.5 * (ca.r + cb.r);
             // `k` counts files; time follows frame indices, which count dropped frames too.

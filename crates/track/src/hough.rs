@@ -286,3 +286,17 @@ fn radius_at(g: &Gradients, edges: &[usize], cx: f64, cy: f64, rmin: f64, rmax: 
     let expected = std::f64::consts::TAU * r * inside as f64 / steps as f64;
     Some((cx, cy, r, (count / expected).min(1.0)))
 }
+
+/// Keeps only the outermost of nested candidates: a circle lying inside a larger, about as well supported
+/// candidate is a feature of that object (a ball's seam, a fixture's inner ring), not an object. A weak
+/// larger ring (a halo, edges of the background that happen to line up) does not hide a clear circle.
+pub fn outermost(circles: &[Circle]) -> Vec<Circle> {
+    let inside = |c: &Circle, o: &Circle| {
+        o.r > c.r + 0.5 && (c.x - o.x).hypot(c.y - o.y) + c.r <= o.r * 1.03 + 2.0 && o.support >= 0.9 * c.support
+    };
+    circles
+        .iter()
+        .filter(|c| !circles.iter().any(|o| inside(c, o)))
+        .copied()
+        .collect()
+}

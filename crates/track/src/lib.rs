@@ -13,6 +13,8 @@
 mod clip;
 mod fit;
 mod hough;
+#[cfg(feature = "opencv")]
+pub mod opencv;
 mod plane;
 mod refine;
 mod surface;
@@ -20,9 +22,9 @@ mod tracker;
 
 pub use clip::{ClipTracking, Scale, Track, TrackError, TrajectoryRow, track_clip};
 pub use fit::{CircleFit, fit_circle};
-pub use hough::{Circle, CircleDetection, detect_circles};
+pub use hough::{Circle, CircleDetection, detect_circles, outermost};
 pub use plane::{Pixel, Plane};
-pub use refine::{EdgeSearch, Refined, refine_circle};
+pub use refine::{EdgeSearch, Refined, refine_circle, refined_candidates};
 pub use surface::{SurfaceLine, find_surface_line};
 pub use tracker::{BallFix, Status, TrackOptions, Tracker};
 

@@ -181,7 +181,25 @@ fn refine_once<P: Pixel>(
         points.push([x + d * c, y + d * s]);
         contrasts.push(per_px);
     }
-    let fit = fit_circle(&points, x, y, r)?;
+    let mut fit = fit_circle(&points, x, y, r)?;
+    // Neighbouring rays see overlapping texture, so their edge errors are correlated and the fit's σ (which
+    // assumes independent points) is optimistic. Inflate it by the AR(1) factor √((1+ρ)/(1−ρ)), with ρ the
+    // lag-1 correlation of the residuals around the rim (points are in ray order), measured on this frame.
+    let res: Vec<f64> = points
+        .iter()
+        .map(|p| (p[0] - fit.x).hypot(p[1] - fit.y) - fit.r)
+        .filter(|e| e.abs() < 3.0 * fit.rms.max(0.02))
+        .collect();
+    if res.len() > 8 {
+        let m = res.iter().sum::<f64>() / res.len() as f64;
+        let var: f64 = res.iter().map(|e| (e - m).powi(2)).sum();
+        let lag: f64 = res.windows(2).map(|w| (w[0] - m) * (w[1] - m)).sum();
+        let rho = (lag / var.max(1e-300)).clamp(0.0, 0.8);
+        let k = ((1.0 + rho) / (1.0 - rho)).sqrt();
+        fit.sigma_x *= k;
+        fit.sigma_y *= k;
+        fit.sigma_r *= k;
+    }
     let mid = contrasts.len() / 2;
     let contrast = *contrasts.select_nth_unstable_by(mid, f32::total_cmp).1;
     Some(Refined {
@@ -192,4 +210,48 @@ fn refine_once<P: Pixel>(
         rays: n,
         contrast,
     })
+}
+
+/// Circle candidates found by [`detect_circles`](crate::detect_circles), each refined to sub-pixel
+/// precision, duplicates merged, nested ones dropped (see [`outermost`](crate::outermost)), and scored by
+/// the refined quality (stored in `support`). Best first.
+pub fn refined_candidates<P: Pixel>(
+    img: &Plane<P>,
+    detection: &crate::CircleDetection,
+    search: &EdgeSearch,
+    surface: Option<&SurfaceLine>,
+    min_quality: f64,
+) -> Vec<(crate::Circle, Refined)> {
+    let wide = EdgeSearch {
+        half_width: search.half_width.max(6.0),
+        ..search.clone()
+    };
+    let mut out: Vec<(crate::Circle, Refined)> = Vec::new();
+    for c in crate::detect_circles(img, detection) {
+        let Some(f) = refine_circle(img, c.x, c.y, c.r, &wide, surface) else {
+            continue;
+        };
+        let (q, fit) = (f.quality(), f.fit);
+        if q < min_quality || fit.r < detection.min_radius * 0.95 || fit.r > detection.max_radius * 1.05 {
+            continue;
+        }
+        let same =
+            |o: &(crate::Circle, Refined)| (o.0.x - fit.x).hypot(o.0.y - fit.y) < 2.0 && (o.0.r - fit.r).abs() < 2.0;
+        if out.iter().any(same) {
+            continue;
+        }
+        out.push((
+            crate::Circle {
+                x: fit.x,
+                y: fit.y,
+                r: fit.r,
+                support: q,
+            },
+            f,
+        ));
+    }
+    let kept = crate::outermost(&out.iter().map(|c| c.0).collect::<Vec<_>>());
+    out.retain(|c| kept.contains(&c.0));
+    out.sort_by(|a, b| b.0.support.total_cmp(&a.0.support));
+    out
 }

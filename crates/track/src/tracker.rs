@@ -1,9 +1,9 @@
 //! Frame-to-frame tracking: predict, refine around the prediction, re-detect when that fails, and say
 //! what happened in every frame.
 
-use crate::hough::{Circle, CircleDetection, detect_circles};
+use crate::hough::{Circle, CircleDetection};
 use crate::plane::{Pixel, Plane};
-use crate::refine::{EdgeSearch, Refined, refine_circle};
+use crate::refine::{EdgeSearch, Refined, refine_circle, refined_candidates};
 use crate::surface::{SurfaceLine, find_surface_line};
 use serde::{Deserialize, Serialize};
 
@@ -235,12 +235,7 @@ impl Tracker {
             max_radius: hi,
             ..CircleDetection::default()
         };
-        let mut cands: Vec<(Circle, Refined)> = detect_circles(img, &det)
-            .into_iter()
-            .filter(|c| c.support > 0.4)
-            .filter_map(|c| refine_circle(img, c.x, c.y, c.r, &self.opts.search, self.surface.as_ref()).map(|f| (c, f)))
-            .filter(|(_, f)| f.fit.r >= lo * 0.95 && f.fit.r <= hi * 1.05 && f.quality() > 0.3)
-            .collect();
+        let mut cands = refined_candidates(img, &det, &self.opts.search, self.surface.as_ref(), 0.3);
         if cands.is_empty() {
             if !self.history.is_empty() && self.history.len() < 1_000_000 {
                 self.warnings.push(format!("frame {frame}: ball lost"));

@@ -1,0 +1,15 @@
+//! What the lab publishes for each shot, measured from the ball's track: the phases of the impact, the
+//! velocities in and out, the coefficient of restitution, the effective friction, the contact time and the
+//! maximum penetration, each with an honest standard error.
+//!
+//! The flight phases are fitted as ballistic arcs with gravity's components on the incline known (weighted
+//! least squares, the tracker's per-frame σ as weights, inflated by the fit's own scatter when that is
+//! larger), and the contact's start and end are where those arcs bring the ball's centre to one radius above
+//! the surface line. So every number comes from many frames, not from the one or two frames nearest the
+//! impact, and a phase too short to fit is said to be so rather than guessed.
+
+mod ballistic;
+mod shot;
+
+pub use ballistic::{BallisticFit, fit_ballistic};
+pub use shot::{Conditions, Estimate, EstimateError, Measured, PhaseFrames, estimate};

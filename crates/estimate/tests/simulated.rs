@@ -1,0 +1,190 @@
+//! The estimator on tracks made from the contact model with known outputs, plus tracker-like noise.
+
+use bouncelab_estimate::{Conditions, EstimateError, estimate};
+use bouncelab_model::{Ball, Impact, Model, SimOptions, State, simulate};
+use bouncelab_track::{BallFix, Scale, Status, SurfaceLine, Track};
+
+const SCALE: f64 = 4e-4; // m/px
+const SURFACE_Y: f64 = 420.0; // px
+const NOISE_PX: f64 = 0.05;
+
+struct Rng(u64);
+impl Rng {
+    fn gauss(&mut self) -> f64 {
+        let mut u = || {
+            self.0 = self
+                .0
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((self.0 >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+        };
+        let (a, b) = (u(), u());
+        (-2.0 * a.ln()).sqrt() * (std::f64::consts::TAU * b).cos()
+    }
+}
+
+/// A shot from 15 ms before touch to `after` s after it, as a tracker would report it.
+fn shot(model: &Model, incline_deg: f64, drop_m: f64, after: f64, seed: u64) -> (Track, Impact) {
+    let beta = incline_deg.to_radians();
+    let g = model.gravity;
+    let v = (2.0 * g * drop_m).sqrt();
+    let (vt, vn) = (v * beta.sin(), -v * beta.cos());
+    let (at, an) = (g * beta.sin(), -g * beta.cos());
+    let before = 0.015;
+    let r = model.ball.radius_m;
+    // Back along the ballistic arc from the touch point (x = 0, y = R).
+    let start = State::flying(
+        -vt * before + 0.5 * at * before * before,
+        r - vn * before + 0.5 * an * before * before,
+        vt - at * before,
+        vn - an * before,
+    );
+    let times: Vec<f64> = (0..((before + after) * 1e4) as usize)
+        .map(|i| i as f64 * 1e-4)
+        .collect();
+    let sim = simulate(model, beta, 0.0, start, &times, &SimOptions::default()).unwrap();
+    let mut rng = Rng(seed.wrapping_mul(0x9E3779B97F4A7C15) ^ 0xD1B54A32D192ED03);
+    let fixes = sim
+        .samples
+        .iter()
+        .enumerate()
+        .map(|(i, s)| BallFix {
+            frame: i,
+            t_s: s.t,
+            x_px: 150.0 + s.state.x / SCALE + NOISE_PX * rng.gauss(),
+            y_px: SURFACE_Y - s.state.y / SCALE + NOISE_PX * rng.gauss(),
+            r_px: r / SCALE,
+            sigma_px: NOISE_PX,
+            sigma_r_px: 0.02,
+            quality: 1.0,
+            status: Status::Ok,
+        })
+        .collect();
+    let track = Track {
+        fixes,
+        surface: Some(SurfaceLine {
+            x0: 255.5,
+            y0: SURFACE_Y,
+            slope: 0.0,
+            sigma_y0: 0.005,
+            sigma_tilt_deg: 0.001,
+            columns: 120,
+        }),
+        scale: Some(Scale {
+            m_per_px: SCALE,
+            sigma_m_per_px: SCALE * 2e-4,
+            radius_px: r / SCALE,
+            frames: 150,
+        }),
+        warnings: Vec::new(),
+        seconds_waiting: 0.0,
+        seconds_tracking: 0.0,
+        downslope_negative_x: false,
+    };
+    (track, sim.impact)
+}
+
+fn conditions(incline_deg: f64) -> Conditions {
+    Conditions {
+        incline_deg,
+        gravity: 9.81,
+        ball_diameter_m: 2.0 * Ball::TENNIS.radius_m,
+    }
+}
+
+#[test]
+fn estimates_match_the_model_outputs() {
+    let model = Model::paper(25_650.0, 14.0, 0.5);
+    for (k, (angle, drop)) in [(0.0, 0.2), (7.5, 0.3), (15.0, 0.4), (22.5, 0.9)]
+        .into_iter()
+        .enumerate()
+    {
+        let (track, truth) = shot(&model, angle, drop, 0.02, k as u64);
+        let e = estimate(&track, &conditions(angle)).unwrap();
+        let vin = truth.state_in;
+        let vout = truth.state_out;
+        let rel = |m: f64, t: f64| (m - t).abs() / t.abs();
+        assert!(
+            (e.cor.value - truth.restitution).abs() < 0.003,
+            "{angle}°: e {} vs {}",
+            e.cor.value,
+            truth.restitution
+        );
+        assert!(
+            (e.mu.value - truth.effective_friction).abs() < 0.01,
+            "{angle}°: μ {} vs {}",
+            e.mu.value,
+            truth.effective_friction
+        );
+        assert!(
+            rel(e.v_in[1].value, vin.vy) < 0.003 && rel(e.v_out[1].value, vout.vy) < 0.003,
+            "{e:?}"
+        );
+        assert!(
+            (e.contact_ms.value - truth.contact_time() * 1e3).abs() < 0.1,
+            "{angle}°: {} vs {}",
+            e.contact_ms.value,
+            truth.contact_time() * 1e3
+        );
+        assert!(
+            (e.delta_max_m.value - truth.delta_max).abs() < 3e-4,
+            "{angle}°: δ {} vs {}",
+            e.delta_max_m.value,
+            truth.delta_max
+        );
+        assert!((e.t_max - truth.t_max_compression).abs() < 3e-4);
+    }
+}
+
+#[test]
+fn standard_errors_are_calibrated() {
+    let model = Model::paper(25_650.0, 14.0, 0.5);
+    let (mut z_cor, mut z_vin, mut z_vout) = (Vec::new(), Vec::new(), Vec::new());
+    for seed in 0..40 {
+        let (track, truth) = shot(&model, 15.0, 0.3, 0.02, 1000 + seed);
+        let e = estimate(&track, &conditions(15.0)).unwrap();
+        z_cor.push((e.cor.value - truth.restitution) / e.cor.se);
+        z_vin.push((e.v_in[1].value - truth.state_in.vy) / e.v_in[1].se);
+        z_vout.push((e.v_out[1].value - truth.state_out.vy) / e.v_out[1].se);
+    }
+    let rms = |z: &[f64]| (z.iter().map(|v| v * v).sum::<f64>() / z.len() as f64).sqrt();
+    for (name, z) in [("cor", &z_cor), ("v_in_n", &z_vin), ("v_out_n", &z_vout)] {
+        let r = rms(z);
+        assert!((0.5..=2.0).contains(&r), "{name}: RMS(error/SE) = {r}");
+    }
+}
+
+#[test]
+fn a_dropped_frame_and_flagged_frames_change_little() {
+    let model = Model::paper(25_650.0, 14.0, 0.5);
+    let (mut track, truth) = shot(&model, 7.5, 0.3, 0.02, 7);
+    track.fixes.remove(60); // dropped frame: the index and time jump
+    track.fixes[20].status = Status::Absent;
+    track.fixes[30].status = Status::CutByBorder;
+    track.fixes[30].x_px += 5.0; // a bad measurement on a flagged frame must not count
+    let e = estimate(&track, &conditions(7.5)).unwrap();
+    assert!(
+        (e.cor.value - truth.restitution).abs() < 0.003,
+        "{} vs {}",
+        e.cor.value,
+        truth.restitution
+    );
+}
+
+#[test]
+fn a_clip_ending_close_to_the_impact_is_refused_with_a_reason() {
+    let model = Model::paper(25_650.0, 14.0, 0.5);
+    // Ends 0.3 ms after separation: too few outgoing frames.
+    let (track, truth) = shot(&model, 0.0, 0.3, 0.0, 3);
+    let cut = truth.t_separation + 3e-4;
+    let track = Track {
+        fixes: track.fixes.into_iter().filter(|f| f.t_s <= cut).collect(),
+        ..track
+    };
+    let err = estimate(&track, &conditions(0.0)).unwrap_err();
+    assert!(
+        matches!(err, EstimateError::FlightTooShort { phase: "outgoing", .. }),
+        "{err}"
+    );
+    assert!(err.to_string().contains("ends too close to the impact"), "{err}");
+}

@@ -1,0 +1,115 @@
+//! Built-in scenarios: `smoke` (regression tests), `paper` (the paper's 144-shot session), `none` and one
+//! `effect-<name>` session per non-base effect of the model crate (for the missing-effect diagnosis).
+
+use bouncelab_model::{ModelSpec, builtin_effects};
+
+/// The magnitude each `effect-<name>` preset switches its effect on at, as `model.toml` parameter lines,
+/// chosen so the measurable outputs change clearly (see `docs/renderer.md`).
+pub const EFFECT_MAGNITUDES: &[(&str, &str)] = &[
+    ("hertz", "k_h = 400000"),
+    ("hunt_crossley", "lambda = 2000\nn = 1"),
+    ("restitution_damping", "b_r = 8"),
+    ("plastic_dent", "phi = 0.25"),
+    ("rolling_resistance", "c_rr = 0.02"),
+    ("inertia_factor", "dc = -0.25"),
+    ("drag", "cd = 1.5\nrho = 1.204"),
+    ("camera_roll", "roll_deg = 3"),
+];
+
+/// The names of every preset.
+pub fn preset_names() -> Vec<String> {
+    let mut v: Vec<String> = ["smoke", "paper", "none"].iter().map(|s| s.to_string()).collect();
+    for e in builtin_effects().iter().filter(|e| !e.base) {
+        v.push(format!("effect-{}", e.name));
+    }
+    v
+}
+
+/// The paper's model (`[model]` and per-surface values) written from `ModelSpec::paper()`, with the
+/// surfaces' textures: clay → clay, tape1 → white tape, tape2 → green tape.
+fn paper_model_tables() -> String {
+    let spec = ModelSpec::paper();
+    let mut s = format!("[model]\ngravity_m_s2 = {}\n", spec.gravity);
+    let base = spec.settings(None).expect("the paper model has values");
+    let mut last = String::new();
+    for (r, p) in &base {
+        if r.effect != last {
+            s += &format!("[model.effects.{}]\n", r.effect);
+            last = r.effect.clone();
+        }
+        s += &format!("{} = {}\n", r.param, p.value);
+    }
+    for name in spec.surface_names() {
+        let texture = match name {
+            "clay" => "clay",
+            "tape1" => "white_tape",
+            _ => "green_tape",
+        };
+        s += &format!("\n[surfaces.{name}]\ntexture = \"{texture}\"\n");
+        for (r, p) in spec
+            .surfaces
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, v)| v.clone())
+            .unwrap_or_default()
+        {
+            s += &format!("{}.{} = {}\n", r.effect, r.param, p.value);
+        }
+    }
+    s
+}
+
+const CAMERA_512: &str =
+    "[camera]\nwidth = 512\nheight = 512\nscale_m_per_px = 4.0e-4\nfps = 10000\nexposure_s = 5e-5\n";
+
+/// The scenario text of preset `name`, or `None`.
+pub fn preset_toml(name: &str) -> Option<String> {
+    let ball = "[ball]\ndiameter_m = 0.067\nmass_kg = 0.0567\ninertia_factor = 0.6666666666666666\n";
+    match name {
+        "smoke" => Some(format!(
+            "name = \"smoke\"\ndescription = \"3 small shots for regression tests\"\nseed = 1\npre_contact_ms = 6\npost_separation_ms = 6\n\n{ball}\n[camera]\nwidth = 256\nheight = 256\nscale_m_per_px = 8.0e-4\nfps = 10000\nexposure_s = 5e-5\n\n{}\n[[shots]]\nsurface = \"clay\"\nangle_deg = 0\ndrop_height_m = 0.3\n\n[[shots]]\nsurface = \"tape1\"\nangle_deg = 15\ndrop_height_m = 0.25\n\n[[shots]]\nsurface = \"tape2\"\nangle_deg = 22.5\ndrop_height_m = 0.35\n",
+            paper_model_tables()
+        )),
+        "paper" => Some(format!(
+            "name = \"paper\"\ndescription = \"The paper's session: 3 surfaces x 4 drop heights x 4 angles x 3 repeats\"\nseed = 2024\npre_contact_ms = 15\npost_separation_ms = 20\n\n{ball}\n{CAMERA_512}\n{}\n[grid]\nsurfaces = [\"clay\", \"tape1\", \"tape2\"]\ndrop_heights_m = [0.2, 0.27, 0.33, 0.4]\nangles_deg = [0, 7.5, 15, 22.5]\nrepeats = 3\n",
+            paper_model_tables()
+        )),
+        "none" => Some(effect_session("none", None)),
+        _ => {
+            let effect = name.strip_prefix("effect-")?;
+            let info = builtin_effects().iter().find(|e| e.name == effect && !e.base)?;
+            Some(effect_session(name, Some(info.name)))
+        }
+    }
+}
+
+/// A 12-shot clay session (drop heights 0.2, 0.55, 0.9 m × angles 0, 7.5, 15, 22.5°) with `effect`
+/// switched on at its [`EFFECT_MAGNITUDES`] value.
+fn effect_session(name: &str, effect: Option<&str>) -> String {
+    let (extra, list, what) = match effect {
+        Some(e) => {
+            let params = EFFECT_MAGNITUDES
+                .iter()
+                .find(|(n, _)| *n == e)
+                .map(|(_, p)| *p)
+                .unwrap_or("");
+            (
+                format!("[extra_effects.{e}]\n{params}\n"),
+                format!("[\"{e}\"]"),
+                format!("the hidden effect `{e}` switched on"),
+            )
+        }
+        None => (
+            String::new(),
+            "[]".to_string(),
+            "no hidden effect (the paper's model)".to_string(),
+        ),
+    };
+    let seed = crate::rng::mix(
+        name.bytes()
+            .fold(7u64, |h, b| h.wrapping_mul(31).wrapping_add(b as u64)),
+    ) % 1_000_000;
+    format!(
+        "name = \"{name}\"\ndescription = \"Diagnosis session: clay, {what}\"\nseed = {seed}\npre_contact_ms = 10\npost_separation_ms = 10\n\n[ball]\ndiameter_m = 0.067\nmass_kg = 0.0567\ninertia_factor = 0.6666666666666666\n\n{CAMERA_512}\n[model]\ngravity_m_s2 = 9.81\n[model.effects.spring]\nk = 25650\n[model.effects.damping]\nb = 14\n[model.effects.coulomb]\nmu = 0.5\n\n[surfaces.clay]\ntexture = \"clay\"\n\n{extra}\n[grid]\nsurfaces = [\"clay\"]\ndrop_heights_m = [0.2, 0.55, 0.9]\nangles_deg = [0, 7.5, 15, 22.5]\nrepeats = 1\neffects = {list}\n"
+    )
+}

@@ -1,0 +1,753 @@
+//! The scenario file: the session to render (camera, ball, surfaces with their physics, shots) and how it
+//! is read and checked.
+
+use crate::RenderError;
+use bouncelab_model::ModelSpec;
+use serde::Deserialize;
+use std::path::Path;
+use toml::{Table, Value};
+
+/// What a surface band looks like.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Texture {
+    /// Granular green clay: fine, grainy, mid-dark, with brighter grains.
+    Clay,
+    /// White court-line tape: bright, woven herringbone.
+    WhiteTape,
+    /// Green court-line tape: mid-gray, woven.
+    GreenTape,
+}
+
+impl Texture {
+    /// Name as written in scenario files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Texture::Clay => "clay",
+            Texture::WhiteTape => "white_tape",
+            Texture::GreenTape => "green_tape",
+        }
+    }
+}
+
+/// Image file format of the frames.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Format {
+    /// PNG with fast compression (default).
+    Png,
+    /// Uncompressed TIFF.
+    Tiff,
+}
+
+/// Which image direction is down the slope (SPEC §2.7).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+pub enum Downslope {
+    /// Down-slope is +x_px (to the right); the default.
+    #[serde(rename = "+x")]
+    PlusX,
+    /// Down-slope is −x_px: the image is the mirror image of the `+x` camera's.
+    #[serde(rename = "-x")]
+    MinusX,
+}
+
+impl Downslope {
+    /// As written in `session.toml`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Downslope::PlusX => "+x",
+            Downslope::MinusX => "-x",
+        }
+    }
+    /// +1 or −1: the sign of x_px along the down-slope direction.
+    pub fn sign(self) -> f64 {
+        match self {
+            Downslope::PlusX => 1.0,
+            Downslope::MinusX => -1.0,
+        }
+    }
+}
+
+/// The high-speed camera and its lighting (`[camera]`).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Camera {
+    /// Frame width, pixels (default 512).
+    pub width: u32,
+    /// Frame height, pixels (default 512).
+    pub height: u32,
+    /// Scale, metres per pixel (default 4.0e-4: the ball is about 168 px across).
+    pub scale_m_per_px: f64,
+    /// Frame rate, frames per second (default 10,000).
+    pub fps: f64,
+    /// Exposure time, s (default 5e-5); a frame integrates the window centred on its time.
+    pub exposure_s: f64,
+    /// Read noise, standard deviation in DN of the 8-bit scale (default 1.8).
+    pub read_noise: f64,
+    /// Shot-noise gain, DN per photo-electron: the noise variance is `read_noise² + gain·signal` with the
+    /// signal in DN (default 0.06).
+    pub shot_noise_gain: f64,
+    /// Light flicker, relative amplitude of the global brightness modulation (default 0.03).
+    pub flicker_amplitude: f64,
+    /// Light flicker frequency, Hz (default 120: mains-powered lights).
+    pub flicker_hz: f64,
+    /// Camera roll, degrees counter-clockwise with respect to the surface: the whole scene turns in the
+    /// image and the surface line is tilted (default 0). Adds to a shot's `camera_roll` effect.
+    pub roll_deg: f64,
+    /// Bits per pixel of the frame files: 8 or 16 (default 8).
+    pub bit_depth: u8,
+    /// Frame file format (default png).
+    pub format: Format,
+    /// Image direction that is down the slope (default "+x").
+    pub downslope: Downslope,
+    /// Frame file name pattern with one `{}` or `{:0N}` placeholder for the frame number, which must be
+    /// the last number of the name (default `C001H001S0001{:06}.png`, `.tif` for TIFF).
+    pub naming: Option<String>,
+    /// Sub-exposure samples averaged for motion blur at the ball's edge (default 6).
+    pub blur_samples: u32,
+    /// Lens vignetting: relative brightness lost at the image corners (default 0.22).
+    pub vignetting: f64,
+    /// Fixed-pattern noise of the sensor: standard deviation of the per-column offsets, DN (rows get half
+    /// of it); the same in every clip of a session (default 0.5).
+    pub fixed_pattern_noise: f64,
+    /// Fraction of hot pixels (a fixed offset of +20 to +80 DN, the same in every clip; default 3e-5).
+    pub hot_pixel_fraction: f64,
+}
+
+impl Default for Camera {
+    fn default() -> Self {
+        Camera {
+            width: 512,
+            height: 512,
+            scale_m_per_px: 4.0e-4,
+            fps: 10_000.0,
+            exposure_s: 5e-5,
+            read_noise: 1.8,
+            shot_noise_gain: 0.06,
+            flicker_amplitude: 0.03,
+            flicker_hz: 120.0,
+            roll_deg: 0.0,
+            bit_depth: 8,
+            format: Format::Png,
+            downslope: Downslope::PlusX,
+            naming: None,
+            blur_samples: 6,
+            vignetting: 0.22,
+            fixed_pattern_noise: 0.5,
+            hot_pixel_fraction: 3e-5,
+        }
+    }
+}
+
+impl Camera {
+    /// The naming pattern in use (the default one for the format when none is given).
+    pub fn naming_pattern(&self) -> String {
+        self.naming.clone().unwrap_or_else(|| match self.format {
+            Format::Png => "C001H001S0001{:06}.png".into(),
+            Format::Tiff => "C001H001S0001{:06}.tif".into(),
+        })
+    }
+
+    /// The file name of frame `frame` (0-based).
+    pub fn frame_name(&self, frame: usize) -> String {
+        let p = parse_naming(&self.naming_pattern()).expect("naming checked when the scenario was read");
+        format!("{}{:0width$}{}", p.0, frame, p.2, width = p.1)
+    }
+}
+
+/// (prefix, zero-padding width, suffix) of a naming pattern.
+fn parse_naming(pattern: &str) -> Result<(String, usize, String), String> {
+    let open = pattern
+        .find('{')
+        .ok_or("needs a `{}` or `{:06}` placeholder for the frame number")?;
+    let close = pattern[open..].find('}').map(|c| open + c).ok_or("unclosed `{`")?;
+    let inner = &pattern[open + 1..close];
+    let width = if inner.is_empty() {
+        0
+    } else if let Some(w) = inner.strip_prefix(":0") {
+        w.parse::<usize>()
+            .map_err(|_| format!("placeholder `{{{inner}}}`: expected `{{}}` or `{{:0N}}`"))?
+    } else {
+        return Err(format!("placeholder `{{{inner}}}`: expected `{{}}` or `{{:0N}}`"));
+    };
+    let (prefix, suffix) = (&pattern[..open], &pattern[close + 1..]);
+    if suffix.contains(['{', '}']) || prefix.contains(['{', '}']) {
+        return Err("only one placeholder is allowed".into());
+    }
+    if suffix.chars().any(|c| c.is_ascii_digit()) {
+        return Err("no digit may follow the placeholder: the frame number must be the last number".into());
+    }
+    if prefix.contains(['/', '\\']) || suffix.contains(['/', '\\']) {
+        return Err("a file name, not a path".into());
+    }
+    Ok((prefix.to_string(), width.min(20), suffix.to_string()))
+}
+
+/// The ball (`[ball]`).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct BallSpec {
+    /// Diameter, m (default 0.067).
+    pub diameter_m: f64,
+    /// Mass, kg (default 0.0567).
+    pub mass_kg: f64,
+    /// Inertia factor c in I = c·m·R² (default 2/3, a thin shell).
+    pub inertia_factor: f64,
+}
+
+impl Default for BallSpec {
+    fn default() -> Self {
+        BallSpec {
+            diameter_m: 0.067,
+            mass_kg: 0.0567,
+            inertia_factor: 2.0 / 3.0,
+        }
+    }
+}
+
+/// A surface of the session (`[surfaces.NAME]`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Surface {
+    /// Its name (as in `clips.csv`).
+    pub name: String,
+    /// How its band looks.
+    pub texture: Texture,
+    /// Its per-surface model values, in `model.toml`'s `[surfaces.NAME]` syntax (`spring.k = 25650`).
+    pub model_values: Table,
+}
+
+/// One drop shot.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Shot {
+    /// Surface name.
+    pub surface: String,
+    /// Incline of the surface β, degrees.
+    pub angle_deg: f64,
+    /// Drop height, m (vertical, from the ball's bottom to the point it hits).
+    pub drop_height_m: f64,
+    /// Repeat number, from 1.
+    #[serde(default = "one")]
+    pub repeat: u32,
+    /// Extra (hidden) effects switched on for this shot, by name in `[extra_effects]`.
+    #[serde(default)]
+    pub effects: Vec<String>,
+}
+
+fn one() -> u32 {
+    1
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Grid {
+    surfaces: Vec<String>,
+    drop_heights_m: Vec<f64>,
+    angles_deg: Vec<f64>,
+    #[serde(default = "one")]
+    repeats: u32,
+    #[serde(default)]
+    effects: Vec<String>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Raw {
+    #[serde(default)]
+    seed: u64,
+    #[serde(default)]
+    name: Option<String>,
+    #[serde(default)]
+    description: Option<String>,
+    #[serde(default = "default_pre")]
+    pre_contact_ms: f64,
+    #[serde(default = "default_post")]
+    post_separation_ms: f64,
+    #[serde(default)]
+    ball: BallSpec,
+    #[serde(default)]
+    camera: Camera,
+    #[serde(default)]
+    model: Option<Table>,
+    #[serde(default)]
+    surfaces: Table,
+    #[serde(default)]
+    shots: Vec<Shot>,
+    #[serde(default)]
+    grid: Option<Grid>,
+    #[serde(default)]
+    extra_effects: Table,
+}
+
+fn default_pre() -> f64 {
+    15.0
+}
+fn default_post() -> f64 {
+    20.0
+}
+
+/// A session to render: read from a scenario file ([`Scenario::load`], [`Scenario::parse`]) or a built-in
+/// preset ([`Scenario::preset`]).
+#[derive(Debug, Clone)]
+pub struct Scenario {
+    /// Where it came from (a path or `preset NAME`), for messages.
+    pub origin: String,
+    /// The scenario's text as read (written to `truth/scenario.toml`).
+    pub source: String,
+    /// Name (metadata).
+    pub name: String,
+    /// Description (metadata, copied into `session.toml`).
+    pub description: String,
+    /// Session seed; per-shot seeds are derived from it and the shot index.
+    pub seed: u64,
+    /// Time from the first frame to the touch, s (a random 0–2 frames are added per shot).
+    pub pre_contact_s: f64,
+    /// Time from separation to the last frame, s.
+    pub post_separation_s: f64,
+    /// The ball.
+    pub ball: BallSpec,
+    /// The camera.
+    pub camera: Camera,
+    /// The surfaces, in file order.
+    pub surfaces: Vec<Surface>,
+    /// The shots, in order (`[[shots]]` first, then the `[grid]` expanded surface × angle × height ×
+    /// repeat).
+    pub shots: Vec<Shot>,
+    model: Table,
+    extra_effects: Table,
+}
+
+impl Scenario {
+    /// Reads a scenario file.
+    pub fn load(path: &Path) -> Result<Scenario, RenderError> {
+        let text = std::fs::read_to_string(path).map_err(|source| RenderError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Scenario::parse(&text, &path.display().to_string())
+    }
+
+    /// A built-in preset (see [`crate::presets`]).
+    pub fn preset(name: &str) -> Result<Scenario, RenderError> {
+        let text = crate::presets::preset_toml(name).ok_or_else(|| RenderError::UnknownPreset {
+            name: name.to_string(),
+            known: crate::presets::preset_names().join(", "),
+        })?;
+        Scenario::parse(&text, &format!("preset {name}"))
+    }
+
+    /// Parses scenario text; `origin` names it in errors.
+    pub fn parse(text: &str, origin: &str) -> Result<Scenario, RenderError> {
+        let syntax = |message: String| RenderError::Syntax {
+            origin: origin.to_string(),
+            message,
+        };
+        let raw: Raw = toml::from_str(text).map_err(|e| syntax(e.to_string().trim_end().replace('\n', " ")))?;
+        let invalid = |field: &str, value: String, reason: &str| RenderError::InvalidValue {
+            origin: origin.to_string(),
+            field: field.to_string(),
+            value,
+            reason: reason.to_string(),
+        };
+        let c = &raw.camera;
+        let check = |field: &str, v: f64, ok: bool, reason: &str| {
+            if ok && v.is_finite() {
+                Ok(())
+            } else {
+                Err(invalid(field, v.to_string(), reason))
+            }
+        };
+        if !(16..=8192).contains(&c.width) {
+            return Err(invalid(
+                "camera.width",
+                c.width.to_string(),
+                "must be 16 to 8192 pixels",
+            ));
+        }
+        if !(16..=8192).contains(&c.height) {
+            return Err(invalid(
+                "camera.height",
+                c.height.to_string(),
+                "must be 16 to 8192 pixels",
+            ));
+        }
+        check(
+            "camera.scale_m_per_px",
+            c.scale_m_per_px,
+            c.scale_m_per_px > 0.0,
+            "must be > 0",
+        )?;
+        check(
+            "camera.fps",
+            c.fps,
+            c.fps > 0.0 && c.fps <= 1e7,
+            "must be > 0 (and ≤ 1e7)",
+        )?;
+        check(
+            "camera.exposure_s",
+            c.exposure_s,
+            c.exposure_s > 0.0 && c.exposure_s <= 1.0 / c.fps,
+            "must be > 0 and at most one frame period (1/fps)",
+        )?;
+        check("camera.read_noise", c.read_noise, c.read_noise >= 0.0, "must be ≥ 0 DN")?;
+        check(
+            "camera.shot_noise_gain",
+            c.shot_noise_gain,
+            c.shot_noise_gain >= 0.0,
+            "must be ≥ 0 DN per electron",
+        )?;
+        check(
+            "camera.flicker_amplitude",
+            c.flicker_amplitude,
+            (0.0..0.5).contains(&c.flicker_amplitude),
+            "must be in [0, 0.5)",
+        )?;
+        check("camera.flicker_hz", c.flicker_hz, c.flicker_hz >= 0.0, "must be ≥ 0 Hz")?;
+        check(
+            "camera.roll_deg",
+            c.roll_deg,
+            c.roll_deg.abs() <= 45.0,
+            "must be within ±45°",
+        )?;
+        check(
+            "camera.vignetting",
+            c.vignetting,
+            (0.0..=0.9).contains(&c.vignetting),
+            "must be in [0, 0.9]",
+        )?;
+        check(
+            "camera.fixed_pattern_noise",
+            c.fixed_pattern_noise,
+            (0.0..=20.0).contains(&c.fixed_pattern_noise),
+            "must be 0 to 20 DN",
+        )?;
+        check(
+            "camera.hot_pixel_fraction",
+            c.hot_pixel_fraction,
+            (0.0..=0.01).contains(&c.hot_pixel_fraction),
+            "must be 0 to 0.01",
+        )?;
+        if c.bit_depth != 8 && c.bit_depth != 16 {
+            return Err(invalid("camera.bit_depth", c.bit_depth.to_string(), "must be 8 or 16"));
+        }
+        if !(1..=64).contains(&c.blur_samples) {
+            return Err(invalid(
+                "camera.blur_samples",
+                c.blur_samples.to_string(),
+                "must be 1 to 64",
+            ));
+        }
+        let pattern = c.naming_pattern();
+        let (_, _, suffix) =
+            parse_naming(&pattern).map_err(|r| invalid("camera.naming", format!("{pattern:?}"), &r))?;
+        let lower = suffix.to_ascii_lowercase();
+        let ext_ok = match c.format {
+            Format::Png => lower.ends_with(".png"),
+            Format::Tiff => lower.ends_with(".tif") || lower.ends_with(".tiff"),
+        };
+        if !ext_ok {
+            return Err(invalid(
+                "camera.naming",
+                format!("{pattern:?}"),
+                "its extension must match camera.format (.png, or .tif/.tiff)",
+            ));
+        }
+        let b = &raw.ball;
+        check(
+            "ball.diameter_m",
+            b.diameter_m,
+            b.diameter_m > 0.0 && b.diameter_m < 10.0,
+            "must be > 0 m",
+        )?;
+        check("ball.mass_kg", b.mass_kg, b.mass_kg > 0.0, "must be > 0 kg")?;
+        check(
+            "ball.inertia_factor",
+            b.inertia_factor,
+            b.inertia_factor > 0.0,
+            "must be > 0",
+        )?;
+        check(
+            "pre_contact_ms",
+            raw.pre_contact_ms,
+            (0.0..=2000.0).contains(&raw.pre_contact_ms),
+            "must be 0 to 2000 ms",
+        )?;
+        check(
+            "post_separation_ms",
+            raw.post_separation_ms,
+            (0.0..=2000.0).contains(&raw.post_separation_ms),
+            "must be 0 to 2000 ms",
+        )?;
+
+        // Surfaces: a texture plus per-surface model values.
+        let mut surfaces = Vec::new();
+        for (name, body) in &raw.surfaces {
+            let field = format!("surfaces.{name}");
+            let t = body
+                .as_table()
+                .ok_or_else(|| syntax(format!("{field} must be a table")))?;
+            let tex = t
+                .get("texture")
+                .ok_or_else(|| syntax(format!("{field}: missing `texture` (clay, white_tape or green_tape)")))?;
+            let texture: Texture = tex.clone().try_into().map_err(|_| {
+                invalid(
+                    &format!("{field}.texture"),
+                    tex.to_string(),
+                    "expected \"clay\", \"white_tape\" or \"green_tape\"",
+                )
+            })?;
+            let mut model_values = t.clone();
+            model_values.remove("texture");
+            if name.is_empty() || name.contains([',', '"', '/', '\\', '\n']) {
+                return Err(invalid(
+                    &field,
+                    format!("{name:?}"),
+                    "a surface name must be non-empty, without , \" / \\",
+                ));
+            }
+            surfaces.push(Surface {
+                name: name.clone(),
+                texture,
+                model_values,
+            });
+        }
+        if surfaces.is_empty() {
+            return Err(syntax(
+                "no surfaces: add at least one [surfaces.NAME] with a texture".into(),
+            ));
+        }
+        let surface_names = || surfaces.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", ");
+
+        // Shots: the list, then the grid.
+        let mut shots = raw.shots;
+        if let Some(g) = &raw.grid {
+            for s in &g.surfaces {
+                if !surfaces.iter().any(|x| &x.name == s) {
+                    return Err(RenderError::UnknownSurface {
+                        origin: origin.to_string(),
+                        field: "grid.surfaces".into(),
+                        surface: s.clone(),
+                        known: surface_names(),
+                    });
+                }
+            }
+            if g.repeats == 0 {
+                return Err(invalid("grid.repeats", "0".into(), "must be ≥ 1"));
+            }
+            for s in &g.surfaces {
+                for &a in &g.angles_deg {
+                    for &h in &g.drop_heights_m {
+                        for r in 1..=g.repeats {
+                            shots.push(Shot {
+                                surface: s.clone(),
+                                angle_deg: a,
+                                drop_height_m: h,
+                                repeat: r,
+                                effects: g.effects.clone(),
+                            });
+                        }
+                    }
+                }
+            }
+        }
+        if shots.is_empty() {
+            return Err(syntax("no shots: add [[shots]] or a [grid]".into()));
+        }
+        for (i, s) in shots.iter().enumerate() {
+            let f = |k: &str| format!("shots[{i}].{k}");
+            if !surfaces.iter().any(|x| x.name == s.surface) {
+                return Err(RenderError::UnknownSurface {
+                    origin: origin.to_string(),
+                    field: f("surface"),
+                    surface: s.surface.clone(),
+                    known: surface_names(),
+                });
+            }
+            check(
+                &f("angle_deg"),
+                s.angle_deg,
+                s.angle_deg.abs() <= 60.0,
+                "must be within ±60°",
+            )?;
+            check(
+                &f("drop_height_m"),
+                s.drop_height_m,
+                s.drop_height_m > 0.0 && s.drop_height_m <= 10.0,
+                "must be > 0 and ≤ 10 m",
+            )?;
+            if s.repeat == 0 {
+                return Err(invalid(&f("repeat"), "0".into(), "must be ≥ 1"));
+            }
+            for e in &s.effects {
+                if !raw.extra_effects.contains_key(e) {
+                    return Err(RenderError::UnknownEffect {
+                        origin: origin.to_string(),
+                        field: f("effects"),
+                        effect: e.clone(),
+                        known: if raw.extra_effects.is_empty() {
+                            "none".into()
+                        } else {
+                            raw.extra_effects.keys().cloned().collect::<Vec<_>>().join(", ")
+                        },
+                    });
+                }
+            }
+        }
+        let model = raw.model.unwrap_or_else(default_model);
+        for key in ["ball", "surfaces"] {
+            if model.contains_key(key) {
+                return Err(syntax(format!(
+                    "model.{key}: the ball comes from [ball] and per-surface values go under [surfaces.NAME]"
+                )));
+            }
+        }
+        let scenario = Scenario {
+            origin: origin.to_string(),
+            source: text.to_string(),
+            name: raw.name.unwrap_or_else(|| "scenario".into()),
+            description: raw.description.unwrap_or_default(),
+            seed: raw.seed,
+            pre_contact_s: raw.pre_contact_ms * 1e-3,
+            post_separation_s: raw.post_separation_ms * 1e-3,
+            ball: raw.ball,
+            camera: raw.camera,
+            surfaces,
+            shots,
+            model,
+            extra_effects: raw.extra_effects,
+        };
+        // Surface values may only name effects of the model or of [extra_effects].
+        let model_effects = scenario.model.get("effects").and_then(Value::as_table);
+        for s in &scenario.surfaces {
+            for key in s.model_values.keys() {
+                let known =
+                    model_effects.is_some_and(|m| m.contains_key(key)) || scenario.extra_effects.contains_key(key);
+                if !known {
+                    return Err(syntax(format!(
+                        "surfaces.{}.{key}: no effect `{key}` in [model.effects] or [extra_effects] (write e.g. spring.k = 25650)",
+                        s.name
+                    )));
+                }
+            }
+        }
+        // Check every effect set the shots use, for every surface they use it on.
+        let mut seen: Vec<(Vec<String>, String)> = Vec::new();
+        for s in &scenario.shots {
+            let key = (s.effects.clone(), s.surface.clone());
+            if seen.contains(&key) {
+                continue;
+            }
+            let spec = scenario.model_spec(&s.effects)?;
+            spec.build(Some(&s.surface)).map_err(|source| RenderError::Model {
+                origin: origin.to_string(),
+                context: format!("surface `{}` with effects [{}]", s.surface, s.effects.join(", ")),
+                source: Box::new(source),
+            })?;
+            seen.push(key);
+        }
+        Ok(scenario)
+    }
+
+    /// The model file (model.toml text) for shots with the extra effects `effects` switched on: `[model]`,
+    /// the ball, the chosen `[extra_effects]` and every surface's values for the effects present.
+    pub fn model_toml(&self, effects: &[String]) -> String {
+        let mut t = Table::new();
+        if let Some(g) = self.model.get("gravity_m_s2") {
+            t.insert("gravity_m_s2".into(), g.clone());
+        }
+        let mut ball = Table::new();
+        ball.insert("mass_kg".into(), Value::Float(self.ball.mass_kg));
+        ball.insert("radius_m".into(), Value::Float(self.ball.diameter_m / 2.0));
+        ball.insert("inertia_factor".into(), Value::Float(self.ball.inertia_factor));
+        t.insert("ball".into(), Value::Table(ball));
+        for (k, v) in &self.model {
+            if k != "gravity_m_s2" && k != "effects" {
+                t.insert(k.clone(), v.clone());
+            }
+        }
+        let mut fx = self
+            .model
+            .get("effects")
+            .and_then(Value::as_table)
+            .cloned()
+            .unwrap_or_default();
+        for e in effects {
+            if !fx.contains_key(e)
+                && let Some(v) = self.extra_effects.get(e)
+            {
+                fx.insert(e.clone(), v.clone());
+            }
+        }
+        let mut surfaces = Table::new();
+        for s in &self.surfaces {
+            let mut vals = Table::new();
+            for (k, v) in &s.model_values {
+                if fx.contains_key(k) {
+                    vals.insert(k.clone(), v.clone());
+                }
+            }
+            surfaces.insert(s.name.clone(), Value::Table(vals));
+        }
+        t.insert("effects".into(), Value::Table(fx));
+        t.insert("surfaces".into(), Value::Table(surfaces));
+        toml::to_string(&t).expect("a TOML table serializes")
+    }
+
+    /// The parsed model for shots with the extra effects `effects` switched on.
+    pub fn model_spec(&self, effects: &[String]) -> Result<ModelSpec, RenderError> {
+        let text = self.model_toml(effects);
+        ModelSpec::parse(&text, &format!("{} [model]", self.origin)).map_err(|source| RenderError::Model {
+            origin: self.origin.clone(),
+            context: format!("the model with effects [{}]", effects.join(", ")),
+            source: Box::new(source),
+        })
+    }
+
+    /// The surface called `name`.
+    pub fn surface(&self, name: &str) -> Option<&Surface> {
+        self.surfaces.iter().find(|s| s.name == name)
+    }
+
+    /// The extra effects defined in `[extra_effects]`, in file order.
+    pub fn extra_effect_names(&self) -> Vec<&str> {
+        self.extra_effects.keys().map(String::as_str).collect()
+    }
+
+    /// The clip (folder) name of shot `index` (0-based), e.g. `S001_clay_7.5deg_300mm_r1`.
+    pub fn clip_name(&self, index: usize) -> String {
+        let s = &self.shots[index];
+        format!(
+            "S{:03}_{}_{}deg_{}mm_r{}",
+            index + 1,
+            s.surface,
+            s.angle_deg,
+            (s.drop_height_m * 1000.0).round() as i64,
+            s.repeat
+        )
+    }
+}
+
+/// The paper's base model without per-surface values, for scenarios without `[model]`.
+fn default_model() -> Table {
+    let text =
+        "gravity_m_s2 = 9.81\n[effects.spring]\nk = 25650\n[effects.damping]\nb = 14\n[effects.coulomb]\nmu = 0.5\n";
+    text.parse().expect("built-in model parses")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn naming_patterns() {
+        assert_eq!(
+            parse_naming("C001H001S0001{:06}.png").unwrap(),
+            ("C001H001S0001".into(), 6, ".png".into())
+        );
+        assert_eq!(parse_naming("{}.tif").unwrap().1, 0);
+        assert!(parse_naming("img.png").is_err());
+        assert!(parse_naming("img{:06}_2.png").is_err());
+        let c = Camera::default();
+        assert_eq!(c.frame_name(123), "C001H001S0001000123.png");
+    }
+}

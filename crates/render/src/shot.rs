@@ -1,0 +1,381 @@
+//! One shot: its physics (the model simulated at the frame and sub-exposure times), the camera placement,
+//! and the exact truth per frame and per shot.
+
+use crate::rng::{Rng, derive};
+use crate::{RenderError, Scenario};
+use bouncelab_model::{Phase, SimOptions, simulate_drop};
+use serde::Serialize;
+
+/// Where the ball is with respect to the frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Visibility {
+    /// The whole disc is inside the frame.
+    Full,
+    /// Part of the disc is outside the frame.
+    CutByBorder,
+    /// The disc is entirely outside the frame.
+    Absent,
+}
+
+impl Visibility {
+    /// As written in truth files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Visibility::Full => "full",
+            Visibility::CutByBorder => "cut_by_border",
+            Visibility::Absent => "absent",
+        }
+    }
+}
+
+/// The truth of one frame, at its mid-exposure time.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct FrameTruth {
+    /// Frame index (0-based).
+    pub frame: usize,
+    /// Time since the first frame, s (= frame / fps).
+    pub t_s: f64,
+    /// Ball centre, pixels, x to the right (pixel centres at integers).
+    pub x_px: f64,
+    /// Ball centre, pixels, y down.
+    pub y_px: f64,
+    /// Ball radius, pixels.
+    pub r_px: f64,
+    /// Ball centre along the surface (down-slope), m, local frame (SPEC §3).
+    pub x_m: f64,
+    /// Ball centre height above the surface line, m, local frame.
+    pub y_m: f64,
+    /// Orientation of the ball (its seam), rad, counter-clockwise, local frame (the model's θ plus the
+    /// shot's random initial orientation).
+    pub theta_rad: f64,
+    /// Phase of the impact.
+    pub phase: Phase,
+    /// Where the disc is with respect to the frame.
+    pub visible: Visibility,
+    /// Penetration δ = max(R − y, 0), m.
+    pub delta_m: f64,
+}
+
+/// The truth of one shot (a row of `truth/shots.csv`). Velocities in m/s in the local frame, spin in
+/// rad/s counter-clockwise, times in s since the clip's first frame.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ShotTruth {
+    /// Clip (folder) name.
+    pub clip: String,
+    /// Surface name.
+    pub surface: String,
+    /// Incline β, degrees.
+    pub angle_deg: f64,
+    /// Drop height, m.
+    pub drop_height_m: f64,
+    /// Repeat number.
+    pub repeat: u32,
+    /// The shot's seed (derived from the session seed and the shot index).
+    pub seed: u64,
+    /// Number of frames.
+    pub frames: usize,
+    /// Tangential velocity at touch.
+    pub v_in_t: f64,
+    /// Normal velocity at touch (< 0).
+    pub v_in_n: f64,
+    /// Tangential velocity at separation.
+    pub v_out_t: f64,
+    /// Normal velocity at separation (> 0).
+    pub v_out_n: f64,
+    /// Coefficient of restitution |v_out_n / v_in_n|.
+    pub cor: f64,
+    /// Effective friction −Δv_t/Δv_n (the paper's momentum ratio).
+    pub mu_eff: f64,
+    /// Touch time, s.
+    pub t_touch_s: f64,
+    /// Maximum-compression time, s.
+    pub t_max_s: f64,
+    /// Separation time, s.
+    pub t_sep_s: f64,
+    /// Contact time, ms.
+    pub contact_ms: f64,
+    /// Maximum penetration, m.
+    pub delta_max_m: f64,
+    /// Spin at touch, rad/s.
+    pub spin_in: f64,
+    /// Spin at separation, rad/s.
+    pub spin_out: f64,
+    /// True if the ball rolled (contact point sticking) at separation.
+    pub rolling_at_separation: bool,
+    /// Scale, m per pixel.
+    pub scale_m_per_px: f64,
+    /// Ball radius, pixels.
+    pub r_px: f64,
+    /// y of the surface line at the image's centre column, pixels.
+    pub surface_y_px: f64,
+    /// Angle of the surface line in the image, degrees counter-clockwise as seen (−roll for "+x").
+    pub surface_tilt_deg: f64,
+    /// Total camera roll (scenario `camera.roll_deg` plus the `camera_roll` effect), degrees.
+    pub roll_deg: f64,
+    /// Image direction that is down-slope.
+    pub downslope: String,
+    /// Spring stiffness k of the shot's model, N/m (if it has a `spring`).
+    pub k: Option<f64>,
+    /// Compression damping b, N·s/m (if it has `damping`).
+    pub b: Option<f64>,
+    /// Coulomb friction μ (if it has `coulomb`).
+    pub mu: Option<f64>,
+    /// Every effect of the shot's model with its parameter values, as JSON (`{"spring":{"k":25650},…}`).
+    pub effects_json: String,
+    /// The extra (hidden) effects switched on for this shot.
+    pub extra_effects: Vec<String>,
+}
+
+/// Camera placement: local metres → image pixels (roll, mirror for "-x", translation).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Geometry {
+    pub scale: f64,
+    pub cos: f64,
+    pub sin: f64,
+    pub dir: f64,
+    pub tx: f64,
+    pub ty: f64,
+}
+
+impl Geometry {
+    /// Image pixel position of the local point (x, y) m.
+    pub fn to_px(self, x: f64, y: f64) -> (f64, f64) {
+        let xc = self.cos * x + self.sin * y;
+        let yc = -self.sin * x + self.cos * y;
+        (self.tx + self.dir * xc / self.scale, self.ty - yc / self.scale)
+    }
+
+    /// Local coordinates of an image point, in pixels: (along the surface, height above the surface line).
+    pub fn to_local_px(self, px: f64, py: f64) -> (f64, f64) {
+        let xc = self.dir * (px - self.tx);
+        let yc = self.ty - py;
+        (self.cos * xc - self.sin * yc, self.sin * xc + self.cos * yc)
+    }
+}
+
+/// A planned shot: physics done, camera placed, truth known; images not yet made
+/// ([`ShotPlan::renderer`] makes them).
+#[derive(Debug, Clone)]
+pub struct ShotPlan {
+    /// Shot index in the scenario (0-based).
+    pub index: usize,
+    /// The shot's truth.
+    pub truth: ShotTruth,
+    /// The truth of every frame.
+    pub frames: Vec<FrameTruth>,
+    pub(crate) camera: crate::Camera,
+    pub(crate) texture: crate::Texture,
+    pub(crate) geom: Geometry,
+    /// Ball centre (px) at each sub-exposure time, `blur_samples` per frame.
+    pub(crate) subs: Vec<(f64, f64)>,
+    /// Orientation of the ball's pattern in the image, rad counter-clockwise as seen, per frame.
+    pub(crate) alpha: Vec<f64>,
+    /// Maximum penetration, pixels.
+    pub(crate) delta_max_px: f64,
+    pub(crate) flicker_phase: f64,
+    /// The session's seed (the sensor's fixed pattern is the same in every clip).
+    pub(crate) session_seed: u64,
+}
+
+/// Shots at most this far (s) from the release cannot start earlier.
+const MIN_T0: f64 = 1e-4;
+
+impl ShotPlan {
+    /// Simulates shot `index` of `scenario` and places the camera.
+    ///
+    /// Placement (per shot): the ball's whole path over the clip is centred horizontally (plus a random
+    /// shift of up to ±30 px where there is room) and the surface line's origin sits at 78 % of the frame
+    /// height, moved down (to at most 94 %) when the path would otherwise leave the top of the frame.
+    pub fn new(scenario: &Scenario, index: usize) -> Result<ShotPlan, RenderError> {
+        let shot = scenario.shots.get(index).ok_or_else(|| RenderError::InvalidValue {
+            origin: scenario.origin.clone(),
+            field: "shots".into(),
+            value: index.to_string(),
+            reason: format!("no shot with that index (there are {})", scenario.shots.len()),
+        })?;
+        let clip = scenario.clip_name(index);
+        let model_err = |source: bouncelab_model::ModelError| RenderError::Model {
+            origin: scenario.origin.clone(),
+            context: format!("shot {clip}"),
+            source: Box::new(source),
+        };
+        let spec = scenario.model_spec(&shot.effects)?;
+        let model = spec.build(Some(&shot.surface)).map_err(model_err)?;
+        let settings = spec.settings(Some(&shot.surface)).map_err(model_err)?;
+        let cam = scenario.camera.clone();
+        let beta = shot.angle_deg.to_radians();
+        let opts = SimOptions::default();
+        let impact = simulate_drop(&model, beta, shot.drop_height_m, &[], &opts)
+            .map_err(model_err)?
+            .impact;
+
+        let seed = derive(scenario.seed, index as u64);
+        let mut rng = Rng::new(seed);
+        let dt = 1.0 / cam.fps;
+        let half = cam.exposure_s / 2.0;
+        let t0 = (impact.t_touch - scenario.pre_contact_s - rng.uniform() * 2.0 * dt).max(half + MIN_T0);
+        let t_end = impact.t_separation + scenario.post_separation_s;
+        let n = ((t_end - t0) * cam.fps).floor().max(0.0) as usize + 1;
+        let k = cam.blur_samples as usize;
+        let mids: Vec<f64> = (0..n).map(|i| t0 + i as f64 / cam.fps).collect();
+        let subs_t: Vec<f64> = mids
+            .iter()
+            .flat_map(|&t| (0..k).map(move |j| t + ((j as f64 + 0.5) / k as f64 - 0.5) * cam.exposure_s))
+            .collect();
+        let sim_mid = simulate_drop(&model, beta, shot.drop_height_m, &mids, &opts).map_err(model_err)?;
+        let sim_sub = simulate_drop(&model, beta, shot.drop_height_m, &subs_t, &opts).map_err(model_err)?;
+
+        let roll_effect = model.effect("camera_roll").map(|e| e.params()[0]).unwrap_or(0.0);
+        let roll_deg = cam.roll_deg + roll_effect;
+        let phi = roll_deg.to_radians();
+        let dir = cam.downslope.sign();
+        let theta0 = rng.range(0.0, std::f64::consts::TAU);
+        let scale = cam.scale_m_per_px;
+        let r_m = scenario.ball.diameter_m / 2.0;
+        let r_px = r_m / scale;
+        let mut geom = Geometry {
+            scale,
+            cos: phi.cos(),
+            sin: phi.sin(),
+            dir,
+            tx: 0.0,
+            ty: 0.0,
+        };
+        let mut subs: Vec<(f64, f64)> = sim_sub
+            .samples
+            .iter()
+            .map(|s| geom.to_px(s.state.x, s.state.y))
+            .collect();
+        let mut centres: Vec<(f64, f64)> = sim_mid
+            .samples
+            .iter()
+            .map(|s| geom.to_px(s.state.x, s.state.y))
+            .collect();
+        let (w, h) = (cam.width as f64, cam.height as f64);
+        let (mut xmin, mut xmax, mut ymin) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY);
+        for &(x, y) in subs.iter().chain(&centres) {
+            xmin = xmin.min(x - r_px);
+            xmax = xmax.max(x + r_px);
+            ymin = ymin.min(y - r_px);
+        }
+        let room = ((w - (xmax - xmin)) / 2.0 - 8.0).clamp(0.0, 30.0);
+        geom.tx = (w - 1.0) / 2.0 - (xmin + xmax) / 2.0 + rng.range(-room, room);
+        geom.ty = 0.78 * h;
+        if ymin + geom.ty < 6.0 {
+            geom.ty = (6.0 - ymin).min(0.94 * h);
+        }
+        for p in subs.iter_mut().chain(centres.iter_mut()) {
+            p.0 += geom.tx;
+            p.1 += geom.ty;
+        }
+        let alpha: Vec<f64> = sim_mid
+            .samples
+            .iter()
+            .map(|s| dir * (theta0 + s.state.theta - phi))
+            .collect();
+        let frames: Vec<FrameTruth> = sim_mid
+            .samples
+            .iter()
+            .zip(&centres)
+            .enumerate()
+            .map(|(i, (s, &(x, y)))| {
+                let (l, r, t, b) = (x - r_px, x + r_px, y - r_px, y + r_px);
+                let visible = if l >= -0.5 && r <= w - 0.5 && t >= -0.5 && b <= h - 0.5 {
+                    Visibility::Full
+                } else if r < -0.5 || l > w - 0.5 || b < -0.5 || t > h - 0.5 {
+                    Visibility::Absent
+                } else {
+                    Visibility::CutByBorder
+                };
+                FrameTruth {
+                    frame: i,
+                    t_s: i as f64 / cam.fps,
+                    x_px: x,
+                    y_px: y,
+                    r_px,
+                    x_m: s.state.x,
+                    y_m: s.state.y,
+                    theta_rad: theta0 + s.state.theta,
+                    phase: s.phase,
+                    visible,
+                    delta_m: (r_m - s.state.y).max(0.0),
+                }
+            })
+            .collect();
+
+        let find = |e: &str, p: &str| {
+            settings
+                .iter()
+                .find(|(r, _)| r.effect == e && r.param == p)
+                .map(|(_, s)| s.value)
+        };
+        let mut effects = serde_json::Map::new();
+        for (r, s) in &settings {
+            let entry = effects
+                .entry(r.effect.clone())
+                .or_insert_with(|| serde_json::Value::Object(serde_json::Map::new()));
+            if let serde_json::Value::Object(m) = entry {
+                m.insert(r.param.clone(), serde_json::json!(s.value));
+            }
+        }
+        let xcen = (w - 1.0) / 2.0;
+        let surface_y_px = geom.ty + geom.sin * (xcen - geom.tx) / (dir * geom.cos);
+        let truth = ShotTruth {
+            clip,
+            surface: shot.surface.clone(),
+            angle_deg: shot.angle_deg,
+            drop_height_m: shot.drop_height_m,
+            repeat: shot.repeat,
+            seed,
+            frames: n,
+            v_in_t: impact.state_in.vx,
+            v_in_n: impact.state_in.vy,
+            v_out_t: impact.state_out.vx,
+            v_out_n: impact.state_out.vy,
+            cor: impact.restitution,
+            mu_eff: impact.effective_friction,
+            t_touch_s: impact.t_touch - t0,
+            t_max_s: impact.t_max_compression - t0,
+            t_sep_s: impact.t_separation - t0,
+            contact_ms: impact.contact_time() * 1e3,
+            delta_max_m: impact.delta_max,
+            spin_in: impact.omega_in(),
+            spin_out: impact.omega_out(),
+            rolling_at_separation: impact.rolling_at_separation,
+            scale_m_per_px: scale,
+            r_px,
+            surface_y_px,
+            surface_tilt_deg: -dir * roll_deg,
+            roll_deg,
+            downslope: cam.downslope.as_str().to_string(),
+            k: find("spring", "k"),
+            b: find("damping", "b"),
+            mu: find("coulomb", "mu"),
+            effects_json: serde_json::Value::Object(effects).to_string(),
+            extra_effects: shot.effects.clone(),
+        };
+        let texture = scenario
+            .surface(&shot.surface)
+            .map(|s| s.texture)
+            .unwrap_or(crate::Texture::Clay);
+        Ok(ShotPlan {
+            index,
+            truth,
+            frames,
+            camera: cam,
+            texture,
+            geom,
+            subs,
+            alpha,
+            delta_max_px: impact.delta_max / scale,
+            flicker_phase: rng.range(0.0, std::f64::consts::TAU),
+            session_seed: scenario.seed,
+        })
+    }
+
+    /// The seed of frame `frame`'s noise.
+    pub(crate) fn frame_seed(&self, frame: usize) -> u64 {
+        derive(self.truth.seed, 1 + frame as u64)
+    }
+}

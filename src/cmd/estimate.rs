@@ -1,0 +1,108 @@
+//! `bouncelab estimate`: one clip folder → its per-shot measurements with standard errors.
+
+use anyhow::Context;
+use bouncelab_estimate::{Conditions, Estimate, estimate};
+use bouncelab_frames::{Clip, ClipOptions, Downslope, Session};
+use bouncelab_track::{ClipTracking, track_clip};
+use std::path::{Path, PathBuf};
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Folder of frames (one clip), inside a session folder or on its own.
+    clip_dir: PathBuf,
+    /// Incline of the surface, degrees (default: the clip's angle_deg in the session's clips.csv).
+    #[arg(long, allow_negative_numbers = true)]
+    angle: Option<f64>,
+    /// Frame rate, frames/s (beats clip.toml and session.toml).
+    #[arg(long)]
+    fps: Option<f64>,
+    /// Gravitational acceleration, m/s².
+    #[arg(long, default_value_t = 9.81)]
+    gravity: f64,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+/// What the session around the clip says: ball diameter, down-slope direction, and the clip's incline.
+fn from_session(clip_dir: &Path) -> (Option<f64>, bool, Option<f64>) {
+    let Ok(dir) = clip_dir.canonicalize() else {
+        return (None, false, None);
+    };
+    let (Some(parent), Some(name)) = (dir.parent(), dir.file_name().and_then(|n| n.to_str())) else {
+        return (None, false, None);
+    };
+    if !parent.join("session.toml").is_file() {
+        return (None, false, None);
+    }
+    match Session::load(parent) {
+        Ok(s) => {
+            let clip = s.clip(name);
+            let minus_x = clip.map(|c| c.downslope).unwrap_or(s.downslope) == Downslope::MinusX;
+            (Some(s.ball.diameter_m), minus_x, clip.map(|c| c.angle_deg))
+        }
+        Err(_) => (None, false, None),
+    }
+}
+
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let options = a.fps.map(ClipOptions::with_fps).unwrap_or_default();
+    let clip = Clip::open_with(&a.clip_dir, &options)?;
+    let (diameter, minus_x, session_angle) = from_session(&a.clip_dir);
+    let Some(angle) = a.angle.or(session_angle) else {
+        anyhow::bail!(
+            "{}: no incline known: give --angle, or put the clip in a session folder whose clips.csv lists it",
+            a.clip_dir.display()
+        );
+    };
+    let diameter = diameter.unwrap_or(0.067);
+    let opts = ClipTracking {
+        ball_diameter_m: diameter,
+        downslope_negative_x: minus_x,
+        ..ClipTracking::default()
+    };
+    let bar = super::progress_bar(clip.len() as u64, "tracking");
+    let track = track_clip(&clip, &opts, |done, _| bar.set_position(done as u64))
+        .with_context(|| format!("tracking {}", a.clip_dir.display()))?;
+    bar.finish_and_clear();
+    let c = Conditions {
+        incline_deg: angle,
+        gravity: a.gravity,
+        ball_diameter_m: diameter,
+    };
+    let e = estimate(&track, &c).with_context(|| format!("estimating {}", a.clip_dir.display()))?;
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&e)?);
+    } else {
+        print_table(&a.clip_dir, angle, &e);
+    }
+    Ok(())
+}
+
+fn print_table(clip: &Path, angle: f64, e: &Estimate) {
+    println!("{}  (incline {angle}°)", clip.display());
+    let row = |name: &str, unit: &str, v: f64, se: f64| println!("  {name:<14} {v:>10.4} ± {se:<8.4} {unit}");
+    row("v_in_t", "m/s", e.v_in[0].value, e.v_in[0].se);
+    row("v_in_n", "m/s", e.v_in[1].value, e.v_in[1].se);
+    row("v_out_t", "m/s", e.v_out[0].value, e.v_out[0].se);
+    row("v_out_n", "m/s", e.v_out[1].value, e.v_out[1].se);
+    row("COR", "", e.cor.value, e.cor.se);
+    row("μ_eff", "", e.mu.value, e.mu.se);
+    row("contact", "ms", e.contact_ms.value, e.contact_ms.se);
+    row("δ_max", "mm", e.delta_max_m.value * 1e3, e.delta_max_m.se * 1e3);
+    match (e.spin_in, e.spin_out) {
+        (Some(i), Some(o)) => {
+            row("spin_in", "rad/s", i.value, i.se);
+            row("spin_out", "rad/s", o.value, o.se);
+        }
+        _ => println!("  spin           not measured (texture rotation is not implemented yet)"),
+    }
+    let p = &e.phases;
+    println!(
+        "  phases: flight in frames {}–{} ({} fitted), contact {}–{}, flight out {}–{} ({} fitted)",
+        p.flight_in.0, p.flight_in.1, p.fitted.0, p.contact.0, p.contact.1, p.flight_out.0, p.flight_out.1, p.fitted.1
+    );
+    for n in &e.notes {
+        println!("  note: {n}");
+    }
+}
