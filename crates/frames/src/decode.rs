@@ -4,7 +4,7 @@
 //! bottleneck, can also go through `zune-png` ([`PngDecoder::Zune`]) for the plain variants it is checked
 //! byte-identical to `image` on (8/16-bit gray, gray+alpha, RGB, RGBA, not interlaced; palette, sub-8-bit
 //! and interlaced PNGs and anything it rejects fall back to `image`). Measured on noisy 512×512 8-bit
-//! frames (`docs/frames-decoders.md`), `image` 0.25 (png 0.18) was the faster of the two — 1.1–3.5× — so
+//! frames (`docs/frames-decoding.md`), `image` 0.25 (png 0.18) was the faster of the two — 1.1–3.5× — so
 //! it is the default and `zune-png` stays as the measured alternative. Colour is converted to luma with
 //! `image`'s Rec. 709 weights on both paths.
 
