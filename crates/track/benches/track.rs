@@ -2,9 +2,9 @@
 //!
 //! Run: `cargo bench -p bouncelab-track --bench track`
 //! 100 synthetic 512×512 8-bit frames of a ball (radius 84 px) falling onto a textured surface band, decoded
-//! in memory beforehand; "track_frame" is the per-frame cost of following the ball (prediction, edge search
-//! along 128 rays, two robust fits); "detect_full_frame" is the Hough search used on the first frame and
-//! after a loss.
+//! in memory beforehand. "track_frame_steady": following the ball once found (prediction, one edge pass
+//! along 128 rays, the robust fit). "cold_start_first_frame": the first frame of a clip without a track
+//! (surface line, Hough, refined candidates). "detect_full_frame": the Hough transform alone.
 
 use bouncelab_track::testutil::{Scene, render};
 use bouncelab_track::{CircleDetection, Plane, TrackOptions, Tracker, detect_circles};
@@ -32,20 +32,27 @@ fn frames() -> Vec<Vec<u8>> {
 
 fn bench(c: &mut Criterion) {
     let frames = frames();
+    let opts = TrackOptions {
+        radius_px: Some((70.0, 100.0)),
+        ..TrackOptions::default()
+    };
+    // A tracker that has already found the ball and the surface on the first frame.
+    let mut warm = Tracker::new(opts.clone());
+    warm.observe(0, 0.0, &Plane::new(&frames[0], 512, 512));
     let mut g = c.benchmark_group("track");
-    g.throughput(Throughput::Elements(frames.len() as u64));
-    g.bench_function("track_frame", |b| {
+    g.throughput(Throughput::Elements((frames.len() - 1) as u64));
+    g.bench_function("track_frame_steady", |b| {
         b.iter(|| {
-            let mut t = Tracker::new(TrackOptions {
-                radius_px: Some((70.0, 100.0)),
-                ..TrackOptions::default()
-            });
-            for (i, f) in frames.iter().enumerate() {
+            let mut t = warm.clone();
+            for (i, f) in frames.iter().enumerate().skip(1) {
                 black_box(t.observe(i, i as f64 * 1e-4, &Plane::new(f, 512, 512)));
             }
         })
     });
     g.throughput(Throughput::Elements(1));
+    g.bench_function("cold_start_first_frame", |b| {
+        b.iter(|| black_box(Tracker::new(opts.clone()).observe(0, 0.0, &Plane::new(&frames[0], 512, 512))))
+    });
     let det = CircleDetection {
         min_radius: 70.0,
         max_radius: 100.0,

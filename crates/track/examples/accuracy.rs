@@ -1,4 +1,4 @@
-// cargo run --release -p bouncelab-track --example accuracy -- [PRESET|SESSION_DIR TRUTH_DIR] [--seed N]
+// cargo run --release -p bouncelab-track --example accuracy -- [PRESET|SCENARIO.toml|SESSION_DIR TRUTH_DIR] [--seed N]
 //
 //! Tracker accuracy against the renderer's exact truth: per clip, the centre error in flight and in contact,
 //! the jitter (residual from a local quadratic over 11 frames), the radius bias, the calibration of σ, the
@@ -76,7 +76,11 @@ fn main() {
         (positional[0].into(), positional[1].into())
     } else {
         let preset = positional.first().map(|s| s.as_str()).unwrap_or("none");
-        let mut scenario = bouncelab_render::Scenario::preset(preset).expect("preset");
+        let mut scenario = if preset.ends_with(".toml") {
+            bouncelab_render::Scenario::load(Path::new(preset)).expect("scenario")
+        } else {
+            bouncelab_render::Scenario::preset(preset).expect("preset")
+        };
         if let Some(s) = seed {
             scenario.seed = s;
         }

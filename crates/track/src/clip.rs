@@ -204,6 +204,8 @@ fn acquire(clip: &Clip, opts: &ClipTracking, warnings: &mut Vec<String>) -> Resu
     let det = CircleDetection {
         min_radius: 8.0,
         max_radius: w.min(h) as f64 / 2.0,
+        // A seam drawn as a dark line can out-vote the rim: keep enough candidates for the rim to be among them.
+        max_candidates: 24,
         ..CircleDetection::default()
     };
     let circles_in = |k: usize| -> Result<Vec<crate::Circle>, TrackError> {

@@ -228,9 +228,17 @@ pub fn refined_candidates<P: Pixel>(
     };
     let mut out: Vec<(crate::Circle, Refined)> = Vec::new();
     for c in crate::detect_circles(img, detection) {
+        // A vote peak next to a circle already refined would converge onto it again.
+        if out
+            .iter()
+            .any(|o| (o.0.x - c.x).hypot(o.0.y - c.y) < 0.1 * c.r && (o.0.r - c.r).abs() < 0.1 * c.r)
+        {
+            continue;
+        }
         let Some(f) = refine_circle(img, c.x, c.y, c.r, &wide, surface) else {
             continue;
         };
+        let f = grow_outward(img, f, &wide, surface, detection.max_radius);
         let (q, fit) = (f.quality(), f.fit);
         if q < min_quality || fit.r < detection.min_radius * 0.95 || fit.r > detection.max_radius * 1.05 {
             continue;
@@ -254,4 +262,33 @@ pub fn refined_candidates<P: Pixel>(
     out.retain(|c| kept.contains(&c.0));
     out.sort_by(|a, b| b.0.support.total_cmp(&a.0.support));
     out
+}
+
+/// The outermost clean circle around `f`: a ball's seam or shading can form a circle inside the ball; the
+/// ball's own rim is a larger circle containing it that is at least about as clean. Tries a few larger
+/// radii from the same centre and takes the first such circle, until none is found.
+fn grow_outward<P: Pixel>(
+    img: &Plane<P>,
+    mut f: Refined,
+    search: &EdgeSearch,
+    surface: Option<&SurfaceLine>,
+    max_r: f64,
+) -> Refined {
+    for _ in 0..4 {
+        let c = f.fit;
+        let grown = [1.12, 1.25, 1.4].iter().find_map(|k| {
+            let r = c.r * k;
+            if r > max_r * 1.05 {
+                return None;
+            }
+            let g = refine_circle(img, c.x, c.y, r, search, surface)?;
+            let contains = (g.fit.x - c.x).hypot(g.fit.y - c.y) + c.r <= g.fit.r * 1.03 + 2.0;
+            (g.fit.r > c.r + 2.0 && contains && g.quality() >= 0.9 * f.quality() && g.quality() >= 0.5).then_some(g)
+        });
+        match grown {
+            Some(g) => f = g,
+            None => break,
+        }
+    }
+    f
 }

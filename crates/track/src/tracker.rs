@@ -233,6 +233,8 @@ impl Tracker {
         let det = CircleDetection {
             min_radius: lo,
             max_radius: hi,
+            // A seam drawn as a dark line can out-vote the rim: keep enough candidates for the rim to be among them.
+            max_candidates: 24,
             ..CircleDetection::default()
         };
         let mut cands = refined_candidates(img, &det, &self.opts.search, self.surface.as_ref(), 0.3);

@@ -1,0 +1,77 @@
+//! Shared contact-model parameters fitted to the measured trajectories of many shots at once.
+//!
+//! Given measured shots ([`MeasuredShot`]: frames in the local frame, the incoming state taken from the
+//! measurement) and a [`ModelSpec`] whose parameters say which are free (globally, or per surface when
+//! `[surfaces.NAME]` sets them), [`fit`] finds the free parameters that make every simulated trajectory
+//! match its measured one in the weighted least-squares sense, with standard errors and confidence
+//! intervals. The design follows argmin: a [`Problem`] (implementing [`LeastSquares`]) owns the residuals,
+//! a [`LevenbergMarquardt`] solver written here minimises them (finite-difference Jacobian, parameter
+//! scaling, bounds by projection) and reports every iteration to an [`Observer`], and the run ends with a
+//! [`Termination`] reason the report can show. Shots are simulated in parallel with results collected in
+//! shot order, so a fit is deterministic.
+
+mod error;
+mod params;
+mod problem;
+mod result;
+mod shot;
+mod solver;
+
+pub use bouncelab_model::{ModelSpec, SimOptions, State};
+pub use error::FitError;
+pub use params::FreeParam;
+pub use problem::Problem;
+pub use result::{FitResult, FittedParam, ObliqueRow, ShotFit, SurfaceError};
+pub use shot::{MeasuredFrame, MeasuredOutputs, MeasuredShot, StartState};
+pub use solver::{
+    Iteration, LeastSquares, LevenbergMarquardt, LogObserver, NoObserver, Observer, SolverOutcome, Termination,
+};
+
+/// Settings of a fit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FitOptions {
+    /// The solver and its tolerances.
+    pub solver: LevenbergMarquardt,
+    /// Integration settings for every simulation.
+    pub sim: SimOptions,
+    /// Confidence level of the intervals (default 0.95).
+    pub confidence: f64,
+    /// Simulate the shots on several threads (default true; the result is identical either way).
+    pub parallel: bool,
+}
+
+impl Default for FitOptions {
+    fn default() -> Self {
+        FitOptions {
+            solver: LevenbergMarquardt::default(),
+            sim: SimOptions::default(),
+            confidence: 0.95,
+            parallel: true,
+        }
+    }
+}
+
+/// Fits the free parameters of `spec` to `shots`, starting from the model file's values.
+///
+/// Errors name the shot when an input cannot be used or its simulation fails at the starting values; a
+/// failure during the search ends it at the last good point with [`Termination::SimulationFailed`].
+pub fn fit(
+    spec: &ModelSpec,
+    shots: Vec<MeasuredShot>,
+    options: &FitOptions,
+    observer: &mut dyn Observer,
+) -> Result<FitResult, FitError> {
+    let problem = Problem::new(spec, shots, options.sim)?.with_parallel(options.parallel);
+    fit_problem(&problem, &spec.origin, options, observer)
+}
+
+/// Fits an already built [`Problem`]; `model` names the model in the result.
+pub fn fit_problem(
+    problem: &Problem,
+    model: &str,
+    options: &FitOptions,
+    observer: &mut dyn Observer,
+) -> Result<FitResult, FitError> {
+    let out = options.solver.run(problem, &problem.initial(), observer)?;
+    result::build(problem, &out, model, options.confidence)
+}

@@ -1,0 +1,530 @@
+//! A Levenberg–Marquardt solver for bounded least squares, argmin style: a problem trait, a solver that
+//! reports every iteration to an [`Observer`], and a [`Termination`] reason.
+
+use crate::FitError;
+use nalgebra::{DMatrix, DVector};
+use serde::{Deserialize, Serialize};
+use std::fmt;
+use std::io::Write;
+
+/// A least-squares problem: minimise `Σ rᵢ(p)²` over bounded parameters.
+pub trait LeastSquares: Sync {
+    /// Number of parameters.
+    fn n_params(&self) -> usize;
+    /// The residual vector at `p` (always the same length).
+    fn residuals(&self, p: &[f64]) -> Result<Vec<f64>, FitError>;
+    /// Bounds of parameter `j` (inclusive); unbounded by default.
+    fn bounds(&self, _j: usize) -> (f64, f64) {
+        (f64::NEG_INFINITY, f64::INFINITY)
+    }
+    /// Typical size of parameter `j` (> 0): the solver works in `p / scale` and takes finite-difference
+    /// steps relative to it.
+    fn scale(&self, _j: usize) -> f64 {
+        1.0
+    }
+}
+
+/// What the solver reports after each iteration (iteration 0 is the starting point).
+#[derive(Debug, Clone, Copy)]
+pub struct Iteration<'a> {
+    /// Iteration number, 0 for the start.
+    pub iteration: usize,
+    /// Cost `Σ r²` (χ² for weighted residuals) at `params`.
+    pub cost: f64,
+    /// Current parameters, in their units.
+    pub params: &'a [f64],
+    /// Damping λ (dimensionless: it multiplies the diagonal of JᵀJ) to be used for the next step.
+    pub lambda: f64,
+}
+
+/// Receives every iteration of a solver: a progress bar, a log, a test.
+pub trait Observer {
+    /// Called once per iteration.
+    fn observe(&mut self, it: &Iteration<'_>);
+}
+
+/// Ignores every iteration.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NoObserver;
+
+impl Observer for NoObserver {
+    fn observe(&mut self, _it: &Iteration<'_>) {}
+}
+
+/// Any closure taking an [`Iteration`] is an observer.
+impl<F: FnMut(&Iteration<'_>)> Observer for F {
+    fn observe(&mut self, it: &Iteration<'_>) {
+        self(it)
+    }
+}
+
+/// Writes one line per iteration: `iter 3  cost 1.234e3  λ 1.0e-4  clay:spring.k=25650 …`.
+#[derive(Debug)]
+pub struct LogObserver<W: Write> {
+    out: W,
+    names: Vec<String>,
+}
+
+impl<W: Write> LogObserver<W> {
+    /// A logger writing to `out`, naming the parameters with `names` (e.g. from [`crate::Problem::params`]).
+    pub fn new(out: W, names: Vec<String>) -> Self {
+        LogObserver { out, names }
+    }
+
+    /// The writer back.
+    pub fn into_inner(self) -> W {
+        self.out
+    }
+}
+
+impl<W: Write> Observer for LogObserver<W> {
+    fn observe(&mut self, it: &Iteration<'_>) {
+        let params = it
+            .params
+            .iter()
+            .enumerate()
+            .map(|(j, v)| match self.names.get(j) {
+                Some(n) => format!("{n}={v:.6e}"),
+                None => format!("p{j}={v:.6e}"),
+            })
+            .collect::<Vec<_>>()
+            .join(" ");
+        // A log that cannot be written is not a reason to stop a fit.
+        let _ = writeln!(
+            self.out,
+            "iter {:3}  cost {:.6e}  λ {:.1e}  {params}",
+            it.iteration, it.cost, it.lambda
+        );
+    }
+}
+
+/// Why the solver stopped.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "reason", rename_all = "snake_case")]
+#[non_exhaustive]
+pub enum Termination {
+    /// The relative cost change of an accepted step fell below `ftol`.
+    ConvergedCost,
+    /// The scaled step fell below `xtol` (relative to the scaled parameters).
+    ConvergedStep,
+    /// `max_iterations` reached.
+    MaxIterations,
+    /// No step lowering the cost was found even with very strong damping (a minimum to the solver's
+    /// resolution, or a parameter pressed against its bound).
+    Stalled,
+    /// A simulation failed at a trial point and no nearby point worked; the result is the last good point.
+    SimulationFailed {
+        /// The shot whose simulation failed.
+        shot: String,
+        /// Why.
+        message: String,
+    },
+}
+
+impl Termination {
+    /// True for the two converged reasons.
+    pub fn converged(&self) -> bool {
+        matches!(self, Termination::ConvergedCost | Termination::ConvergedStep)
+    }
+}
+
+impl fmt::Display for Termination {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Termination::ConvergedCost => write!(f, "converged (relative cost change below tolerance)"),
+            Termination::ConvergedStep => write!(f, "converged (step below tolerance)"),
+            Termination::MaxIterations => write!(f, "stopped at the maximum number of iterations"),
+            Termination::Stalled => write!(f, "stalled (no step lowers the cost)"),
+            Termination::SimulationFailed { shot, message } => {
+                write!(f, "stopped: the simulation of shot `{shot}` failed: {message}")
+            }
+        }
+    }
+}
+
+/// Levenberg–Marquardt with a finite-difference Jacobian, parameter scaling and bounds by projection.
+///
+/// Works in scaled parameters `u = p / scale`. Each step solves `(A + λ·diag A) δ = −g` with `A = JᵀJ`,
+/// `g = Jᵀr` (Marquardt's scaling, so λ is dimensionless), projects `u + δ` onto the bounds, and accepts
+/// it if the cost falls; λ follows Nielsen's rule (`λ·max(1/3, 1 − (2ρ − 1)³)` on success with gain ratio
+/// ρ, `λ·ν, ν·2` on failure). A trial point whose simulation fails counts as a failed step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LevenbergMarquardt {
+    /// Most iterations (accepted steps plus the final failed search).
+    pub max_iterations: usize,
+    /// Converged when an accepted step lowers the cost by less than `ftol · cost`.
+    pub ftol: f64,
+    /// Converged when the scaled step is below `xtol · (‖u‖ + xtol)`.
+    pub xtol: f64,
+    /// Finite-difference step relative to each parameter's scale (central differences, one-sided at a bound).
+    pub fd_step: f64,
+    /// Starting damping λ.
+    pub lambda_init: f64,
+    /// Damping at which the search gives up (stalled).
+    pub lambda_max: f64,
+}
+
+impl Default for LevenbergMarquardt {
+    fn default() -> Self {
+        LevenbergMarquardt {
+            max_iterations: 100,
+            ftol: 1e-10,
+            xtol: 1e-9,
+            fd_step: 1e-5,
+            lambda_init: 1e-3,
+            lambda_max: 1e12,
+        }
+    }
+}
+
+/// What the solver found.
+#[derive(Debug, Clone)]
+pub struct SolverOutcome {
+    /// Best parameters, in their units.
+    pub params: Vec<f64>,
+    /// Residuals there.
+    pub residuals: Vec<f64>,
+    /// Cost `Σ r²` there.
+    pub cost: f64,
+    /// Jacobian `∂r/∂p` (unscaled) at `params`, `None` if it could not be evaluated.
+    pub jacobian: Option<DMatrix<f64>>,
+    /// Iterations done.
+    pub iterations: usize,
+    /// Residual evaluations (simulations of every shot) done.
+    pub evaluations: usize,
+    /// Why it stopped.
+    pub termination: Termination,
+}
+
+struct Eval<'a, P: LeastSquares> {
+    problem: &'a P,
+    scale: Vec<f64>,
+    lo: Vec<f64>,
+    hi: Vec<f64>,
+    count: usize,
+}
+
+impl<P: LeastSquares> Eval<'_, P> {
+    fn params(&self, u: &[f64]) -> Vec<f64> {
+        u.iter().zip(&self.scale).map(|(u, s)| u * s).collect()
+    }
+
+    fn residuals(&mut self, u: &[f64], n: Option<usize>) -> Result<DVector<f64>, FitError> {
+        self.count += 1;
+        let r = self.problem.residuals(&self.params(u))?;
+        if let Some(n) = n
+            && r.len() != n
+        {
+            return Err(FitError::BadResiduals(format!("{} residuals, expected {n}", r.len())));
+        }
+        if let Some(i) = r.iter().position(|v| !v.is_finite()) {
+            return Err(FitError::BadResiduals(format!("residual {i} is {}", r[i])));
+        }
+        Ok(DVector::from_vec(r))
+    }
+
+    /// Jacobian with respect to the scaled parameters.
+    fn jacobian(&mut self, u: &[f64], r0: &DVector<f64>, h: f64) -> Result<DMatrix<f64>, FitError> {
+        let n = r0.len();
+        let mut jac = DMatrix::zeros(n, u.len());
+        for j in 0..u.len() {
+            let (lo, hi) = (self.lo[j], self.hi[j]);
+            let mut up = u.to_vec();
+            let mut dn = u.to_vec();
+            let col = if u[j] + h <= hi && u[j] - h >= lo {
+                up[j] += h;
+                dn[j] -= h;
+                (self.residuals(&up, Some(n))? - self.residuals(&dn, Some(n))?) / (2.0 * h)
+            } else if u[j] + h <= hi {
+                up[j] += h;
+                (self.residuals(&up, Some(n))? - r0) / h
+            } else {
+                dn[j] -= h;
+                (r0 - self.residuals(&dn, Some(n))?) / h
+            };
+            jac.set_column(j, &col);
+        }
+        Ok(jac)
+    }
+}
+
+fn failure(e: &FitError) -> Option<Termination> {
+    match e {
+        FitError::Simulation { shot, source } => Some(Termination::SimulationFailed {
+            shot: shot.clone(),
+            message: source.to_string(),
+        }),
+        _ => None,
+    }
+}
+
+impl LevenbergMarquardt {
+    /// Minimises `problem` from `p0` (clamped into the bounds), reporting each iteration to `observer`.
+    ///
+    /// Errors only when the starting point itself cannot be evaluated (e.g. a shot's simulation fails
+    /// there); a failure later ends the search at the last good point with
+    /// [`Termination::SimulationFailed`].
+    pub fn run<P: LeastSquares>(
+        &self,
+        problem: &P,
+        p0: &[f64],
+        observer: &mut dyn Observer,
+    ) -> Result<SolverOutcome, FitError> {
+        let np = problem.n_params();
+        assert_eq!(p0.len(), np, "starting point has the wrong length");
+        let scale: Vec<f64> = (0..np)
+            .map(|j| {
+                let s = problem.scale(j);
+                if s.is_finite() && s > 0.0 { s } else { 1.0 }
+            })
+            .collect();
+        let lo: Vec<f64> = (0..np).map(|j| problem.bounds(j).0 / scale[j]).collect();
+        let hi: Vec<f64> = (0..np).map(|j| problem.bounds(j).1 / scale[j]).collect();
+        let mut ev = Eval {
+            problem,
+            scale,
+            lo,
+            hi,
+            count: 0,
+        };
+        let project = |u: &mut [f64], lo: &[f64], hi: &[f64]| {
+            for j in 0..u.len() {
+                u[j] = u[j].clamp(lo[j], hi[j]);
+            }
+        };
+        let mut u: Vec<f64> = p0.iter().zip(&ev.scale).map(|(p, s)| p / s).collect();
+        project(&mut u, &ev.lo, &ev.hi);
+        let mut r = ev.residuals(&u, None)?;
+        let n = r.len();
+        let mut cost = r.norm_squared();
+        let mut lambda = self.lambda_init;
+        let mut nu = 2.0;
+        observer.observe(&Iteration {
+            iteration: 0,
+            cost,
+            params: &ev.params(&u),
+            lambda,
+        });
+        let mut iterations = 0;
+        let termination = 'outer: loop {
+            if iterations >= self.max_iterations {
+                break Termination::MaxIterations;
+            }
+            iterations += 1;
+            let jac = match ev.jacobian(&u, &r, self.fd_step) {
+                Ok(j) => j,
+                Err(e) => break failure(&e).ok_or(e)?,
+            };
+            let a = jac.transpose() * &jac;
+            let g = jac.transpose() * &r;
+            let diag: Vec<f64> = (0..np).map(|j| a[(j, j)].max(1e-12 * a.diagonal().max())).collect();
+            let mut last_failure = None;
+            loop {
+                if lambda > self.lambda_max {
+                    break 'outer last_failure.unwrap_or(Termination::Stalled);
+                }
+                let mut m = a.clone();
+                for j in 0..np {
+                    m[(j, j)] += lambda * diag[j];
+                }
+                let Some(chol) = m.cholesky() else {
+                    lambda *= nu;
+                    nu *= 2.0;
+                    continue;
+                };
+                let delta = chol.solve(&(-&g));
+                let mut trial: Vec<f64> = u.iter().zip(delta.iter()).map(|(u, d)| u + d).collect();
+                project(&mut trial, &ev.lo, &ev.hi);
+                let step = DVector::from_iterator(np, trial.iter().zip(&u).map(|(t, u)| t - u));
+                let predicted = -(2.0 * g.dot(&step) + (&a * &step).dot(&step));
+                let unorm = DVector::from_column_slice(&u).norm();
+                let tiny_step = step.norm() <= self.xtol * (unorm + self.xtol);
+                let r_new = match ev.residuals(&trial, Some(n)) {
+                    Ok(r) => Some(r),
+                    Err(e) => {
+                        last_failure = Some(failure(&e).ok_or(e)?);
+                        None
+                    }
+                };
+                let new_cost = r_new.as_ref().map(|r| r.norm_squared()).unwrap_or(f64::INFINITY);
+                if new_cost < cost && predicted > 0.0 {
+                    let rho = (cost - new_cost) / predicted;
+                    lambda *= (1.0 - (2.0 * rho - 1.0).powi(3)).max(1.0 / 3.0);
+                    nu = 2.0;
+                    let change = cost - new_cost;
+                    u = trial;
+                    r = r_new.expect("a lower cost has residuals");
+                    cost = new_cost;
+                    observer.observe(&Iteration {
+                        iteration: iterations,
+                        cost,
+                        params: &ev.params(&u),
+                        lambda,
+                    });
+                    if change <= self.ftol * cost {
+                        break 'outer Termination::ConvergedCost;
+                    }
+                    if tiny_step {
+                        break 'outer Termination::ConvergedStep;
+                    }
+                    continue 'outer;
+                }
+                if tiny_step && r_new.is_some() {
+                    // The step is below the tolerance and does not help: we are at the minimum.
+                    observer.observe(&Iteration {
+                        iteration: iterations,
+                        cost,
+                        params: &ev.params(&u),
+                        lambda,
+                    });
+                    break 'outer Termination::ConvergedStep;
+                }
+                lambda *= nu;
+                nu *= 2.0;
+            }
+        };
+        let jacobian = ev.jacobian(&u, &r, self.fd_step).ok().map(|mut j| {
+            // Back to the parameters' own units: ∂r/∂p = ∂r/∂u / scale.
+            for (k, s) in ev.scale.iter().enumerate() {
+                j.column_mut(k).scale_mut(1.0 / s);
+            }
+            j
+        });
+        Ok(SolverOutcome {
+            params: ev.params(&u),
+            residuals: r.as_slice().to_vec(),
+            cost,
+            jacobian,
+            iterations,
+            evaluations: ev.count,
+            termination,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use bouncelab_model::ModelError;
+
+    /// y = a·exp(−t/τ) + c sampled without noise.
+    struct Decay {
+        t: Vec<f64>,
+        y: Vec<f64>,
+        bounds: [(f64, f64); 3],
+    }
+
+    impl Decay {
+        fn new(truth: [f64; 3]) -> Decay {
+            let t: Vec<f64> = (0..40).map(|i| i as f64 * 0.05).collect();
+            let y = t.iter().map(|t| truth[0] * (-t / truth[1]).exp() + truth[2]).collect();
+            Decay {
+                t,
+                y,
+                bounds: [(0.0, 100.0), (1e-3, 10.0), (-5.0, 5.0)],
+            }
+        }
+    }
+
+    impl LeastSquares for Decay {
+        fn n_params(&self) -> usize {
+            3
+        }
+        fn residuals(&self, p: &[f64]) -> Result<Vec<f64>, FitError> {
+            Ok(self
+                .t
+                .iter()
+                .zip(&self.y)
+                .map(|(t, y)| p[0] * (-t / p[1]).exp() + p[2] - y)
+                .collect())
+        }
+        fn bounds(&self, j: usize) -> (f64, f64) {
+            self.bounds[j]
+        }
+        fn scale(&self, j: usize) -> f64 {
+            [10.0, 0.5, 1.0][j]
+        }
+    }
+
+    #[test]
+    fn finds_the_minimum_of_a_curve_fit() {
+        let p = Decay::new([12.0, 0.4, 1.5]);
+        let out = LevenbergMarquardt::default()
+            .run(&p, &[6.0, 0.8, 0.5], &mut NoObserver)
+            .unwrap();
+        assert!(out.termination.converged(), "{}", out.termination);
+        for (got, want) in out.params.iter().zip([12.0, 0.4, 1.5]) {
+            assert!((got - want).abs() < 1e-6 * want, "{:?}", out.params);
+        }
+        assert!(out.jacobian.is_some());
+    }
+
+    #[test]
+    fn bounds_hold_the_parameters() {
+        // The best c is 1.5, but c ≤ 1 is imposed.
+        let mut p = Decay::new([12.0, 0.4, 1.5]);
+        p.bounds[2] = (-5.0, 1.0);
+        let out = LevenbergMarquardt::default()
+            .run(&p, &[5.0, 1.0, 0.0], &mut NoObserver)
+            .unwrap();
+        assert!(out.params[2] <= 1.0 && out.params[2] > 0.999, "{:?}", out.params);
+        // The start is clamped into the bounds too.
+        let out = LevenbergMarquardt::default()
+            .run(&p, &[5.0, 1.0, 3.0], &mut NoObserver)
+            .unwrap();
+        assert!(out.params[2] <= 1.0);
+    }
+
+    #[test]
+    fn the_log_observer_writes_one_line_per_iteration() {
+        let p = Decay::new([12.0, 0.4, 1.5]);
+        let mut log = LogObserver::new(Vec::new(), vec!["a".into(), "tau".into(), "c".into()]);
+        let out = LevenbergMarquardt::default()
+            .run(&p, &[1.0, 2.0, 0.0], &mut log)
+            .unwrap();
+        let text = String::from_utf8(log.into_inner()).unwrap();
+        assert!(text.starts_with("iter   0  cost "), "{text}");
+        assert!(text.contains("tau="));
+        assert!(text.lines().count() >= out.iterations);
+    }
+
+    /// r = p − 10, but the "simulation" fails for p > 5.
+    struct FailsBeyond;
+
+    impl LeastSquares for FailsBeyond {
+        fn n_params(&self) -> usize {
+            1
+        }
+        fn residuals(&self, p: &[f64]) -> Result<Vec<f64>, FitError> {
+            if p[0] > 5.0 {
+                return Err(FitError::Simulation {
+                    shot: "clip_9".into(),
+                    source: Box::new(ModelError::NoImpact { max_time_s: 10.0 }),
+                });
+            }
+            Ok(vec![p[0] - 10.0, 0.5 * (p[0] - 10.0)])
+        }
+    }
+
+    #[test]
+    fn a_failing_simulation_ends_the_search_at_the_last_good_point_naming_the_shot() {
+        let out = LevenbergMarquardt::default()
+            .run(&FailsBeyond, &[0.0], &mut NoObserver)
+            .unwrap();
+        match &out.termination {
+            Termination::SimulationFailed { shot, message } => {
+                assert_eq!(shot, "clip_9");
+                assert!(message.contains("did not reach the surface"), "{message}");
+            }
+            other => panic!("{other:?}"),
+        }
+        assert!(out.params[0] <= 5.0 && out.params[0] > 4.0, "{:?}", out.params);
+        assert!(out.termination.to_string().contains("clip_9"));
+        // At the start, the failure is an error.
+        assert!(
+            LevenbergMarquardt::default()
+                .run(&FailsBeyond, &[6.0], &mut NoObserver)
+                .is_err()
+        );
+    }
+}
