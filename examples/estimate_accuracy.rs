@@ -6,7 +6,7 @@
 //! (RMS of error/SE), and the per-surface, per-angle mean COR against the truth's. With a preset name
 //! (default `none`) or a scenario file it renders into a temporary folder first.
 
-use bouncelab_estimate::{Conditions, estimate};
+use bouncelab_estimate::{Conditions, estimate_with_frames};
 use bouncelab_frames::Session;
 use bouncelab_track::{ClipTracking, track_clip};
 use std::collections::BTreeMap;
@@ -37,10 +37,14 @@ fn main() {
     let h = truth.headers().unwrap().clone();
     let col = |n: &str| h.iter().position(|c| c == n).unwrap_or_else(|| panic!("column {n}"));
     let rows: Vec<csv::StringRecord> = truth.records().map(|r| r.unwrap()).collect();
-    println!("| clip | COR est ± SE | COR truth | μ est | μ truth | |v_in| err % | |v_out| err % | contact est / truth ms | δ_max est / truth mm |");
+    println!(
+        "| clip | COR est ± SE | COR truth | μ est | μ truth | |v_in| err % | |v_out| err % | contact est / truth ms | δ_max est / truth mm |"
+    );
     println!("|---|---|---|---|---|---|---|---|---|");
-    let (mut e_cor, mut e_mu, mut e_vin, mut e_vout, mut e_tc, mut e_d) = (vec![], vec![], vec![], vec![], vec![], vec![]);
+    let (mut e_cor, mut e_mu, mut e_vin, mut e_vout, mut e_tc, mut e_d) =
+        (vec![], vec![], vec![], vec![], vec![], vec![]);
     let (mut z_cor, mut z_vin, mut z_vout) = (vec![], vec![], vec![]);
+    let mut e_spin: Vec<(f64, f64)> = vec![]; // (error, allowed max(2 rad/s, 3 %))
     let mut groups: BTreeMap<(String, String), (Vec<f64>, Vec<f64>)> = BTreeMap::new();
     let mut failures = Vec::new();
     for r in &rows {
@@ -48,7 +52,10 @@ fn main() {
         let num = |c: &str| r[col(c)].parse::<f64>().unwrap();
         let entry = session.clip(name).expect("clip in clips.csv");
         let clip = entry.open().expect("clip");
-        let opts = ClipTracking { ball_diameter_m: session.ball.diameter_m, ..ClipTracking::default() };
+        let opts = ClipTracking {
+            ball_diameter_m: session.ball.diameter_m,
+            ..ClipTracking::default()
+        };
         let track = match track_clip(&clip, &opts, |_, _| {}) {
             Ok(t) => t,
             Err(e) => {
@@ -56,8 +63,12 @@ fn main() {
                 continue;
             }
         };
-        let c = Conditions { incline_deg: entry.angle_deg, gravity: 9.81, ball_diameter_m: session.ball.diameter_m };
-        let est = match estimate(&track, &c) {
+        let c = Conditions {
+            incline_deg: entry.angle_deg,
+            gravity: 9.81,
+            ball_diameter_m: session.ball.diameter_m,
+        };
+        let est = match estimate_with_frames(&track, &clip, &c) {
             Ok(e) => e,
             Err(e) => {
                 failures.push(format!("{name}: {e}"));
@@ -75,10 +86,17 @@ fn main() {
         e_vout.push((vout / speed(vout_t, vout_n) - 1.0) * 100.0);
         e_tc.push(est.contact_ms.value - num("contact_ms"));
         e_d.push((est.delta_max_m.value - num("delta_max_m")) * 1e3);
+        for (m, t) in [(est.spin_in, num("spin_in")), (est.spin_out, num("spin_out"))] {
+            if let Some(m) = m {
+                e_spin.push((m.value - t, (0.03 * t.abs()).max(2.0)));
+            }
+        }
         z_cor.push((est.cor.value - cor_t) / est.cor.se);
         z_vin.push((est.v_in[1].value - vin_n) / est.v_in[1].se);
         z_vout.push((est.v_out[1].value - vout_n) / est.v_out[1].se);
-        let g = groups.entry((r[col("surface")].to_string(), r[col("angle_deg")].to_string())).or_default();
+        let g = groups
+            .entry((r[col("surface")].to_string(), r[col("angle_deg")].to_string()))
+            .or_default();
         g.0.push(est.cor.value);
         g.1.push(cor_t);
         println!(
@@ -103,13 +121,31 @@ fn main() {
     println!("| outgoing speed | {:.3} % | ≤ 0.3 % |", rms(&e_vout));
     println!("| contact time | {:.4} ms | ≤ 0.1 ms |", rms(&e_tc));
     println!("| δ_max | {:.4} mm | ≤ 0.3 mm |", rms(&e_d));
-    println!("| RMS(error/SE): COR, v_in,n, v_out,n | {:.2}, {:.2}, {:.2} | 0.5–2 |", rms(&z_cor), rms(&z_vin), rms(&z_vout));
+    let spin_err: Vec<f64> = e_spin.iter().map(|e| e.0).collect();
+    let worst = e_spin.iter().map(|e| e.0.abs() / e.1).fold(0.0, f64::max);
+    println!(
+        "| spin (in and out, {} measured) | {:.3} rad/s (worst at {:.0} % of its limit) | ≤ max(2 rad/s, 3 %) |",
+        e_spin.len(),
+        rms(&spin_err),
+        worst * 100.0
+    );
+    println!(
+        "| RMS(error/SE): COR, v_in,n, v_out,n | {:.2}, {:.2}, {:.2} | 0.5–2 |",
+        rms(&z_cor),
+        rms(&z_vin),
+        rms(&z_vout)
+    );
     println!();
     println!("| surface | angle ° | mean COR est | mean COR truth | difference |");
     println!("|---|---|---|---|---|");
     for ((s, a), (est, tru)) in &groups {
         let m = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
-        println!("| {s} | {a} | {:.4} | {:.4} | {:+.4} |", m(est), m(tru), m(est) - m(tru));
+        println!(
+            "| {s} | {a} | {:.4} | {:.4} | {:+.4} |",
+            m(est),
+            m(tru),
+            m(est) - m(tru)
+        );
     }
     for f in failures {
         println!("failed: {f}");

@@ -1,7 +1,7 @@
 //! `bouncelab estimate`: one clip folder → its per-shot measurements with standard errors.
 
 use anyhow::Context;
-use bouncelab_estimate::{Conditions, Estimate, estimate};
+use bouncelab_estimate::{Conditions, Estimate, estimate_with_frames};
 use bouncelab_frames::{Clip, ClipOptions, Downslope, Session};
 use bouncelab_track::{ClipTracking, track_clip};
 use std::path::{Path, PathBuf};
@@ -70,7 +70,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         gravity: a.gravity,
         ball_diameter_m: diameter,
     };
-    let e = estimate(&track, &c).with_context(|| format!("estimating {}", a.clip_dir.display()))?;
+    let e = estimate_with_frames(&track, &clip, &c).with_context(|| format!("estimating {}", a.clip_dir.display()))?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&e)?);
     } else {
@@ -90,12 +90,11 @@ fn print_table(clip: &Path, angle: f64, e: &Estimate) {
     row("μ_eff", "", e.mu.value, e.mu.se);
     row("contact", "ms", e.contact_ms.value, e.contact_ms.se);
     row("δ_max", "mm", e.delta_max_m.value * 1e3, e.delta_max_m.se * 1e3);
-    match (e.spin_in, e.spin_out) {
-        (Some(i), Some(o)) => {
-            row("spin_in", "rad/s", i.value, i.se);
-            row("spin_out", "rad/s", o.value, o.se);
+    for (name, spin) in [("spin_in", e.spin_in), ("spin_out", e.spin_out)] {
+        match spin {
+            Some(m) => row(name, "rad/s", m.value, m.se),
+            None => println!("  {name:<14} not measured (see the notes)"),
         }
-        _ => println!("  spin           not measured (texture rotation is not implemented yet)"),
     }
     let p = &e.phases;
     println!(

@@ -10,6 +10,10 @@
 
 mod ballistic;
 mod shot;
+mod spin;
 
 pub use ballistic::{BallisticFit, fit_ballistic};
 pub use shot::{Conditions, Estimate, EstimateError, Measured, PhaseFrames, estimate};
+pub use spin::{
+    Rotation, Spin, SpinFrame, SpinOptions, estimate_with_frames, measure_spin, rotation_between, spin_from_frames,
+};

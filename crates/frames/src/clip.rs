@@ -1,6 +1,5 @@
 //! A clip folder: listing, ordering, timing, and streaming its frames.
 
-use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
@@ -220,7 +219,14 @@ impl Clip {
 
     /// Streams the frames in order, decoding a bounded window ahead in parallel on rayon's global pool.
     pub fn frames(&self) -> FrameStream<'_> {
-        FrameStream::new(self, None, 4 * rayon::current_num_threads(), PngDecoder::default())
+        FrameStream {
+            clip: self,
+            source: Source::Caller {
+                next: 0,
+                png: PngDecoder::default(),
+            },
+            remaining: self.files.len(),
+        }
     }
 
     /// Streams the frames in order with these options (thread count, window, PNG decoder).
@@ -247,7 +253,7 @@ impl Clip {
             (_, p) => p,
         };
         let window = options.window.unwrap_or(4 * threads).max(1);
-        Ok(FrameStream::new(self, pool, window, options.png_decoder))
+        FrameStream::new(self, pool, window, options.png_decoder)
     }
 
     fn decode(&self, file: &FrameFile, png: PngDecoder) -> Result<Frame> {
@@ -282,42 +288,63 @@ enum Pool {
 
 /// An ordered stream of a clip's decoded frames, from [`Clip::frames`] or [`Clip::frames_with`].
 ///
-/// Decodes `window` frames at a time in parallel, then hands them out in order, so at most `window`
-/// decoded frames are held in memory whatever the clip's length. A frame that fails to decode yields an
-/// `Err` in its place; the stream goes on with the next frame.
+/// With more than one decoding thread, a background reader decodes `window` frames at a time in parallel
+/// and hands them over through a channel of `window` frames, so the next window is decoded while the
+/// caller works on the current one (tracking hides behind decoding); at most about two windows of decoded
+/// frames are held in memory whatever the clip's length. With one thread, frames are decoded on the
+/// caller's thread as they are asked for. A frame that fails to decode yields an `Err` in its place; the
+/// stream goes on with the next frame. Dropping the stream stops the reader.
 pub struct FrameStream<'a> {
     clip: &'a Clip,
-    pool: Option<Pool>,
-    window: usize,
-    png: PngDecoder,
-    next: usize,
-    ready: VecDeque<Result<Frame>>,
+    source: Source,
+    remaining: usize,
+}
+
+enum Source {
+    /// Decoded on the caller's thread, one frame at a time.
+    Caller { next: usize, png: PngDecoder },
+    /// Decoded ahead by a background reader.
+    Reader(std::sync::mpsc::Receiver<Result<Frame>>),
 }
 
 impl<'a> FrameStream<'a> {
-    fn new(clip: &'a Clip, pool: Option<Pool>, window: usize, png: PngDecoder) -> Self {
-        Self {
-            clip,
-            pool,
-            window: window.max(1),
-            png,
-            next: 0,
-            ready: VecDeque::new(),
-        }
-    }
-
-    fn refill(&mut self) {
-        let end = (self.next + self.window).min(self.clip.files.len());
-        let batch = &self.clip.files[self.next..end];
-        let (clip, png) = (self.clip, self.png);
-        let decode_all = || batch.par_iter().map(|f| clip.decode(f, png)).collect::<Vec<_>>();
-        let decoded = match &self.pool {
-            None => batch.iter().map(|f| clip.decode(f, png)).collect(),
-            Some(Pool::Global) => decode_all(),
-            Some(Pool::Own(pool)) => pool.install(decode_all),
+    fn new(clip: &'a Clip, pool: Option<Pool>, window: usize, png: PngDecoder) -> Result<Self> {
+        let remaining = clip.files.len();
+        let source = match pool {
+            None => Source::Caller { next: 0, png },
+            Some(pool) => {
+                let window = window.max(1);
+                let (tx, rx) = std::sync::mpsc::sync_channel(window);
+                let owned = std::sync::Arc::new(clip.clone());
+                std::thread::Builder::new()
+                    .name("frames-reader".into())
+                    .spawn(move || {
+                        let decode =
+                            |chunk: &[FrameFile]| chunk.par_iter().map(|f| owned.decode(f, png)).collect::<Vec<_>>();
+                        for chunk in owned.files.chunks(window) {
+                            let decoded = match &pool {
+                                Pool::Global => decode(chunk),
+                                Pool::Own(p) => p.install(|| decode(chunk)),
+                            };
+                            for frame in decoded {
+                                if tx.send(frame).is_err() {
+                                    return; // the stream was dropped
+                                }
+                            }
+                        }
+                    })
+                    .map_err(|e| FramesError::ThreadPool {
+                        threads: 1,
+                        message: e.to_string(),
+                    })?;
+                Source::Reader(rx)
+            }
         };
-        self.ready.extend(decoded);
-        self.next = end;
+        Ok(Self {
+            clip,
+            source,
+            remaining,
+        })
     }
 }
 
@@ -325,15 +352,29 @@ impl Iterator for FrameStream<'_> {
     type Item = Result<Frame>;
 
     fn next(&mut self) -> Option<Self::Item> {
-        if self.ready.is_empty() && self.next < self.clip.files.len() {
-            self.refill();
+        if self.remaining == 0 {
+            return None;
         }
-        self.ready.pop_front()
+        let item = match &mut self.source {
+            Source::Caller { next, png } => {
+                let file = &self.clip.files[*next];
+                *next += 1;
+                Some(self.clip.decode(file, *png))
+            }
+            // The reader sends every frame, in order, unless it died (a panic in a decoder).
+            Source::Reader(rx) => Some(rx.recv().unwrap_or_else(|_| {
+                Err(FramesError::ThreadPool {
+                    threads: 1,
+                    message: "the frame reader stopped before the end of the clip".into(),
+                })
+            })),
+        };
+        self.remaining -= 1;
+        item
     }
 
     fn size_hint(&self) -> (usize, Option<usize>) {
-        let n = self.ready.len() + self.clip.files.len() - self.next;
-        (n, Some(n))
+        (self.remaining, Some(self.remaining))
     }
 }
 
