@@ -317,7 +317,12 @@ pub fn track_clip(
     if absent > 0 {
         warnings.push(format!("ball not found in {absent} of {} frames", fixes.len()));
     }
-    let scale = scale_from(&fixes, tracker.surface(), opts.ball_diameter_m);
+    let scale = scale_from(
+        &fixes,
+        tracker.surface(),
+        opts.ball_diameter_m,
+        tracker.edge_definition_px(),
+    );
     Ok(Track {
         fixes,
         surface: tracker.surface().copied(),
@@ -334,7 +339,16 @@ fn observe<P: Pixel>(tracker: &mut Tracker, frame: usize, t_s: f64, p: &Plane<P>
 }
 
 /// m/px from the mean radius of frames where the whole ball is clear of the surface and the border.
-fn scale_from(fixes: &[BallFix], surface: Option<&SurfaceLine>, diameter: f64) -> Option<Scale> {
+///
+/// Its standard error holds the radius's scatter over those frames and, as a Type-B term, the rim's
+/// definition: `edge_definition_px / √3`, the median distance between the gradient-maximum edge and the
+/// half-contrast crossing taken as the half-width of a uniform uncertainty.
+pub(crate) fn scale_from(
+    fixes: &[BallFix],
+    surface: Option<&SurfaceLine>,
+    diameter: f64,
+    edge_definition_px: f64,
+) -> Option<Scale> {
     let radii: Vec<f64> = fixes
         .iter()
         .filter(|f| f.status == Status::Ok)
@@ -350,7 +364,7 @@ fn scale_from(fixes: &[BallFix], surface: Option<&SurfaceLine>, diameter: f64) -
     let m_per_px = diameter / (2.0 * mean);
     Some(Scale {
         m_per_px,
-        sigma_m_per_px: m_per_px * (sd / n.sqrt()) / mean,
+        sigma_m_per_px: m_per_px * ((sd * sd / n) + edge_definition_px.powi(2) / 3.0).sqrt() / mean,
         radius_px: mean,
         frames: radii.len(),
     })

@@ -41,7 +41,7 @@
 //! [`track_clip_opencv`] runs the detection on every frame of a clip (no refinement, no prediction) and
 //! keeps per frame the candidate of the expected size nearest the previous centre.
 
-use crate::clip::{ClipTracking, Scale, Track, TrackError};
+use crate::clip::{ClipTracking, Track, TrackError};
 use crate::hough::{Circle, CircleDetection};
 use crate::plane::{Pixel, Plane};
 use crate::surface::{SurfaceLine, find_surface_line};
@@ -398,7 +398,8 @@ pub fn track_clip_opencv(
     if absent > 0 {
         warnings.push(format!("ball not found in {absent} of {} frames", fixes.len()));
     }
-    let scale = scale_from(&fixes, surface.as_ref(), opts.ball_diameter_m);
+    // OpenCV gives no edge profile, so no edge-definition term: statistical error only.
+    let scale = crate::clip::scale_from(&fixes, surface.as_ref(), opts.ball_diameter_m, 0.0);
     Ok(Track {
         fixes,
         surface,
@@ -451,28 +452,4 @@ fn pick(cands: &[Circle], previous: Option<(f64, f64)>, frame: usize, t_s: f64, 
         quality: c.support,
         status,
     }
-}
-
-/// m/px from the mean radius of `ok` frames whose whole ball is clear of the surface (the rule of
-/// [`track_clip`](crate::track_clip)).
-fn scale_from(fixes: &[BallFix], surface: Option<&SurfaceLine>, diameter: f64) -> Option<Scale> {
-    let radii: Vec<f64> = fixes
-        .iter()
-        .filter(|f| f.status == Status::Ok)
-        .filter(|f| surface.is_none_or(|l| f.y_px + f.r_px < l.y_at(f.x_px) - 3.0))
-        .map(|f| f.r_px)
-        .collect();
-    if radii.len() < 3 {
-        return None;
-    }
-    let n = radii.len() as f64;
-    let mean = radii.iter().sum::<f64>() / n;
-    let sd = (radii.iter().map(|r| (r - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
-    let m_per_px = diameter / (2.0 * mean);
-    Some(Scale {
-        m_per_px,
-        sigma_m_per_px: m_per_px * (sd / n.sqrt()) / mean,
-        radius_px: mean,
-        frames: radii.len(),
-    })
 }

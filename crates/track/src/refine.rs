@@ -52,6 +52,9 @@ pub struct Refined {
     pub rays: usize,
     /// Median brightness step at the edge points, 0–255 scale per px.
     pub contrast: f32,
+    /// Median distance from the gradient-maximum edge to the half-contrast crossing, px (positive outward):
+    /// how much "the rim" depends on how an edge is defined.
+    pub edge_definition_px: f64,
 }
 
 impl Refined {
@@ -108,6 +111,7 @@ fn refine_once<P: Pixel>(
     let mut profile = vec![0.0f32; samples];
     let mut points = Vec::with_capacity(n);
     let mut contrasts = Vec::with_capacity(n);
+    let mut offsets: Vec<f64> = Vec::with_capacity(n);
     let (mut outside, mut hidden) = (0, 0);
     // Ray directions by rotating one unit vector: no sin/cos per ray.
     let (dc, ds) = (std::f64::consts::TAU / n as f64).sin_cos();
@@ -180,6 +184,9 @@ fn refine_once<P: Pixel>(
         let d = start + (best_j as f64 + off) * search.step;
         points.push([x + d * c, y + d * s]);
         contrasts.push(per_px);
+        if let Some(o) = half_level_offset(profile, best_j, best_j as f64 + off) {
+            offsets.push(o * search.step);
+        }
     }
     let mut fit = fit_circle(&points, x, y, r)?;
     // Neighbouring rays see overlapping texture, so their edge errors are correlated and the fit's σ (which
@@ -202,6 +209,12 @@ fn refine_once<P: Pixel>(
     }
     let mid = contrasts.len() / 2;
     let contrast = *contrasts.select_nth_unstable_by(mid, f32::total_cmp).1;
+    let edge_definition_px = if offsets.len() >= 8 {
+        let mid = offsets.len() / 2;
+        *offsets.select_nth_unstable_by(mid, f64::total_cmp).1
+    } else {
+        0.0
+    };
     Some(Refined {
         fit,
         rays_with_edge: points.len(),
@@ -209,6 +222,24 @@ fn refine_once<P: Pixel>(
         rays_hidden: hidden,
         rays: n,
         contrast,
+        edge_definition_px,
+    })
+}
+
+/// Where the profile crosses half-way between its levels inside and outside the edge, relative to the
+/// gradient maximum at `edge` (both in samples). Two reasonable definitions of "the edge" that agree on a
+/// symmetric blurred step; their difference on a real (shaded, fuzzy) rim measures how well the edge is
+/// defined at all.
+fn half_level_offset(profile: &[f32], j: usize, edge: f64) -> Option<f64> {
+    if j < 3 || j + 3 >= profile.len() {
+        return None;
+    }
+    let inside = profile[..j - 1].iter().sum::<f32>() / (j - 1) as f32;
+    let outside = profile[j + 2..].iter().sum::<f32>() / (profile.len() - j - 2) as f32;
+    let half = 0.5 * (inside + outside);
+    (j - 2..j + 2).find_map(|k| {
+        let (a, b) = (profile[k] - half, profile[k + 1] - half);
+        (a == 0.0 || (a < 0.0) != (b < 0.0)).then(|| k as f64 + (a / (a - b)) as f64 - edge)
     })
 }
 

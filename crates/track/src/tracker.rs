@@ -110,6 +110,8 @@ pub struct Tracker {
     history: Vec<(f64, f64, f64)>,
     /// Radii measured in free flight (the bottom clear of the surface).
     flight_radii: Vec<f64>,
+    /// Edge-definition spread (see [`Refined::edge_definition_px`]) in the same frames, px.
+    flight_edges: Vec<f64>,
     surface: Option<SurfaceLine>,
     surface_tries: usize,
     warnings: Vec<String>,
@@ -130,6 +132,7 @@ impl Tracker {
             opts,
             history: Vec::new(),
             flight_radii: Vec::new(),
+            flight_edges: Vec::new(),
             surface: None,
             surface_tries: 0,
             warnings: Vec::new(),
@@ -156,6 +159,17 @@ impl Tracker {
     /// Things a person should know (a second ball, a lost track), each naming its frame.
     pub fn warnings(&self) -> &[String] {
         &self.warnings
+    }
+
+    /// How much the rim's position depends on the edge definition in free flight: the median over recent
+    /// flight frames of [`Refined::edge_definition_px`], px (0 before any).
+    pub fn edge_definition_px(&self) -> f64 {
+        if self.flight_edges.is_empty() {
+            return 0.0;
+        }
+        let mut e = self.flight_edges.clone();
+        let mid = e.len() / 2;
+        *e.select_nth_unstable_by(mid, f64::total_cmp).1
     }
 
     /// The radius expected from free flight so far, px.
@@ -304,8 +318,10 @@ impl Tracker {
         };
         if status == Status::Ok && clear && f.rays_hidden == 0 {
             self.flight_radii.push(fit.r);
+            self.flight_edges.push(f.edge_definition_px);
             if self.flight_radii.len() > 64 {
                 self.flight_radii.remove(0);
+                self.flight_edges.remove(0);
             }
         }
         // Seeds from later frames give way to real measurements.
