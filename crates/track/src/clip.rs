@@ -287,23 +287,12 @@ pub fn track_clip(
     if let Some((a, b)) = seed {
         tracker.seed(a, b);
     }
-    let mut fixes = Vec::with_capacity(clip.len());
-    let (mut waiting, mut tracking) = (0.0, 0.0);
-    let total = clip.len();
-    let mut t_wait = Instant::now();
-    for frame in clip.frames_with(&opts.read)? {
-        let frame = frame?;
-        let t_track = Instant::now();
-        waiting += (t_track - t_wait).as_secs_f64();
-        let fix = with_plane(
+    let (fixes, waiting, tracking) = stream_fixes(clip, opts, &mut progress, |frame| {
+        with_plane(
             &frame.pixels,
             |p| on_plane!(p, p => observe(&mut tracker, frame.index as usize, frame.t_s, &p)),
-        );
-        fixes.push(fix);
-        t_wait = Instant::now();
-        tracking += (t_wait - t_track).as_secs_f64();
-        progress(fixes.len(), total);
-    }
+        )
+    })?;
     warnings.extend(tracker.warnings().iter().cloned());
     let measured = fixes.iter().filter(|f| f.status.measured()).count();
     if measured == 0 {
@@ -332,6 +321,30 @@ pub fn track_clip(
         seconds_tracking: tracking,
         downslope_negative_x: opts.downslope_negative_x,
     })
+}
+
+/// Streams the clip's frames in order through `fix_of`, reporting progress and timing how long was spent
+/// waiting for decoded frames and how long on the frames themselves (seconds).
+pub(crate) fn stream_fixes(
+    clip: &Clip,
+    opts: &ClipTracking,
+    progress: &mut impl FnMut(usize, usize),
+    mut fix_of: impl FnMut(&bouncelab_frames::Frame) -> BallFix,
+) -> Result<(Vec<BallFix>, f64, f64), TrackError> {
+    let mut fixes = Vec::with_capacity(clip.len());
+    let (mut waiting, mut working) = (0.0, 0.0);
+    let total = clip.len();
+    let mut t_wait = Instant::now();
+    for frame in clip.frames_with(&opts.read)? {
+        let frame = frame?;
+        let t_work = Instant::now();
+        waiting += (t_work - t_wait).as_secs_f64();
+        fixes.push(fix_of(&frame));
+        t_wait = Instant::now();
+        working += (t_wait - t_work).as_secs_f64();
+        progress(fixes.len(), total);
+    }
+    Ok((fixes, waiting, working))
 }
 
 fn observe<P: Pixel>(tracker: &mut Tracker, frame: usize, t_s: f64, p: &Plane<P>) -> BallFix {

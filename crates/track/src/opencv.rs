@@ -50,7 +50,6 @@ use ::opencv::core::{CV_8UC1, Mat, Scalar, Size, Vec4f, Vector};
 use ::opencv::imgproc;
 use ::opencv::prelude::*;
 use bouncelab_frames::{Clip, GrayPixels};
-use std::time::Instant;
 
 /// Which `HoughCircles` variant.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -348,14 +347,7 @@ pub fn track_clip_opencv(
     let mut surface: Option<SurfaceLine> = None;
     let mut surface_tries = 0;
     let mut previous: Option<(f64, f64)> = None;
-    let mut fixes = Vec::with_capacity(clip.len());
-    let (mut waiting, mut tracking) = (0.0, 0.0);
-    let total = clip.len();
-    let mut t_wait = Instant::now();
-    for frame in clip.frames_with(&opts.read)? {
-        let frame = frame?;
-        let t_track = Instant::now();
-        waiting += (t_track - t_wait).as_secs_f64();
+    let (fixes, waiting, tracking) = crate::clip::stream_fixes(clip, opts, &mut progress, |frame| {
         if surface.is_none() && surface_tries < 5 {
             surface_tries += 1;
             surface = with_plane(&frame.pixels, find_surface_line, find_surface_line);
@@ -382,11 +374,8 @@ pub fn track_clip_opencv(
             warnings.push(format!("frame {index}: ball lost"));
         }
         previous = fix.status.measured().then_some((fix.x_px, fix.y_px));
-        fixes.push(fix);
-        t_wait = Instant::now();
-        tracking += (t_wait - t_track).as_secs_f64();
-        progress(fixes.len(), total);
-    }
+        fix
+    })?;
     if !fixes.iter().any(|f| f.status.measured()) {
         return Err(TrackError::NoBall {
             clip: clip.dir().display().to_string(),
@@ -413,17 +402,7 @@ pub fn track_clip_opencv(
 
 /// The fix of one frame from OpenCV's candidates (already restricted to the expected radius range).
 fn pick(cands: &[Circle], previous: Option<(f64, f64)>, frame: usize, t_s: f64, (w, h): (f64, f64)) -> BallFix {
-    let absent = BallFix {
-        frame,
-        t_s,
-        x_px: f64::NAN,
-        y_px: f64::NAN,
-        r_px: f64::NAN,
-        sigma_px: f64::NAN,
-        sigma_r_px: f64::NAN,
-        quality: 0.0,
-        status: Status::Absent,
-    };
+    let absent = BallFix::absent(frame, t_s, Status::Absent);
     let (c, mut status) = match previous {
         Some((px, py)) => {
             let d = |c: &Circle| (c.x - px).hypot(c.y - py);

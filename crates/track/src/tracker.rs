@@ -65,7 +65,8 @@ pub struct BallFix {
 }
 
 impl BallFix {
-    fn absent(frame: usize, t_s: f64, status: Status) -> BallFix {
+    /// A frame where the ball was not measured (NaN coordinates).
+    pub(crate) fn absent(frame: usize, t_s: f64, status: Status) -> BallFix {
         BallFix {
             frame,
             t_s,

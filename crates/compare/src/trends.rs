@@ -1,0 +1,617 @@
+//! Where the model fails: χ² shares by phase and component, and per-shot errors against the conditions.
+
+use crate::{Comparison, Component, ImpactPhase, ShotComparison};
+use serde::{Deserialize, Serialize};
+use statrs::distribution::{ContinuousCDF, FisherSnedecor, StudentsT};
+
+/// A per-shot quantity whose trend is tested. Errors are measured − predicted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Quantity {
+    /// COR, measured − predicted.
+    CorError,
+    /// Effective friction μ, measured − predicted.
+    MuError,
+    /// Outgoing tangential velocity, (measured − predicted)/|measured|, %.
+    VOutTError,
+    /// Outgoing normal velocity, (measured − predicted)/|measured|, %.
+    VOutNError,
+    /// Contact time, measured − predicted, ms.
+    ContactTimeError,
+    /// RMS of the shot's position residuals, µm.
+    ResidualRms,
+}
+
+impl Quantity {
+    /// Every quantity.
+    pub const ALL: [Quantity; 6] = [
+        Quantity::CorError,
+        Quantity::MuError,
+        Quantity::VOutTError,
+        Quantity::VOutNError,
+        Quantity::ContactTimeError,
+        Quantity::ResidualRms,
+    ];
+
+    /// Snake-case name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Quantity::CorError => "cor_error",
+            Quantity::MuError => "mu_error",
+            Quantity::VOutTError => "v_out_t_error_pct",
+            Quantity::VOutNError => "v_out_n_error_pct",
+            Quantity::ContactTimeError => "contact_time_error_ms",
+            Quantity::ResidualRms => "residual_rms_um",
+        }
+    }
+
+    /// The shot's value, if it has one.
+    pub fn of(self, s: &ShotComparison) -> Option<f64> {
+        let e = s.output_errors;
+        match self {
+            Quantity::CorError => e.map(|e| e.cor_abs),
+            Quantity::MuError => e.map(|e| e.mu_abs),
+            Quantity::VOutTError => e.and_then(|e| e.v_out_t_pct),
+            Quantity::VOutNError => e.and_then(|e| e.v_out_n_pct),
+            Quantity::ContactTimeError => s.contact_time_error_ms,
+            Quantity::ResidualRms => Some(s.rms_m * 1e6),
+        }
+    }
+
+    /// The model's own prediction of the quantity, for the quantities the model predicts (COR, μ).
+    fn predicted(self, s: &ShotComparison) -> Option<f64> {
+        match self {
+            Quantity::CorError => s.output_errors.map(|e| e.cor_predicted),
+            Quantity::MuError => s.output_errors.map(|e| e.mu_predicted),
+            _ => None,
+        }
+    }
+
+    /// (subject, unit, decimals) for sentences.
+    fn words(self) -> (&'static str, &'static str, usize) {
+        match self {
+            Quantity::CorError => ("COR", "", 3),
+            Quantity::MuError => ("μ", "", 3),
+            Quantity::VOutTError => ("the outgoing tangential speed", " %", 2),
+            Quantity::VOutNError => ("the outgoing normal speed", " %", 2),
+            Quantity::ContactTimeError => ("the contact time", " ms", 3),
+            Quantity::ResidualRms => ("the residual RMS", " µm", 2),
+        }
+    }
+
+    /// Spread below which the quantity is taken as constant (numerical noise), in its unit.
+    fn tiny(self) -> f64 {
+        match self {
+            Quantity::VOutTError | Quantity::VOutNError => 1e-4,
+            _ => 1e-6,
+        }
+    }
+}
+
+/// A condition a quantity is tested against.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Against {
+    /// Nothing: is the mean error zero? (one-sample t test; `slope` is the mean).
+    Mean,
+    /// Impact speed |v_n,in|, m/s.
+    ImpactSpeed,
+    /// Incline, degrees.
+    Incline,
+    /// Drop height, m.
+    DropHeight,
+    /// Camera roll from the surface line's tilt, degrees.
+    CameraRoll,
+    /// Test surface, as a factor (one-way ANOVA; `slope` is the highest minus the lowest group mean).
+    Surface,
+}
+
+impl Against {
+    /// Every condition.
+    pub const ALL: [Against; 6] = [
+        Against::Mean,
+        Against::ImpactSpeed,
+        Against::Incline,
+        Against::DropHeight,
+        Against::CameraRoll,
+        Against::Surface,
+    ];
+
+    /// Snake-case name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Against::Mean => "mean",
+            Against::ImpactSpeed => "impact_speed",
+            Against::Incline => "incline",
+            Against::DropHeight => "drop_height",
+            Against::CameraRoll => "camera_roll",
+            Against::Surface => "surface",
+        }
+    }
+
+    fn x(self, s: &ShotComparison) -> Option<f64> {
+        match self {
+            Against::ImpactSpeed => Some(s.impact_speed_m_s),
+            Against::Incline => Some(s.incline_deg),
+            Against::DropHeight => s.drop_height_m,
+            Against::CameraRoll => s.camera_roll_deg,
+            Against::Mean | Against::Surface => None,
+        }
+    }
+
+    /// (words, unit) for sentences.
+    fn words(self) -> (&'static str, &'static str) {
+        match self {
+            Against::ImpactSpeed => ("impact speed", "m/s"),
+            Against::Incline => ("incline", "°"),
+            Against::DropHeight => ("drop height", "m"),
+            Against::CameraRoll => ("camera roll", "°"),
+            Against::Mean => ("", ""),
+            Against::Surface => ("surface", ""),
+        }
+    }
+}
+
+/// One trend test.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Trend {
+    /// The per-shot quantity.
+    pub quantity: Quantity,
+    /// What it is tested against.
+    pub against: Against,
+    /// Slope of the least-squares line, quantity unit per condition unit; the mean for
+    /// [`Against::Mean`]; highest − lowest surface mean for [`Against::Surface`].
+    pub slope: f64,
+    /// Standard error of `slope`.
+    pub slope_se: f64,
+    /// `slope / slope_se`.
+    pub t: f64,
+    /// Two-sided p-value (Student t with n − 2, n − 1 d.o.f.; the ANOVA F test for the surface).
+    pub p: f64,
+    /// `p` adjusted by Holm's method over every test of the report.
+    pub p_holm: f64,
+    /// The F statistic of the surface ANOVA.
+    pub f: Option<f64>,
+    /// Shots in the test.
+    pub n: usize,
+    /// `p_holm < alpha`.
+    pub significant: bool,
+    /// The finding in one plain sentence.
+    pub sentence: String,
+}
+
+/// The share of the total χ² held by one phase and component (all shots).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PhaseShare {
+    /// The phase.
+    pub phase: ImpactPhase,
+    /// The component.
+    pub component: Component,
+    /// Its χ².
+    pub chi2: f64,
+    /// χ² / total χ² (0–1).
+    pub share: f64,
+    /// χ² / n.
+    pub chi2_red: f64,
+    /// Number of residuals.
+    pub n: usize,
+}
+
+/// Where the model fails.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FailureReport {
+    /// χ² shares, largest first.
+    pub phase_shares: Vec<PhaseShare>,
+    /// Every test made, smallest p first.
+    pub trends: Vec<Trend>,
+    /// The findings in plain language: the χ² location, then one sentence per significant trend, or one
+    /// saying there is none.
+    pub sentences: Vec<String>,
+}
+
+/// Settings of [`diagnose`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DiagnoseOptions {
+    /// Significance level after Holm's correction (default 0.01).
+    pub alpha: f64,
+    /// Fewest shots for a test (default 4).
+    pub min_shots: usize,
+}
+
+impl Default for DiagnoseOptions {
+    fn default() -> Self {
+        DiagnoseOptions {
+            alpha: 0.01,
+            min_shots: 4,
+        }
+    }
+}
+
+/// `+0.012`, `−0.050` (a true minus sign).
+fn signed(v: f64, decimals: usize) -> String {
+    let s = format!("{:+.*}", decimals, v);
+    s.replacen('-', "−", 1)
+}
+
+/// `p < 0.001` or `p = 0.003`.
+fn p_text(p: f64) -> String {
+    if p < 0.001 {
+        "p < 0.001".into()
+    } else {
+        format!("p = {p:.3}")
+    }
+}
+
+struct Line {
+    slope: f64,
+    se: f64,
+    p: f64,
+}
+
+/// Ordinary least squares `y = a + b·x`; `None` when x does not vary or n < 3.
+fn regress(x: &[f64], y: &[f64]) -> Option<Line> {
+    let n = x.len();
+    if n < 3 {
+        return None;
+    }
+    let mx = x.iter().sum::<f64>() / n as f64;
+    let my = y.iter().sum::<f64>() / n as f64;
+    let sxx: f64 = x.iter().map(|v| (v - mx) * (v - mx)).sum();
+    let sxy: f64 = x.iter().zip(y).map(|(a, b)| (a - mx) * (b - my)).sum();
+    let floor = 1e-12 * x.iter().map(|v| v * v).sum::<f64>().max(1e-300);
+    if sxx.is_nan() || sxx <= floor {
+        return None;
+    }
+    let slope = sxy / sxx;
+    let sse: f64 = x.iter().zip(y).map(|(a, b)| (b - my - slope * (a - mx)).powi(2)).sum();
+    let df = (n - 2) as f64;
+    let se = (sse / df / sxx).sqrt();
+    let t = slope / se;
+    let p = if se > 0.0 {
+        StudentsT::new(0.0, 1.0, df)
+            .map(|d| 2.0 * d.sf(t.abs()))
+            .unwrap_or(f64::NAN)
+    } else {
+        0.0
+    };
+    Some(Line { slope, se, p })
+}
+
+fn mean_sd(y: &[f64]) -> (f64, f64) {
+    let n = y.len() as f64;
+    let m = y.iter().sum::<f64>() / n;
+    let var = if y.len() > 1 {
+        y.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / (n - 1.0)
+    } else {
+        0.0
+    };
+    (m, var.sqrt())
+}
+
+fn test(q: Quantity, a: Against, shots: &[ShotComparison], opts: &DiagnoseOptions) -> Option<Trend> {
+    let (subject, unit, dec) = q.words();
+    let (xw, xu) = a.words();
+    let have: Vec<&ShotComparison> = shots.iter().filter(|s| q.of(s).is_some()).collect();
+    let trend = |slope: f64, se: f64, p: f64, f: Option<f64>, n: usize, sentence: String| Trend {
+        quantity: q,
+        against: a,
+        slope,
+        slope_se: se,
+        t: slope / se,
+        p,
+        p_holm: p,
+        f,
+        n,
+        significant: false,
+        sentence,
+    };
+    match a {
+        Against::Mean => {
+            if q == Quantity::ResidualRms {
+                return None;
+            }
+            let y: Vec<f64> = have.iter().filter_map(|s| q.of(s)).collect();
+            if y.len() < opts.min_shots {
+                return None;
+            }
+            let (m, sd) = mean_sd(&y);
+            if sd < q.tiny() {
+                return None;
+            }
+            let se = sd / (y.len() as f64).sqrt();
+            let p = StudentsT::new(0.0, 1.0, (y.len() - 1) as f64)
+                .map(|d| 2.0 * d.sf((m / se).abs()))
+                .unwrap_or(f64::NAN);
+            let verb = if m < 0.0 { "over-predicts" } else { "under-predicts" };
+            let sentence = format!(
+                "The model {verb} {subject} by {:.*}{unit} on average ({}, n = {}).",
+                dec,
+                m.abs(),
+                p_text(p),
+                y.len()
+            );
+            Some(trend(m, se, p, None, y.len(), sentence))
+        }
+        Against::Surface => {
+            let mut groups: Vec<(String, Vec<f64>)> = Vec::new();
+            for s in &have {
+                let v = q.of(s).expect("filtered");
+                match groups.iter_mut().find(|(g, _)| *g == s.surface) {
+                    Some((_, vs)) => vs.push(v),
+                    None => groups.push((s.surface.clone(), vec![v])),
+                }
+            }
+            let n: usize = groups.iter().map(|(_, v)| v.len()).sum();
+            let k = groups.len();
+            if k < 2 || n <= k || n < opts.min_shots {
+                return None;
+            }
+            let all: Vec<f64> = groups.iter().flat_map(|(_, v)| v.iter().copied()).collect();
+            let (grand, sd) = mean_sd(&all);
+            if sd < q.tiny() {
+                return None;
+            }
+            let means: Vec<f64> = groups.iter().map(|(_, v)| mean_sd(v).0).collect();
+            let ssb: f64 = groups
+                .iter()
+                .zip(&means)
+                .map(|((_, v), m)| v.len() as f64 * (m - grand).powi(2))
+                .sum();
+            let ssw: f64 = groups
+                .iter()
+                .zip(&means)
+                .map(|((_, v), m)| v.iter().map(|x| (x - m).powi(2)).sum::<f64>())
+                .sum();
+            let (d1, d2) = ((k - 1) as f64, (n - k) as f64);
+            let msw = ssw / d2;
+            let f = (ssb / d1) / msw;
+            let p = if msw > 0.0 {
+                FisherSnedecor::new(d1, d2).map(|d| d.sf(f)).unwrap_or(f64::NAN)
+            } else {
+                0.0
+            };
+            let hi = (0..k).max_by(|&i, &j| means[i].total_cmp(&means[j])).expect("k ≥ 2");
+            let lo = (0..k).min_by(|&i, &j| means[i].total_cmp(&means[j])).expect("k ≥ 2");
+            let slope = means[hi] - means[lo];
+            let se = (msw * (1.0 / groups[hi].1.len() as f64 + 1.0 / groups[lo].1.len() as f64)).sqrt();
+            let what = if q == Quantity::ResidualRms {
+                subject.to_string()
+            } else {
+                format!("{subject} relative to the model (measured − predicted)")
+            };
+            let sentence = format!(
+                "{} differs between surfaces (F = {f:.1}, {}): highest on {} ({}{unit}), lowest on {} ({}{unit}).",
+                capitalise(&what),
+                p_text(p),
+                groups[hi].0,
+                signed(means[hi], dec),
+                groups[lo].0,
+                signed(means[lo], dec)
+            );
+            Some(trend(slope, se, p, Some(f), n, sentence))
+        }
+        _ => {
+            let pairs: Vec<(f64, f64, Option<f64>)> = have
+                .iter()
+                .filter_map(|s| Some((a.x(s)?, q.of(s)?, q.predicted(s))))
+                .collect();
+            if pairs.len() < opts.min_shots {
+                return None;
+            }
+            let x: Vec<f64> = pairs.iter().map(|p| p.0).collect();
+            let y: Vec<f64> = pairs.iter().map(|p| p.1).collect();
+            if mean_sd(&y).1 < q.tiny() {
+                return None;
+            }
+            let line = regress(&x, &y)?;
+            let dir = if line.slope < 0.0 { "falls" } else { "rises" };
+            let per = format!("{}{unit} per {xu}", signed(line.slope, dec));
+            let mut sentence = if q == Quantity::ResidualRms {
+                format!("{} {dir} with {xw}, {per} ({}).", capitalise(subject), p_text(line.p))
+            } else {
+                format!(
+                    "{} {dir} with {xw} relative to the model, {per} (measured − predicted; {})",
+                    capitalise(subject),
+                    p_text(line.p)
+                )
+            };
+            if q != Quantity::ResidualRms {
+                let pred: Vec<f64> = pairs.iter().filter_map(|p| p.2).collect();
+                if pred.len() == x.len() {
+                    match regress(&x, &pred) {
+                        Some(pl) if pl.slope.abs() >= 0.1 * line.slope.abs() => {
+                            sentence.push_str(&format!("; the model predicts {} per {xu}.", signed(pl.slope, dec)))
+                        }
+                        _ => sentence.push_str("; the model predicts a constant."),
+                    }
+                } else {
+                    sentence.push('.');
+                }
+            }
+            Some(trend(line.slope, line.se, line.p, None, pairs.len(), sentence))
+        }
+    }
+}
+
+fn capitalise(s: &str) -> String {
+    let mut c = s.chars();
+    match c.next() {
+        Some(f) => f.to_uppercase().collect::<String>() + c.as_str(),
+        None => String::new(),
+    }
+}
+
+/// Locates where the model fails: the χ² share of every phase and component, and every per-shot quantity
+/// tested against every condition the shots carry (see `docs/compare.md` for the rules).
+pub fn diagnose(comparison: &Comparison, opts: &DiagnoseOptions) -> FailureReport {
+    let total: f64 = comparison.overall.iter().map(|s| s.chi2).sum();
+    let mut phase_shares: Vec<PhaseShare> = comparison
+        .overall
+        .iter()
+        .map(|s| PhaseShare {
+            phase: s.phase,
+            component: s.component,
+            chi2: s.chi2,
+            share: if total > 0.0 { s.chi2 / total } else { 0.0 },
+            chi2_red: s.chi2_red,
+            n: s.n,
+        })
+        .collect();
+    phase_shares.sort_by(|a, b| b.chi2.total_cmp(&a.chi2));
+
+    let mut trends: Vec<Trend> = Quantity::ALL
+        .iter()
+        .flat_map(|q| Against::ALL.iter().map(move |a| (*q, *a)))
+        .filter_map(|(q, a)| test(q, a, &comparison.shots, opts))
+        .collect();
+    trends.sort_by(|a, b| a.p.total_cmp(&b.p));
+    // Holm's step-down adjustment over the whole family.
+    let m = trends.len();
+    let mut running = 0.0f64;
+    for (i, t) in trends.iter_mut().enumerate() {
+        running = running.max(((m - i) as f64 * t.p).min(1.0));
+        t.p_holm = running;
+        t.significant = running < opts.alpha;
+    }
+
+    let mut sentences = Vec::new();
+    let dof = comparison.n_residuals.saturating_sub(comparison.n_params).max(1) as f64;
+    let chi2_red = comparison.chi2_red_total;
+    if chi2_red <= 1.0 + 3.0 * (2.0 / dof).sqrt() {
+        sentences.push(format!(
+            "The trajectories fit to the tracking noise (reduced χ² = {chi2_red:.2})."
+        ));
+    } else if let Some(top) = phase_shares.first() {
+        sentences.push(format!(
+            "Reduced χ² = {chi2_red:.2}; most of χ² is in the {} component during {}: {:.0} % (its reduced χ² = {:.1}).",
+            top.component.name(),
+            top.phase.words(),
+            top.share * 100.0,
+            top.chi2_red
+        ));
+    }
+    let significant: Vec<&Trend> = trends.iter().filter(|t| t.significant).collect();
+    if significant.is_empty() {
+        match trends.first() {
+            Some(t) => sentences.push(format!(
+                "No trend across conditions (smallest p = {:.2} over {m} tests, {:.2} after Holm's correction).",
+                t.p, t.p_holm
+            )),
+            None => sentences.push("No trend could be tested (too few shots or conditions).".into()),
+        }
+    } else {
+        sentences.extend(significant.iter().map(|t| t.sentence.clone()));
+    }
+    FailureReport {
+        phase_shares,
+        trends,
+        sentences,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{OutputErrors, ShotComparison};
+
+    fn shot(surface: &str, speed: f64, cor_err: f64) -> ShotComparison {
+        ShotComparison {
+            shot: format!("{surface}-{speed}"),
+            surface: surface.into(),
+            incline_deg: 0.0,
+            impact_speed_m_s: speed,
+            drop_height_m: None,
+            camera_roll_deg: None,
+            contact_time_error_ms: None,
+            residuals: Vec::new(),
+            by_phase: Vec::new(),
+            output_errors: Some(OutputErrors {
+                v_out_t_pct: None,
+                v_out_n_pct: None,
+                cor_pct: 0.0,
+                cor_abs: cor_err,
+                mu_abs: 0.0,
+                cor_measured: 0.7 + cor_err,
+                cor_predicted: 0.7,
+                mu_measured: 0.0,
+                mu_predicted: 0.0,
+                v_out_measured: [0.0, 1.0],
+                v_out_predicted: [0.0, 1.0],
+            }),
+            rms_m: 0.0,
+            chi2: 0.0,
+            n: 0,
+        }
+    }
+
+    /// The slope, its standard error and p against a hand computation (R: `summary(lm(y ~ x))`).
+    #[test]
+    fn regression_matches_hand_computation() {
+        let x = [1.0, 2.0, 3.0, 4.0, 5.0];
+        let y = [1.1, 1.9, 3.2, 3.8, 5.1];
+        let l = regress(&x, &y).unwrap();
+        // Sxx = 10, Sxy = 9.9, slope 0.99, SSE = 0.107, se = sqrt(0.107/3/10).
+        assert!((l.slope - 0.99).abs() < 1e-12);
+        assert!((l.se - (0.107f64 / 30.0).sqrt()).abs() < 1e-12);
+        // t = 16.577 with 3 d.o.f.: two-sided p = 4.8e-4.
+        assert!((l.p - 4.8e-4).abs() < 0.2e-4, "{}", l.p);
+        assert!(regress(&[2.0; 5], &y).is_none());
+    }
+
+    /// Reference test: with two surfaces, the ANOVA F equals the square of the pooled two-sample t, and
+    /// the p-values agree.
+    #[test]
+    fn anova_of_two_groups_is_the_t_test() {
+        let vals_a = [0.01, 0.02, -0.01, 0.015];
+        let vals_b = [-0.02, -0.01, -0.03, 0.0, -0.015];
+        let mut shots: Vec<ShotComparison> = vals_a.iter().map(|v| shot("clay", 2.0, *v)).collect();
+        shots.extend(vals_b.iter().map(|v| shot("tape", 2.0, *v)));
+        let t = test(
+            Quantity::CorError,
+            Against::Surface,
+            &shots,
+            &DiagnoseOptions::default(),
+        )
+        .unwrap();
+        let f = t.f.unwrap();
+        assert!((f - t.t * t.t).abs() < 1e-9 * f, "F {f} t² {}", t.t * t.t);
+        let st = StudentsT::new(0.0, 1.0, 7.0).unwrap();
+        assert!((t.p - 2.0 * st.sf(t.t.abs())).abs() < 1e-9);
+        assert!(t.sentence.contains("highest on clay"), "{}", t.sentence);
+    }
+
+    /// Holm: the adjusted p-values are monotone, ≥ the raw ones and ≤ 1; an exact linear trend is found.
+    #[test]
+    fn holm_adjustment_and_sentences() {
+        let shots: Vec<ShotComparison> = (0..8)
+            .map(|i| {
+                shot(
+                    "clay",
+                    1.0 + i as f64 * 0.5,
+                    -0.05 * (1.0 + i as f64 * 0.5) + 0.001 * ((i * 7 % 5) as f64),
+                )
+            })
+            .collect();
+        let comparison = Comparison {
+            shots,
+            overall: Vec::new(),
+            chi2: 0.0,
+            n_residuals: 0,
+            n_params: 0,
+            chi2_red_total: f64::NAN,
+        };
+        let r = diagnose(&comparison, &DiagnoseOptions::default());
+        let mut last = 0.0;
+        for t in &r.trends {
+            assert!(t.p_holm >= t.p && t.p_holm <= 1.0 && t.p_holm >= last);
+            last = t.p_holm;
+        }
+        let top = &r.trends[0];
+        assert_eq!((top.quantity, top.against), (Quantity::CorError, Against::ImpactSpeed));
+        assert!(
+            top.sentence
+                .starts_with("COR falls with impact speed relative to the model, −0.050 per m/s")
+        );
+        assert!(r.sentences.contains(&top.sentence));
+    }
+}
