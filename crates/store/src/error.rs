@@ -1,0 +1,97 @@
+//! The crate's one error type.
+
+use std::path::PathBuf;
+
+/// A `Result` whose error is [`StoreError`].
+pub type Result<T, E = StoreError> = std::result::Result<T, E>;
+
+/// Everything that can go wrong with the results store. Each variant names the database file (`:memory:` for
+/// an in-memory store) and, where there is one, the table and field.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum StoreError {
+    /// The database could not be opened, or its pragmas could not be set.
+    #[error("{}: cannot open the results store: {source}", .path.display())]
+    Open {
+        /// The database file.
+        path: PathBuf,
+        /// What SQLite said.
+        #[source]
+        source: rusqlite::Error,
+    },
+    /// A statement on a table failed (constraint, I/O, busy, corrupt file …).
+    #[error("{}: table `{table}`: {source}", .path.display())]
+    Sql {
+        /// The database file.
+        path: PathBuf,
+        /// The table the statement was about.
+        table: &'static str,
+        /// What SQLite said.
+        #[source]
+        source: rusqlite::Error,
+    },
+    /// A value is not acceptable for its column, or a stored value cannot be read back.
+    #[error("{}: table `{table}`, field `{field}`: {message}", .path.display())]
+    Field {
+        /// The database file.
+        path: PathBuf,
+        /// The table.
+        table: &'static str,
+        /// The column.
+        field: &'static str,
+        /// What is wrong.
+        message: String,
+    },
+    /// A row referred to by id does not exist.
+    #[error("{}: table `{table}`: no row with id {id}", .path.display())]
+    NotFound {
+        /// The database file.
+        path: PathBuf,
+        /// The table.
+        table: &'static str,
+        /// The id asked for.
+        id: i64,
+    },
+    /// The file was written by a newer bouncelab with a schema this build does not know.
+    #[error(
+        "{}: table `schema_version`: the store has schema version {found}, this program knows up to \
+         {supported}; use a newer bouncelab",
+        .path.display()
+    )]
+    SchemaTooNew {
+        /// The database file.
+        path: PathBuf,
+        /// Version found in the file.
+        found: i64,
+        /// Newest version this build can migrate to.
+        supported: i64,
+    },
+    /// A table name given to the CSV export does not exist.
+    #[error("unknown table `{name}`; the tables are: {known}")]
+    UnknownTable {
+        /// The name asked for.
+        name: String,
+        /// The known names, comma separated.
+        known: String,
+    },
+    /// Reading or writing a file (CSV export, clip fingerprint) failed.
+    #[error("{}: {source}", .path.display())]
+    Io {
+        /// The file or folder.
+        path: PathBuf,
+        /// The I/O error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// Writing CSV failed.
+    #[error("{}: table `{table}`: CSV export failed: {source}", .path.display())]
+    Csv {
+        /// The database file.
+        path: PathBuf,
+        /// The table being exported.
+        table: &'static str,
+        /// The CSV error.
+        #[source]
+        source: csv::Error,
+    },
+}

@@ -1,0 +1,302 @@
+//! The schema: its migrations and the list of tables with their columns in export order.
+
+use std::fmt;
+use std::str::FromStr;
+
+use crate::error::StoreError;
+
+/// SQL for the current time as ISO 8601 UTC with milliseconds (`2026-04-14T09:30:00.123Z`).
+macro_rules! now_sql {
+    () => {
+        "strftime('%Y-%m-%dT%H:%M:%fZ', 'now')"
+    };
+}
+pub(crate) use now_sql;
+
+/// One schema migration: applied once, inside the transaction that records its version.
+#[derive(Debug, Clone, Copy)]
+pub struct Migration {
+    /// The version this migration brings the schema to (1, 2, …; contiguous).
+    pub version: i64,
+    /// One line on what it changes.
+    pub description: &'static str,
+    /// The SQL, run with `execute_batch`.
+    pub sql: &'static str,
+}
+
+/// Every migration in order. The migration hook: to change the schema, append a migration here (never edit
+/// an applied one), add its tables to [`Table`], and describe it in `docs/store.md`.
+pub const MIGRATIONS: &[Migration] = &[Migration {
+    version: 1,
+    description: "sessions, shots, tracks, trajectory, estimates, model_versions, fits",
+    sql: concat!(
+        "
+CREATE TABLE sessions (
+    id INTEGER PRIMARY KEY,
+    path TEXT NOT NULL UNIQUE,
+    description TEXT,
+    settings_hash TEXT NOT NULL,
+    session_toml TEXT NOT NULL,
+    loaded_at TEXT NOT NULL DEFAULT (",
+        now_sql!(),
+        "),
+    updated_at TEXT NOT NULL DEFAULT (",
+        now_sql!(),
+        ")
+);
+CREATE TABLE shots (
+    id INTEGER PRIMARY KEY,
+    session_id INTEGER NOT NULL REFERENCES sessions(id) ON DELETE CASCADE,
+    clip TEXT NOT NULL,
+    surface TEXT NOT NULL,
+    angle_deg REAL,
+    drop_height_m REAL,
+    fps REAL,
+    metadata TEXT NOT NULL DEFAULT '{}' CHECK (json_valid(metadata)),
+    frames_hash TEXT NOT NULL,
+    status TEXT NOT NULL DEFAULT 'pending'
+        CHECK (status IN ('pending', 'tracked', 'estimated', 'failed')),
+    error TEXT,
+    updated_at TEXT NOT NULL DEFAULT (",
+        now_sql!(),
+        "),
+    UNIQUE (session_id, clip)
+);
+CREATE TABLE tracks (
+    shot_id INTEGER PRIMARY KEY REFERENCES shots(id) ON DELETE CASCADE,
+    frames INTEGER NOT NULL CHECK (frames >= 0),
+    measured INTEGER NOT NULL CHECK (measured >= 0 AND measured <= frames),
+    scale_m_per_px REAL,
+    scale_se REAL,
+    surface_y_px REAL,
+    surface_tilt_deg REAL,
+    warnings TEXT NOT NULL DEFAULT '[]' CHECK (json_valid(warnings)),
+    seconds REAL,
+    created_at TEXT NOT NULL DEFAULT (",
+        now_sql!(),
+        ")
+);
+CREATE TABLE trajectory (
+    shot_id INTEGER NOT NULL REFERENCES tracks(shot_id) ON DELETE CASCADE,
+    frame INTEGER NOT NULL CHECK (frame >= 0),
+    t_s REAL,
+    x_px REAL,
+    y_px REAL,
+    r_px REAL,
+    sigma_px REAL,
+    quality REAL,
+    status TEXT NOT NULL,
+    x_m REAL,
+    y_m REAL,
+    PRIMARY KEY (shot_id, frame)
+) WITHOUT ROWID;
+CREATE TABLE estimates (
+    shot_id INTEGER PRIMARY KEY REFERENCES shots(id) ON DELETE CASCADE,
+    v_in_t REAL, v_in_t_se REAL,
+    v_in_n REAL, v_in_n_se REAL,
+    v_out_t REAL, v_out_t_se REAL,
+    v_out_n REAL, v_out_n_se REAL,
+    cor REAL, cor_se REAL,
+    mu REAL, mu_se REAL,
+    contact_ms REAL, contact_ms_se REAL,
+    spin_in REAL, spin_in_se REAL,
+    spin_out REAL, spin_out_se REAL,
+    delta_max_m REAL, delta_max_m_se REAL,
+    notes TEXT NOT NULL DEFAULT '[]' CHECK (json_valid(notes)),
+    created_at TEXT NOT NULL DEFAULT (",
+        now_sql!(),
+        ")
+);
+CREATE TABLE model_versions (
+    id INTEGER PRIMARY KEY,
+    name TEXT NOT NULL,
+    toml TEXT NOT NULL,
+    parent_id INTEGER REFERENCES model_versions(id),
+    created_at TEXT NOT NULL DEFAULT (",
+        now_sql!(),
+        "),
+    UNIQUE (name, toml)
+);
+CREATE TABLE fits (
+    id INTEGER PRIMARY KEY,
+    session_id INTEGER REFERENCES sessions(id) ON DELETE CASCADE,
+    model_version_id INTEGER NOT NULL REFERENCES model_versions(id),
+    json TEXT NOT NULL CHECK (json_valid(json)),
+    reduced_chi2 REAL,
+    rms_m REAL,
+    mae_pct REAL,
+    created_at TEXT NOT NULL DEFAULT (",
+        now_sql!(),
+        ")
+);
+CREATE INDEX fits_by_session ON fits(session_id, id);
+CREATE INDEX fits_by_model ON fits(model_version_id, id);
+"
+    ),
+}];
+
+/// The newest schema version this build knows.
+pub fn latest_version() -> i64 {
+    MIGRATIONS.last().map_or(0, |m| m.version)
+}
+
+/// A table of the store.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum Table {
+    /// Applied migrations.
+    SchemaVersion,
+    /// One row per session folder.
+    Sessions,
+    /// One row per (session, clip).
+    Shots,
+    /// One row per tracked shot: summary of its track.
+    Tracks,
+    /// One row per frame of a tracked shot (SPEC §5 trajectory columns).
+    Trajectory,
+    /// One row per estimated shot (SPEC §5 estimates columns).
+    Estimates,
+    /// Model files, each version once.
+    ModelVersions,
+    /// Fits of a model version to a session's shots.
+    Fits,
+}
+
+impl Table {
+    /// Every table, in export order.
+    pub const ALL: [Table; 8] = [
+        Table::SchemaVersion,
+        Table::Sessions,
+        Table::Shots,
+        Table::Tracks,
+        Table::Trajectory,
+        Table::Estimates,
+        Table::ModelVersions,
+        Table::Fits,
+    ];
+
+    /// The SQL name (also the CSV file's stem).
+    pub fn name(self) -> &'static str {
+        match self {
+            Table::SchemaVersion => "schema_version",
+            Table::Sessions => "sessions",
+            Table::Shots => "shots",
+            Table::Tracks => "tracks",
+            Table::Trajectory => "trajectory",
+            Table::Estimates => "estimates",
+            Table::ModelVersions => "model_versions",
+            Table::Fits => "fits",
+        }
+    }
+
+    /// Columns in their stable export order (the CSV header).
+    pub fn columns(self) -> &'static [&'static str] {
+        match self {
+            Table::SchemaVersion => &["version", "description", "applied_at"],
+            Table::Sessions => &[
+                "id",
+                "path",
+                "description",
+                "settings_hash",
+                "session_toml",
+                "loaded_at",
+                "updated_at",
+            ],
+            Table::Shots => &[
+                "id",
+                "session_id",
+                "clip",
+                "surface",
+                "angle_deg",
+                "drop_height_m",
+                "fps",
+                "metadata",
+                "frames_hash",
+                "status",
+                "error",
+                "updated_at",
+            ],
+            Table::Tracks => &[
+                "shot_id",
+                "frames",
+                "measured",
+                "scale_m_per_px",
+                "scale_se",
+                "surface_y_px",
+                "surface_tilt_deg",
+                "warnings",
+                "seconds",
+                "created_at",
+            ],
+            Table::Trajectory => &[
+                "shot_id", "frame", "t_s", "x_px", "y_px", "r_px", "sigma_px", "quality", "status", "x_m", "y_m",
+            ],
+            Table::Estimates => &[
+                "shot_id",
+                "v_in_t",
+                "v_in_t_se",
+                "v_in_n",
+                "v_in_n_se",
+                "v_out_t",
+                "v_out_t_se",
+                "v_out_n",
+                "v_out_n_se",
+                "cor",
+                "cor_se",
+                "mu",
+                "mu_se",
+                "contact_ms",
+                "contact_ms_se",
+                "spin_in",
+                "spin_in_se",
+                "spin_out",
+                "spin_out_se",
+                "delta_max_m",
+                "delta_max_m_se",
+                "notes",
+                "created_at",
+            ],
+            Table::ModelVersions => &["id", "name", "toml", "parent_id", "created_at"],
+            Table::Fits => &[
+                "id",
+                "session_id",
+                "model_version_id",
+                "json",
+                "reduced_chi2",
+                "rms_m",
+                "mae_pct",
+                "created_at",
+            ],
+        }
+    }
+
+    /// The ORDER BY of the export (primary key order).
+    pub(crate) fn order_by(self) -> &'static str {
+        match self {
+            Table::SchemaVersion => "version",
+            Table::Tracks | Table::Estimates => "shot_id",
+            Table::Trajectory => "shot_id, frame",
+            _ => "id",
+        }
+    }
+}
+
+impl fmt::Display for Table {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Table {
+    type Err = StoreError;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Table::ALL
+            .into_iter()
+            .find(|t| t.name() == s)
+            .ok_or_else(|| StoreError::UnknownTable {
+                name: s.to_string(),
+                known: Table::ALL.map(Table::name).join(", "),
+            })
+    }
+}
