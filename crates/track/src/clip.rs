@@ -221,7 +221,9 @@ fn acquire(clip: &Clip, opts: &ClipTracking, warnings: &mut Vec<String>) -> Resu
     let mut fallback = None;
     while k + gap < n && k <= n / 2 {
         let (a, b) = (circles_in(k)?, circles_in(k + gap)?);
-        let good = |c: &&crate::Circle| c.support > 0.5;
+        // Both ends of a pair must be clean circles (a ball's rim refines to a quality near 1; a seam or a
+        // texture ghost does not), or the seed would start the track on the wrong circle.
+        let good = |c: &&crate::Circle| c.support > 0.85;
         // Circles that moved between the two frames, with their positions in both.
         let mut moving: Vec<(crate::Circle, crate::Circle)> = Vec::new();
         for ca in a.iter().filter(good) {
@@ -235,7 +237,7 @@ fn acquire(clip: &Clip, opts: &ClipTracking, warnings: &mut Vec<String>) -> Resu
         }
         let best = moving
             .iter()
-            .max_by(|p, q| p.0.support.total_cmp(&q.0.support))
+            .max_by(|p, q| p.0.support.min(p.1.support).total_cmp(&q.0.support.min(q.1.support)))
             .map(|(ca, cb)| (ca.support, *ca, *cb));
         if let Some((_, ca, cb)) = best {
             let r = 0.5 * (ca.r + cb.r);
