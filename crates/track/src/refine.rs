@@ -291,6 +291,16 @@ pub fn refined_candidates<P: Pixel>(
     }
     let kept = crate::outermost(&out.iter().map(|c| c.0).collect::<Vec<_>>());
     out.retain(|c| kept.contains(&c.0));
+    // An object's outline separates it from what is behind: the brightness just inside differs from just
+    // outside all round. A seam drawn on the ball has felt on both sides. Drop circles whose silhouette
+    // contrast is less than half the clearest one's.
+    let silhouettes: Vec<f64> = out.iter().map(|c| silhouette_contrast(img, &c.0)).collect();
+    let best = silhouettes.iter().copied().fold(0.0, f64::max);
+    let mut k = 0;
+    out.retain(|_| {
+        k += 1;
+        silhouettes[k - 1] >= 0.5 * best
+    });
     out.sort_by(|a, b| b.0.support.total_cmp(&a.0.support));
     out
 }
@@ -322,4 +332,28 @@ fn grow_outward<P: Pixel>(
         }
     }
     f
+}
+
+/// Median over 64 directions of |mean brightness 3–6 px inside the circle − 3–6 px outside|, 0–255 scale.
+fn silhouette_contrast<P: Pixel>(img: &Plane<P>, c: &crate::Circle) -> f64 {
+    let mut diffs: Vec<f64> = (0..64)
+        .filter_map(|k| {
+            let a = std::f64::consts::TAU * k as f64 / 64.0;
+            let (dx, dy) = (a.cos(), a.sin());
+            let mean = |from: f64, to: f64| -> Option<f64> {
+                let mut sum = 0.0;
+                for i in 0..4 {
+                    let d = c.r + from + (to - from) * i as f64 / 3.0;
+                    sum += img.sample((c.x + d * dx) as f32, (c.y + d * dy) as f32)? as f64;
+                }
+                Some(sum / 4.0)
+            };
+            Some((mean(-6.0, -3.0)? - mean(3.0, 6.0)?).abs())
+        })
+        .collect();
+    if diffs.is_empty() {
+        return 0.0;
+    }
+    let mid = diffs.len() / 2;
+    *diffs.select_nth_unstable_by(mid, f64::total_cmp).1
 }
