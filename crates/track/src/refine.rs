@@ -292,14 +292,20 @@ pub fn refined_candidates<P: Pixel>(
     let kept = crate::outermost(&out.iter().map(|c| c.0).collect::<Vec<_>>());
     out.retain(|c| kept.contains(&c.0));
     // An object's outline separates it from what is behind: the brightness just inside differs from just
-    // outside all round. A seam drawn on the ball has felt on both sides. Drop circles whose silhouette
-    // contrast is less than half the clearest one's.
+    // outside all round. A seam drawn on the ball has felt on both sides. Of two overlapping circles (a seam
+    // and the rim it lies on), drop the one with less than half the other's silhouette contrast; separate
+    // objects elsewhere in the frame do not compete.
     let silhouettes: Vec<f64> = out.iter().map(|c| silhouette_contrast(img, &c.0)).collect();
-    let best = silhouettes.iter().copied().fold(0.0, f64::max);
+    let overlaps = |a: &crate::Circle, b: &crate::Circle| (a.x - b.x).hypot(a.y - b.y) < 0.5 * (a.r + b.r);
+    let keep: Vec<bool> = (0..out.len())
+        .map(|i| {
+            !(0..out.len()).any(|j| j != i && overlaps(&out[i].0, &out[j].0) && silhouettes[i] < 0.5 * silhouettes[j])
+        })
+        .collect();
     let mut k = 0;
     out.retain(|_| {
         k += 1;
-        silhouettes[k - 1] >= 0.5 * best
+        keep[k - 1]
     });
     out.sort_by(|a, b| b.0.support.total_cmp(&a.0.support));
     out

@@ -118,6 +118,8 @@ pub struct Tracker {
     warnings: Vec<String>,
     /// Distance between the last prediction and its measurement, px.
     last_innovation: f64,
+    /// Consecutive frames where only circles far from the prediction were found.
+    missed: usize,
 }
 
 /// Search half-width around a confident prediction, px.
@@ -138,6 +140,7 @@ impl Tracker {
             surface_tries: 0,
             warnings: Vec::new(),
             last_innovation: 0.0,
+            missed: 0,
         }
     }
 
@@ -273,6 +276,21 @@ impl Tracker {
                     .min_by(|a, b| d(a.1).total_cmp(&d(b.1)))
                     .expect("non-empty");
                 let chosen = cands.swap_remove(i);
+                // A circle far from where the ball must be is not the ball: say it is missing, and give up the
+                // track after a few such frames so the ball can be found afresh.
+                let r_expected = self.expected_radius().unwrap_or(chosen.1.fit.r);
+                if (chosen.1.fit.x - px).hypot(chosen.1.fit.y - py) > 0.5 * r_expected {
+                    self.missed += 1;
+                    if self.missed >= 3 {
+                        self.history.clear();
+                        self.warnings.push(format!(
+                            "frame {frame}: track given up after {} frames without the ball",
+                            self.missed
+                        ));
+                        self.missed = 0;
+                    }
+                    return BallFix::absent(frame, t_s, Status::Absent);
+                }
                 if rivals > 1 {
                     self.warnings.push(format!(
                         "frame {frame}: {rivals} ball-like circles; tracking the one at ({:.1}, {:.1}) because it continues the track",
@@ -305,6 +323,7 @@ impl Tracker {
     }
 
     fn accept<P: Pixel>(&mut self, frame: usize, t_s: f64, img: &Plane<P>, f: Refined, mut status: Status) -> BallFix {
+        self.missed = 0;
         let fit = f.fit;
         let (w, h) = (img.width as f64, img.height as f64);
         if fit.x - fit.r < -0.5 || fit.y - fit.r < -0.5 || fit.x + fit.r > w - 0.5 || fit.y + fit.r > h - 0.5 {
