@@ -16,6 +16,8 @@ mod problem;
 mod result;
 mod shot;
 mod solver;
+#[doc(hidden)]
+pub mod testutil;
 
 pub use bouncelab_model::{ModelSpec, SimOptions, State};
 pub use error::FitError;

@@ -3,12 +3,12 @@
 #![allow(dead_code)]
 
 use bouncelab_compare::{ShotExtras, SpinFrame};
-use bouncelab_fit::{MeasuredFrame, MeasuredOutputs, MeasuredShot, StartState};
-use bouncelab_model::{Model, SimOptions, State, simulate_drop};
+use bouncelab_fit::{MeasuredOutputs, MeasuredShot, StartState};
+use bouncelab_model::{Model, State};
 
-/// Camera: 10 kHz, 4e-4 m/px, centre noise 0.05 px.
-pub const FPS: f64 = 10_000.0;
-pub const SIGMA_M: f64 = 0.05 * 4e-4;
+pub use bouncelab_fit::testutil::{CLAY, Rng, TAPE1};
+use bouncelab_fit::testutil::{noisy_frames, simulate_shot};
+
 /// Spin noise, rad/s.
 pub const SIGMA_OMEGA: f64 = 2.0;
 /// Noise of the measured outputs: COR, μ (absolute), v_out (relative).
@@ -18,33 +18,8 @@ pub const SIGMA_V_REL: f64 = 0.005;
 /// Noise of the measured contact time, s.
 pub const SIGMA_TC: f64 = 2e-5;
 
-/// The paper's values.
-pub const CLAY: (f64, f64) = (25_650.0, 14.0);
-pub const TAPE1: (f64, f64) = (30_800.0, 15.0);
-
-/// A small deterministic generator (SplitMix64) with Box–Muller normals.
-pub struct Rng(u64);
-
-impl Rng {
-    pub fn new(seed: u64) -> Rng {
-        Rng(seed)
-    }
-    pub fn uniform(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        ((z >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
-    pub fn normal(&mut self) -> f64 {
-        let (u1, u2) = (self.uniform(), self.uniform());
-        (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
-    }
-}
-
 /// One synthetic shot: `model` dropped from `height_m` onto a surface inclined by `incline_deg`, sampled at
-/// 10 kHz from 10 ms before touch to 10 ms after separation, with Gaussian noise σ = [`SIGMA_M`] on what
+/// 10 kHz from 10 ms before touch to 10 ms after separation, with Gaussian noise σ = `SIGMA_M` on what
 /// the camera sees (x, y), an arbitrary x origin, and as the start the observed state at the first frame
 /// (what the estimator's incoming fit would give). The extras carry the drop height, a noisy contact time
 /// and a noisy spin at every frame.
@@ -57,25 +32,9 @@ pub fn synth_shot(
     x_offset_m: f64,
     rng: &mut Rng,
 ) -> (MeasuredShot, ShotExtras) {
-    let opts = SimOptions::default();
     let beta = incline_deg.to_radians();
-    let probe = simulate_drop(model, beta, height_m, &[], &opts).expect("synthetic drop simulates");
-    let (t_touch, t_sep) = (probe.impact.t_touch, probe.impact.t_separation);
-    let phase = 0.37 / FPS * rng.uniform();
-    let first = ((t_touch - 0.010) * FPS).ceil() as i64;
-    let last = ((t_sep + 0.010) * FPS).floor() as i64;
-    let times: Vec<f64> = (first..=last).map(|k| k as f64 / FPS + phase).collect();
-    let sim = simulate_drop(model, beta, height_m, &times, &opts).expect("synthetic drop simulates");
-    let frames = sim
-        .samples
-        .iter()
-        .map(|s| MeasuredFrame {
-            t_s: s.t,
-            x_m: s.observed.x + x_offset_m + SIGMA_M * rng.normal(),
-            y_m: s.observed.y + SIGMA_M * rng.normal(),
-            sigma_m: SIGMA_M,
-        })
-        .collect();
+    let sim = simulate_shot(model, height_m, incline_deg, rng);
+    let frames = noisy_frames(&sim, x_offset_m, rng);
     let spin = sim
         .samples
         .iter()
@@ -145,13 +104,5 @@ pub fn shots_for(
 
 /// A model file with k and b free per surface (starting away from the truth) and μ fixed at 0.5.
 pub fn spec_toml(surfaces: &[&str]) -> String {
-    let mut s = String::from(
-        "[model]\nname = \"paper-compare-test\"\n\n[effects.spring]\nk = { value = 20000, free = true, min = 1000, max = 1000000 }\n\
-         [effects.damping]\nb = { value = 10, free = true, min = 0, max = 200 }\n\
-         [effects.coulomb]\nmu = 0.5\n",
-    );
-    for sf in surfaces {
-        s.push_str(&format!("\n[surfaces.{sf}]\nspring.k = 20000\ndamping.b = 10\n"));
-    }
-    s
+    bouncelab_fit::testutil::spec_toml("paper-compare-test", surfaces, "")
 }
