@@ -23,6 +23,9 @@ pub struct EdgeSearch {
     pub min_contrast: f32,
     /// Rays whose rim point lies less than this above the surface line are skipped, px (default 2).
     pub surface_margin: f64,
+    /// Also measure [`Refined::edge_definition_px`] (default false: it costs ≈ 3 µs a frame and the scale
+    /// needs it in a few dozen frames only).
+    pub edge_definition: bool,
 }
 
 impl Default for EdgeSearch {
@@ -33,6 +36,7 @@ impl Default for EdgeSearch {
             step: 0.5,
             min_contrast: 2.0,
             surface_margin: 2.0,
+            edge_definition: false,
         }
     }
 }
@@ -53,7 +57,8 @@ pub struct Refined {
     /// Median brightness step at the edge points, 0–255 scale per px.
     pub contrast: f32,
     /// Median distance from the gradient-maximum edge to the half-contrast crossing, px (positive outward):
-    /// how much "the rim" depends on how an edge is defined.
+    /// how much "the rim" depends on how an edge is defined. NaN unless [`EdgeSearch::edge_definition`]
+    /// asked for it (or too few rays gave one).
     pub edge_definition_px: f64,
 }
 
@@ -184,7 +189,9 @@ fn refine_once<P: Pixel>(
         let d = start + (best_j as f64 + off) * search.step;
         points.push([x + d * c, y + d * s]);
         contrasts.push(per_px);
-        if let Some(o) = half_level_offset(profile, best_j, best_j as f64 + off) {
+        if search.edge_definition
+            && let Some(o) = half_level_offset(profile, best_j, best_j as f64 + off)
+        {
             offsets.push(o * search.step);
         }
     }
@@ -213,7 +220,7 @@ fn refine_once<P: Pixel>(
         let mid = offsets.len() / 2;
         *offsets.select_nth_unstable_by(mid, f64::total_cmp).1
     } else {
-        0.0
+        f64::NAN
     };
     Some(Refined {
         fit,

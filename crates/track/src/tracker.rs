@@ -111,7 +111,7 @@ pub struct Tracker {
     history: Vec<(f64, f64, f64)>,
     /// Radii measured in free flight (the bottom clear of the surface).
     flight_radii: Vec<f64>,
-    /// Edge-definition spread (see [`Refined::edge_definition_px`]) in the same frames, px.
+    /// Edge-definition spread (see [`Refined::edge_definition_px`]) in the first free-flight frames, px.
     flight_edges: Vec<f64>,
     surface: Option<SurfaceLine>,
     surface_tries: usize,
@@ -121,6 +121,9 @@ pub struct Tracker {
     /// Consecutive frames where only circles far from the prediction were found.
     missed: usize,
 }
+
+/// Free-flight frames in which the edge definition is measured (its median enters the scale's error).
+const EDGE_SAMPLES: usize = 64;
 
 /// Search half-width around a confident prediction, px.
 const CONFIDENT_HALF_WIDTH: f64 = 2.0;
@@ -165,7 +168,7 @@ impl Tracker {
         &self.warnings
     }
 
-    /// How much the rim's position depends on the edge definition in free flight: the median over recent
+    /// How much the rim's position depends on the edge definition in free flight: the median over the first
     /// flight frames of [`Refined::edge_definition_px`], px (0 before any).
     pub fn edge_definition_px(&self) -> f64 {
         if self.flight_edges.is_empty() {
@@ -231,6 +234,7 @@ impl Tracker {
         };
         let search = EdgeSearch {
             half_width,
+            edge_definition: self.flight_edges.len() < EDGE_SAMPLES,
             ..self.opts.search.clone()
         };
         let max_jump = self.opts.max_jump_px.max(2.0 * self.last_innovation + 2.0);
@@ -338,10 +342,11 @@ impl Tracker {
         };
         if status == Status::Ok && clear && f.rays_hidden == 0 {
             self.flight_radii.push(fit.r);
-            self.flight_edges.push(f.edge_definition_px);
             if self.flight_radii.len() > 64 {
                 self.flight_radii.remove(0);
-                self.flight_edges.remove(0);
+            }
+            if f.edge_definition_px.is_finite() && self.flight_edges.len() < EDGE_SAMPLES {
+                self.flight_edges.push(f.edge_definition_px);
             }
         }
         // Seeds from later frames give way to real measurements.

@@ -7,6 +7,16 @@ fn plane<'a>(data: &'a [u8], s: &Scene) -> Plane<'a, u8> {
     Plane::new(data, s.size.0, s.size.1)
 }
 
+/// Hough candidates of radius 25–60 px (the scene's ball is 40 px).
+fn detect_ball_sized(px: &[u8], s: &Scene) -> Vec<bouncelab_track::Circle> {
+    let det = CircleDetection {
+        min_radius: 25.0,
+        max_radius: 60.0,
+        ..Default::default()
+    };
+    detect_circles(&plane(px, s), &det)
+}
+
 #[test]
 fn hough_finds_the_ball_and_not_the_small_distractor() {
     let s = Scene {
@@ -14,14 +24,7 @@ fn hough_finds_the_ball_and_not_the_small_distractor() {
         ..Scene::default()
     };
     let px = render(&s);
-    let c = detect_circles(
-        &plane(&px, &s),
-        &CircleDetection {
-            min_radius: 25.0,
-            max_radius: 60.0,
-            ..Default::default()
-        },
-    );
+    let c = detect_ball_sized(&px, &s);
     let best = c.first().expect("a circle");
     assert!(
         (best.x - s.ball.0).abs() < 1.5 && (best.y - s.ball.1).abs() < 1.5,
@@ -38,14 +41,7 @@ fn hough_ranks_two_balls_by_support() {
         ..Scene::default()
     };
     let px = render(&s);
-    let c = detect_circles(
-        &plane(&px, &s),
-        &CircleDetection {
-            min_radius: 25.0,
-            max_radius: 60.0,
-            ..Default::default()
-        },
-    );
+    let c = detect_ball_sized(&px, &s);
     assert!(c.len() >= 2);
     let near = |x: f64, y: f64| {
         c.iter()
