@@ -32,6 +32,10 @@ enum Command {
     Estimate(cmd::estimate::Args),
     /// Track the ball through one clip folder and write its trajectory (CSV).
     Track(cmd::track::Args),
+    /// Everything over a session folder: track, estimate, fit, compare, diagnose, stats, report.
+    Analyze(cmd::analyze::Args),
+    /// Edit a model file: `model add EFFECT --model model.toml` accepts a diagnosis.
+    Model(cmd::model::Args),
 }
 
 fn main() -> ExitCode {
@@ -43,6 +47,8 @@ fn main() -> ExitCode {
         Command::Render(a) => cmd::render::run(a),
         Command::Track(a) => cmd::track::run(a),
         Command::Estimate(a) => cmd::estimate::run(a),
+        Command::Analyze(a) => cmd::analyze::run(a),
+        Command::Model(a) => cmd::model::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

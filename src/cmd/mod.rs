@@ -1,8 +1,10 @@
 //! One module per subcommand.
 
+pub mod analyze;
 pub mod demo;
 pub mod effects;
 pub mod estimate;
+pub mod model;
 pub mod render;
 pub mod simulate;
 pub mod track;

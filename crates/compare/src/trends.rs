@@ -79,6 +79,20 @@ impl Quantity {
         }
     }
 
+    /// The smallest effect worth a sentence, in the quantity's unit: the instrument's resolution (the
+    /// estimator's accuracy targets: COR 0.002, μ 0.005, speeds 0.3 %, contact time 0.05 ms; 2 µm of
+    /// residual RMS). Smaller trends stay in the table with their p-values but are not called failures: with
+    /// a hundred shots a bias far below what the lab can measure is "significant".
+    pub fn material(self) -> f64 {
+        match self {
+            Quantity::CorError => 0.002,
+            Quantity::MuError => 0.005,
+            Quantity::VOutTError | Quantity::VOutNError => 0.3,
+            Quantity::ContactTimeError => 0.05,
+            Quantity::ResidualRms => 2.0,
+        }
+    }
+
     /// Spread below which the quantity is taken as constant (numerical noise), in its unit.
     fn tiny(self) -> f64 {
         match self {
@@ -176,6 +190,13 @@ pub struct Trend {
     pub n: usize,
     /// `p_holm < alpha`.
     pub significant: bool,
+    /// Size of the effect in the quantity's unit: |mean|, |slope| × the condition's range, or the spread of
+    /// the surface means.
+    #[serde(default)]
+    pub size: f64,
+    /// `size` ≥ the quantity's [`Quantity::material`] resolution.
+    #[serde(default)]
+    pub material: bool,
     /// The finding in one plain sentence.
     pub sentence: String,
 }
@@ -292,7 +313,7 @@ fn test(q: Quantity, a: Against, shots: &[ShotComparison], opts: &DiagnoseOption
     let (subject, unit, dec) = q.words();
     let (xw, xu) = a.words();
     let have: Vec<&ShotComparison> = shots.iter().filter(|s| q.of(s).is_some()).collect();
-    let trend = |slope: f64, se: f64, p: f64, f: Option<f64>, n: usize, sentence: String| Trend {
+    let trend = |slope: f64, se: f64, p: f64, f: Option<f64>, n: usize, size: f64, sentence: String| Trend {
         quantity: q,
         against: a,
         slope,
@@ -303,6 +324,8 @@ fn test(q: Quantity, a: Against, shots: &[ShotComparison], opts: &DiagnoseOption
         f,
         n,
         significant: false,
+        size,
+        material: size >= q.material(),
         sentence,
     };
     match a {
@@ -330,7 +353,7 @@ fn test(q: Quantity, a: Against, shots: &[ShotComparison], opts: &DiagnoseOption
                 p_text(p),
                 y.len()
             );
-            Some(trend(m, se, p, None, y.len(), sentence))
+            Some(trend(m, se, p, None, y.len(), m.abs(), sentence))
         }
         Against::Surface => {
             let mut groups: Vec<(String, Vec<f64>)> = Vec::new();
@@ -388,7 +411,7 @@ fn test(q: Quantity, a: Against, shots: &[ShotComparison], opts: &DiagnoseOption
                 groups[lo].0,
                 signed(means[lo], dec)
             );
-            Some(trend(slope, se, p, Some(f), n, sentence))
+            Some(trend(slope, se, p, Some(f), n, slope.abs(), sentence))
         }
         _ => {
             let pairs: Vec<(f64, f64, Option<f64>)> = have
@@ -428,7 +451,17 @@ fn test(q: Quantity, a: Against, shots: &[ShotComparison], opts: &DiagnoseOption
                     sentence.push('.');
                 }
             }
-            Some(trend(line.slope, line.se, line.p, None, pairs.len(), sentence))
+            let range =
+                x.iter().cloned().fold(f64::NEG_INFINITY, f64::max) - x.iter().cloned().fold(f64::INFINITY, f64::min);
+            Some(trend(
+                line.slope,
+                line.se,
+                line.p,
+                None,
+                pairs.len(),
+                (line.slope * range).abs(),
+                sentence,
+            ))
         }
     }
 }
@@ -436,6 +469,8 @@ fn test(q: Quantity, a: Against, shots: &[ShotComparison], opts: &DiagnoseOption
 fn capitalise(s: &str) -> String {
     let mut c = s.chars();
     match c.next() {
+        // Symbols keep their case: "μ" is not "Μ".
+        Some(f) if !f.is_ascii() => s.to_string(),
         Some(f) => f.to_uppercase().collect::<String>() + c.as_str(),
         None => String::new(),
     }
@@ -490,8 +525,13 @@ pub fn diagnose(comparison: &Comparison, opts: &DiagnoseOptions) -> FailureRepor
             top.chi2_red
         ));
     }
-    let significant: Vec<&Trend> = trends.iter().filter(|t| t.significant).collect();
-    if significant.is_empty() {
+    let significant: Vec<&Trend> = trends.iter().filter(|t| t.significant && t.material).collect();
+    let immaterial = trends.iter().filter(|t| t.significant && !t.material).count();
+    if significant.is_empty() && immaterial > 0 {
+        sentences.push(format!(
+            "No material trend across conditions: {immaterial} test(s) are significant but below the measurement's resolution (COR 0.002, μ 0.005, speeds 0.3 %, contact time 0.05 ms)."
+        ));
+    } else if significant.is_empty() {
         match trends.first() {
             Some(t) => sentences.push(format!(
                 "No trend across conditions (smallest p = {:.2} over {m} tests, {:.2} after Holm's correction).",
@@ -542,6 +582,42 @@ mod tests {
             chi2: 0.0,
             n: 0,
         }
+    }
+
+    /// A trend far below the instrument's resolution is significant with enough shots but is not called a
+    /// failure: it stays in the table, marked immaterial, and the sentence says so.
+    #[test]
+    fn significant_but_immaterial_trends_are_not_failures() {
+        // 40 shots, COR error 0.0003 on average with scatter 0.0001: p ≪ 0.001, size 0.0003 < 0.002.
+        let shots: Vec<ShotComparison> = (0..40)
+            .map(|i| shot("clay", 1.0 + 0.05 * i as f64, 0.0003 + 0.0001 * ((i % 3) as f64 - 1.0)))
+            .collect();
+        let comparison = Comparison {
+            shots,
+            overall: Vec::new(),
+            chi2: 0.0,
+            n_residuals: 100,
+            n_params: 2,
+            chi2_red_total: 1.0,
+        };
+        let r = diagnose(&comparison, &DiagnoseOptions::default());
+        let mean = r
+            .trends
+            .iter()
+            .find(|t| t.quantity == Quantity::CorError && t.against == Against::Mean)
+            .unwrap();
+        assert!(mean.significant && !mean.material, "{mean:?}");
+        assert!(
+            r.sentences.iter().any(|s| s.starts_with("No material trend")),
+            "{:?}",
+            r.sentences
+        );
+        assert!(
+            !r.sentences.iter().any(|s| s.contains("over-predicts")),
+            "{:?}",
+            r.sentences
+        );
+        assert_eq!(capitalise("μ rises"), "μ rises");
     }
 
     /// The slope, its standard error and p against a hand computation (R: `summary(lm(y ~ x))`).

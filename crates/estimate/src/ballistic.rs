@@ -1,7 +1,7 @@
 //! Weighted least-squares fit of a ballistic arc with known acceleration.
 
 /// A fitted arc `p(t) = p0 + v0·(t − t_ref) + ½·a·(t − t_ref)²` per coordinate, with covariances.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BallisticFit {
     /// Reference time, s (the mean time of the fitted frames, for a well-conditioned fit).
     pub t_ref: f64,

@@ -13,7 +13,7 @@ mod shot;
 mod spin;
 
 pub use ballistic::{BallisticFit, fit_ballistic};
-pub use shot::{Conditions, Estimate, EstimateError, Measured, PhaseFrames, estimate};
+pub use shot::{Conditions, Estimate, EstimateError, MIN_SIGMA_PX, Measured, PhaseFrames, estimate};
 pub use spin::{
     Rotation, Spin, SpinFrame, SpinOptions, estimate_with_frames, measure_spin, rotation_between, spin_from_frames,
 };

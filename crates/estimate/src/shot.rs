@@ -2,7 +2,7 @@
 
 use crate::ballistic::{BallisticFit, fit_ballistic};
 use bouncelab_track::{Status, Track};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// The conditions of a shot that the video does not show.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -26,7 +26,7 @@ impl Default for Conditions {
 }
 
 /// A measured value and its standard error, in the value's unit.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Measured {
     /// The value.
     pub value: f64,
@@ -41,7 +41,7 @@ impl Measured {
 }
 
 /// Frame indices (first, last) of each phase, and the frames each flight fit used.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct PhaseFrames {
     /// Incoming flight: first and last frame fitted.
     pub flight_in: (usize, usize),
@@ -54,7 +54,7 @@ pub struct PhaseFrames {
 }
 
 /// The per-shot results (local frame of SPEC §3: t along the surface down-slope, n along the normal).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Estimate {
     /// Velocity at contact start (tangential, normal), m/s.
     pub v_in: [Measured; 2],
@@ -80,11 +80,28 @@ pub struct Estimate {
     pub spin_out: Option<Measured>,
     /// The frames of each phase.
     pub phases: PhaseFrames,
+    /// The incoming ballistic arc (local frame, m, s): where a simulation of the shot starts.
+    pub flight_in: BallisticFit,
+    /// The outgoing ballistic arc.
+    pub flight_out: BallisticFit,
     /// Reduced χ² of the flight fits (in x, in y, out x, out y): ≫ 1 means the tracker's σ is too small or the
     /// flight is not ballistic (drag, a bad frame).
     pub chi2_red: [f64; 4],
     /// Things a person should know.
     pub notes: Vec<String>,
+}
+
+impl Estimate {
+    /// Contact start and end, s, had the surface been `level_m` above the surface line found in the image (the
+    /// flight arcs crossing `radius_m + level_m`): how a fitted surface level carries over to the contact
+    /// time.
+    pub fn contact_at_level(&self, level_m: f64, radius_m: f64) -> (f64, f64) {
+        let y = radius_m + level_m;
+        (
+            crossing(&self.flight_in, y, self.t_touch.value, 0.0).value,
+            crossing(&self.flight_out, y, self.t_sep.value, 0.0).value,
+        )
+    }
 }
 
 /// Why a shot could not be measured.
@@ -119,8 +136,9 @@ pub enum EstimateError {
 pub const MIN_FLIGHT_FRAMES: usize = 6;
 /// A frame counts as flight when the ball's bottom is at least this far above the surface line, px.
 const CLEARANCE_MARGIN_PX: f64 = 1.0;
-/// Smallest per-frame σ used as a weight, px (the tracker's σ can be optimistic on clean frames).
-const MIN_SIGMA_PX: f64 = 0.01;
+/// Smallest per-frame σ used as a weight, px (the tracker's σ can be optimistic on clean frames); later
+/// stages weighting the same frames use it too.
+pub const MIN_SIGMA_PX: f64 = 0.01;
 
 struct Point {
     frame: usize,
@@ -248,6 +266,8 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
             fitted: (incoming.len(), outgoing.len()),
         },
         chi2_red: [fin.chi2_red[0], fin.chi2_red[1], fout.chi2_red[0], fout.chi2_red[1]],
+        flight_in: fin,
+        flight_out: fout,
         notes,
     })
 }

@@ -22,7 +22,7 @@ pub mod testutil;
 pub use bouncelab_model::{ModelSpec, SimOptions, State};
 pub use error::FitError;
 pub use params::FreeParam;
-pub use problem::Problem;
+pub use problem::{Problem, profile_surface_level};
 pub use result::{FitResult, FittedParam, ObliqueRow, ShotFit, SurfaceError};
 pub use shot::{MeasuredFrame, MeasuredOutputs, MeasuredShot, StartState};
 pub use solver::{
@@ -40,6 +40,8 @@ pub struct FitOptions {
     pub confidence: f64,
     /// Simulate the shots on several threads (default true; the result is identical either way).
     pub parallel: bool,
+    /// Fit each shot's surface level as a nuisance (default true; see [`Problem::with_surface_offsets`]).
+    pub surface_offsets: bool,
 }
 
 impl Default for FitOptions {
@@ -49,6 +51,7 @@ impl Default for FitOptions {
             sim: SimOptions::default(),
             confidence: 0.95,
             parallel: true,
+            surface_offsets: true,
         }
     }
 }
@@ -63,7 +66,9 @@ pub fn fit(
     options: &FitOptions,
     observer: &mut dyn Observer,
 ) -> Result<FitResult, FitError> {
-    let problem = Problem::new(spec, shots, options.sim)?.with_parallel(options.parallel);
+    let problem = Problem::new(spec, shots, options.sim)?
+        .with_parallel(options.parallel)
+        .with_surface_offsets(options.surface_offsets);
     fit_problem(&problem, &spec.origin, options, observer)
 }
 

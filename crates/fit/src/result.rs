@@ -55,6 +55,10 @@ pub struct ShotFit {
     pub cor_error_pct: Option<f64>,
     /// Simulated contact time, ms.
     pub contact_ms_sim: f64,
+    /// The fitted height of the true surface in the measured frame, m (positive: above the surface line the
+    /// tracker found), when surface levels are fitted.
+    #[serde(default)]
+    pub surface_offset_m: Option<f64>,
 }
 
 /// The paper's mean absolute error of the COR for one surface.
@@ -164,6 +168,32 @@ fn inverse(jac: &DMatrix<f64>) -> Option<DMatrix<f64>> {
     }))
 }
 
+/// The cluster-robust (sandwich) covariance with each shot a cluster: `(JᵀJ)⁻¹ (Σ_s J_sᵀ r_s r_sᵀ J_s) (JᵀJ)⁻¹`,
+/// times `S/(S − p)` for S shots; `None` with fewer than p + 2 shots, where it is not worth having.
+fn cluster_robust(inv: &DMatrix<f64>, out: &SolverOutcome, problem: &Problem) -> Option<DMatrix<f64>> {
+    let jac = out.jacobian.as_ref()?;
+    let p = inv.nrows();
+    let shots = problem.shots();
+    if shots.len() < p + 2 || jac.nrows() != out.residuals.len() {
+        return None;
+    }
+    let mut meat = DMatrix::<f64>::zeros(p, p);
+    let mut row = 0;
+    for shot in shots {
+        let n = 2 * shot.frames.len();
+        let mut score = nalgebra::DVector::<f64>::zeros(p);
+        for k in row..row + n {
+            for j in 0..p {
+                score[j] += jac[(k, j)] * out.residuals[k];
+            }
+        }
+        meat += &score * score.transpose();
+        row += n;
+    }
+    let s = shots.len() as f64;
+    Some(inv * meat * inv * (s / (s - p as f64)))
+}
+
 pub(crate) fn build(
     problem: &Problem,
     out: &SolverOutcome,
@@ -173,14 +203,29 @@ pub(crate) fn build(
     let sims = problem.simulate(&out.params)?;
     let n = problem.n_residuals();
     let p = problem.params().len();
-    let dof = n - p;
+    let dof = n
+        .saturating_sub(p + problem.nuisance_per_shot() * problem.shots().len())
+        .max(1);
+    let offsets = problem.offsets();
     let chi2 = out.cost;
     let reduced_chi2 = chi2 / dof as f64;
     let covariance_scale = reduced_chi2.max(1.0);
     let t_quantile = StudentsT::new(0.0, 1.0, dof as f64)
         .map(|t| t.inverse_cdf(0.5 + confidence / 2.0))
         .unwrap_or(f64::NAN);
-    let cov = out.jacobian.as_ref().and_then(inverse).map(|c| c * covariance_scale);
+    let cov = out.jacobian.as_ref().and_then(inverse).map(|c| {
+        let classical = &c * covariance_scale;
+        match cluster_robust(&c, out, problem) {
+            // Residuals within a shot share systematic errors (the track's bias in contact, the scale), so
+            // the shots, not the frames, are the independent units: the larger of the two variances is kept.
+            Some(robust) => DMatrix::from_fn(c.nrows(), c.ncols(), |i, j| {
+                let k = (robust[(i, i)] / classical[(i, i)]).max(1.0).sqrt()
+                    * (robust[(j, j)] / classical[(j, j)]).max(1.0).sqrt();
+                classical[(i, j)] * if k.is_finite() { k } else { 1.0 }
+            }),
+            None => classical,
+        }
+    });
     let parameters = problem
         .params()
         .iter()
@@ -214,7 +259,7 @@ pub(crate) fn build(
     let mut shots = Vec::new();
     let mut oblique = Vec::new();
     let (mut sum_sq, mut count) = (0.0, 0usize);
-    for (shot, sim) in problem.shots().iter().zip(&sims) {
+    for ((shot, sim), offset) in problem.shots().iter().zip(&sims).zip(&offsets) {
         let (mut sq, mut c2) = (0.0, 0.0);
         for (f, s) in shot.frames.iter().zip(&sim.samples) {
             let (dx, dy) = (s.observed.x - f.x_m, s.observed.y - f.y_m);
@@ -237,6 +282,7 @@ pub(crate) fn build(
             cor_measured,
             cor_error_pct: cor_measured.map(|e| ((imp.restitution - e) / e).abs() * 100.0),
             contact_ms_sim: imp.contact_time() * 1e3,
+            surface_offset_m: problem.surface_offsets().then_some(*offset),
         });
         if let Some(m) = shot.measured
             && shot.incline_rad > 0.0

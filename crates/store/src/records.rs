@@ -218,6 +218,8 @@ pub struct EstimateRecord {
     pub delta_max_m: ValueSe,
     /// Estimator notes.
     pub notes: Vec<String>,
+    /// The estimator's full output as JSON (phases, flight arcs …) for later stages, if the caller keeps it.
+    pub detail: Option<String>,
 }
 
 /// An estimate joined with its shot's conditions.

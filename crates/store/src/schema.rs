@@ -26,11 +26,12 @@ pub struct Migration {
 
 /// Every migration in order. The migration hook: to change the schema, append a migration here (never edit
 /// an applied one), add its tables to [`Table`], and describe it in `docs/store.md`.
-pub const MIGRATIONS: &[Migration] = &[Migration {
-    version: 1,
-    description: "sessions, shots, tracks, trajectory, estimates, model_versions, fits",
-    sql: concat!(
-        "
+pub const MIGRATIONS: &[Migration] = &[
+    Migration {
+        version: 1,
+        description: "sessions, shots, tracks, trajectory, estimates, model_versions, fits",
+        sql: concat!(
+            "
 CREATE TABLE sessions (
     id INTEGER PRIMARY KEY,
     path TEXT NOT NULL UNIQUE,
@@ -38,11 +39,11 @@ CREATE TABLE sessions (
     settings_hash TEXT NOT NULL,
     session_toml TEXT NOT NULL,
     loaded_at TEXT NOT NULL DEFAULT (",
-        now_sql!(),
-        "),
+            now_sql!(),
+            "),
     updated_at TEXT NOT NULL DEFAULT (",
-        now_sql!(),
-        ")
+            now_sql!(),
+            ")
 );
 CREATE TABLE shots (
     id INTEGER PRIMARY KEY,
@@ -58,8 +59,8 @@ CREATE TABLE shots (
         CHECK (status IN ('pending', 'tracked', 'estimated', 'failed')),
     error TEXT,
     updated_at TEXT NOT NULL DEFAULT (",
-        now_sql!(),
-        "),
+            now_sql!(),
+            "),
     UNIQUE (session_id, clip)
 );
 CREATE TABLE tracks (
@@ -73,8 +74,8 @@ CREATE TABLE tracks (
     warnings TEXT NOT NULL DEFAULT '[]' CHECK (json_valid(warnings)),
     seconds REAL,
     created_at TEXT NOT NULL DEFAULT (",
-        now_sql!(),
-        ")
+            now_sql!(),
+            ")
 );
 CREATE TABLE trajectory (
     shot_id INTEGER NOT NULL REFERENCES tracks(shot_id) ON DELETE CASCADE,
@@ -104,8 +105,8 @@ CREATE TABLE estimates (
     delta_max_m REAL, delta_max_m_se REAL,
     notes TEXT NOT NULL DEFAULT '[]' CHECK (json_valid(notes)),
     created_at TEXT NOT NULL DEFAULT (",
-        now_sql!(),
-        ")
+            now_sql!(),
+            ")
 );
 CREATE TABLE model_versions (
     id INTEGER PRIMARY KEY,
@@ -113,8 +114,8 @@ CREATE TABLE model_versions (
     toml TEXT NOT NULL,
     parent_id INTEGER REFERENCES model_versions(id),
     created_at TEXT NOT NULL DEFAULT (",
-        now_sql!(),
-        "),
+            now_sql!(),
+            "),
     UNIQUE (name, toml)
 );
 CREATE TABLE fits (
@@ -126,14 +127,20 @@ CREATE TABLE fits (
     rms_m REAL,
     mae_pct REAL,
     created_at TEXT NOT NULL DEFAULT (",
-        now_sql!(),
-        ")
+            now_sql!(),
+            ")
 );
 CREATE INDEX fits_by_session ON fits(session_id, id);
 CREATE INDEX fits_by_model ON fits(model_version_id, id);
 "
-    ),
-}];
+        ),
+    },
+    Migration {
+        version: 2,
+        description: "estimates.detail: the estimator's full output as JSON (phases, flight arcs)",
+        sql: "ALTER TABLE estimates ADD COLUMN detail TEXT CHECK (detail IS NULL OR json_valid(detail));",
+    },
+];
 
 /// The newest schema version this build knows.
 pub fn latest_version() -> i64 {
@@ -255,6 +262,7 @@ impl Table {
                 "delta_max_m_se",
                 "notes",
                 "created_at",
+                "detail",
             ],
             Table::ModelVersions => &["id", "name", "toml", "parent_id", "created_at"],
             Table::Fits => &[

@@ -619,12 +619,12 @@ impl Tx<'_> {
             .execute(
                 "INSERT OR REPLACE INTO estimates (shot_id, v_in_t, v_in_t_se, v_in_n, v_in_n_se, v_out_t,
                     v_out_t_se, v_out_n, v_out_n_se, cor, cor_se, mu, mu_se, contact_ms, contact_ms_se, spin_in,
-                    spin_in_se, spin_out, spin_out_se, delta_max_m, delta_max_m_se, notes)
+                    spin_in_se, spin_out, spin_out_se, delta_max_m, delta_max_m_se, notes, detail)
                  VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15, ?16, ?17, ?18, ?19,
-                         ?20, ?21, ?22)",
+                         ?20, ?21, ?22, ?23)",
                 params![
                     shot_id, a.0, a.1, b.0, b.1, c.0, c.1, d.0, d.1, e.0, e.1, f.0, f.1, g.0, g.1, h.0, h.1, i.0, i.1,
-                    j.0, j.1, notes
+                    j.0, j.1, notes, r.detail
                 ],
             )
             .map_err(sql(self.path, "estimates"))?;
@@ -842,7 +842,7 @@ fn q_estimates(conn: &Connection, path: &Path, column: &str, id: i64) -> Result<
             "SELECT e.shot_id, s.clip, s.surface, s.angle_deg, s.drop_height_m,
                     e.v_in_t, e.v_in_t_se, e.v_in_n, e.v_in_n_se, e.v_out_t, e.v_out_t_se, e.v_out_n, e.v_out_n_se,
                     e.cor, e.cor_se, e.mu, e.mu_se, e.contact_ms, e.contact_ms_se, e.spin_in, e.spin_in_se,
-                    e.spin_out, e.spin_out_se, e.delta_max_m, e.delta_max_m_se, e.notes
+                    e.spin_out, e.spin_out_se, e.delta_max_m, e.delta_max_m_se, e.notes, e.detail
              FROM estimates e JOIN shots s ON s.id = e.shot_id WHERE {column} = ?1 ORDER BY s.id"
         ))
         .map_err(err())?;
@@ -874,6 +874,7 @@ fn q_estimates(conn: &Connection, path: &Path, column: &str, id: i64) -> Result<
                         spin_out: o(21)?,
                         delta_max_m: v(23)?,
                         notes: Vec::new(),
+                        detail: r.get(26)?,
                     },
                 },
                 r.get::<_, String>(25)?,

@@ -65,5 +65,6 @@ pub fn estimate(k: f64) -> EstimateRecord {
         spin_out: Some(v(-15.0)),
         delta_max_m: v(0.004),
         notes: vec!["spin in: seam not visible".into()],
+        detail: Some(format!("{{\"k\": {k}}}")),
     }
 }

@@ -1,0 +1,250 @@
+//! The measuring stage: every clip of a session tracked and estimated, in parallel, through the store.
+//!
+//! A shot whose fingerprint (its frame files and every setting that shapes its track and estimate) is
+//! unchanged and whose estimate is stored is not touched. The others are tracked on worker threads; each
+//! result is written by the calling thread in one transaction (track, trajectory and estimate together), so a
+//! run killed at any instant leaves each shot complete or absent and the next run resumes.
+
+use crate::{AnalyzeError, Progress, Stage};
+use bouncelab_estimate::{Conditions, Estimate, estimate_with_frames};
+use bouncelab_frames::{ClipEntry, Downslope, ReadOptions, Session};
+use bouncelab_store::{
+    ClipFingerprint, EstimateRecord, Fingerprint, SessionRecord, ShotRecord, Store, TrackRecord, TrajectoryRecord,
+    ValueSe, fingerprint_clip_dir,
+};
+use bouncelab_track::{ClipTracking, Track, track_clip};
+use rayon::prelude::*;
+use std::sync::mpsc;
+
+/// What the measuring stage did.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct MeasureSummary {
+    /// The session's row id in the store.
+    pub session_id: i64,
+    /// Shots tracked and estimated in this run.
+    pub measured: Vec<String>,
+    /// Shots whose stored results were reused.
+    pub reused: Vec<String>,
+    /// Shots that could not be measured, with the reason (clip, message).
+    pub failed: Vec<(String, String)>,
+}
+
+/// One clip to measure.
+struct Job<'a> {
+    shot_id: i64,
+    entry: &'a ClipEntry,
+}
+
+/// The session's settings fingerprint: `session.toml` and `clips.csv` as read.
+fn session_record(session: &Session) -> Result<SessionRecord, AnalyzeError> {
+    let read = |name: &str| {
+        let path = session.dir.join(name);
+        std::fs::read_to_string(&path).map_err(|source| AnalyzeError::Io { path, source })
+    };
+    let (toml, csv) = (read("session.toml")?, read("clips.csv")?);
+    let description = session
+        .metadata
+        .get("session")
+        .and_then(|t| t.get("description"))
+        .and_then(|d| d.as_str())
+        .map(str::to_string);
+    Ok(SessionRecord {
+        path: session_key(session),
+        description,
+        settings_hash: Fingerprint::new().str(&toml).str(&csv).finish(),
+        session_toml: toml,
+    })
+}
+
+/// The session's natural key in the store: its canonical path.
+pub(crate) fn session_key(session: &Session) -> String {
+    session
+        .dir
+        .canonicalize()
+        .unwrap_or_else(|_| session.dir.clone())
+        .display()
+        .to_string()
+}
+
+/// Everything besides the frame files that changes a shot's track or estimate.
+fn settings_text(session: &Session, entry: &ClipEntry, gravity: f64) -> String {
+    format!(
+        "bouncelab {} | fps {} | downslope {:?} | diameter {} | angle {} | gravity {} | tracker {:?}",
+        env!("CARGO_PKG_VERSION"),
+        entry.fps,
+        entry.downslope,
+        session.ball.diameter_m,
+        entry.angle_deg,
+        gravity,
+        bouncelab_track::TrackOptions::default(),
+    )
+}
+
+/// Tracks and estimates the shots of `session` that need it and records everything in `store`.
+///
+/// Shots that fail (no ball, ball leaving the frame, a flight too short …) are recorded as failed with their
+/// reason and listed in the summary; the others go on. Errors are only those of the store itself.
+pub fn measure_session(
+    session: &Session,
+    store: &mut Store,
+    gravity: f64,
+    fingerprint: ClipFingerprint,
+    progress: &dyn Progress,
+) -> Result<MeasureSummary, AnalyzeError> {
+    let session_id = store.upsert_session(&session_record(session)?)?;
+    let mut summary = MeasureSummary {
+        session_id,
+        ..MeasureSummary::default()
+    };
+    let mut jobs = Vec::new();
+    for entry in &session.clips {
+        let hash = fingerprint_clip_dir(&entry.dir, &settings_text(session, entry, gravity), fingerprint)?;
+        let record = ShotRecord {
+            clip: entry.name.clone(),
+            surface: entry.surface.clone(),
+            angle_deg: entry.angle_deg,
+            drop_height_m: entry.drop_height_m,
+            fps: entry.fps,
+            metadata: entry.metadata.iter().cloned().collect(),
+            frames_hash: hash,
+        };
+        let up = store.upsert_shot(session_id, &record)?;
+        if up.needs_tracking {
+            jobs.push(Job { shot_id: up.id, entry });
+        } else {
+            summary.reused.push(entry.name.clone());
+        }
+    }
+    progress.start(Stage::Track, jobs.len() as u64);
+    let (tx, rx) = mpsc::channel();
+    let mut store_error = None;
+    std::thread::scope(|scope| {
+        let jobs = &jobs;
+        scope.spawn(move || {
+            jobs.par_iter().for_each_with(tx, |tx, job| {
+                let result = measure_clip(session, job.entry, gravity);
+                // The receiver only goes away after a store error; the remaining shots then stay pending.
+                let _ = tx.send((job.shot_id, job.entry.name.clone(), result));
+            });
+        });
+        for (shot_id, clip, result) in rx {
+            if store_error.is_some() {
+                continue;
+            }
+            let written = store.transaction(|tx| match &result {
+                Ok((track, Ok(estimate))) => {
+                    tx.put_track(shot_id, track)?;
+                    tx.put_estimate(shot_id, estimate)
+                }
+                Ok((track, Err(message))) => {
+                    tx.put_track(shot_id, track)?;
+                    tx.mark_failed(shot_id, message)
+                }
+                Err(message) => tx.mark_failed(shot_id, message),
+            });
+            match (written, result) {
+                (Err(e), _) => store_error = Some(e),
+                (Ok(()), Ok((_, Ok(_)))) => summary.measured.push(clip),
+                (Ok(()), Ok((_, Err(m))) | Err(m)) => {
+                    progress.note(&format!("{clip}: {m}"));
+                    summary.failed.push((clip, m));
+                }
+            }
+            progress.advance(Stage::Track, 1);
+        }
+    });
+    if let Some(e) = store_error {
+        return Err(e.into());
+    }
+    // Shots reused from the store may have failed before: list them too.
+    for row in store.shots(session_id)? {
+        if row.status == bouncelab_store::ShotStatus::Failed
+            && !summary.failed.iter().any(|(c, _)| *c == row.record.clip)
+        {
+            summary
+                .failed
+                .push((row.record.clip.clone(), row.error.clone().unwrap_or_default()));
+        }
+    }
+    progress.finish(
+        Stage::Track,
+        &format!(
+            "{} shot(s) tracked, {} reused, {} failed",
+            summary.measured.len(),
+            summary.reused.len(),
+            summary.failed.len()
+        ),
+    );
+    Ok(summary)
+}
+
+type Measured = Result<(TrackRecord, Result<EstimateRecord, String>), String>;
+
+/// Tracks and estimates one clip on the calling thread.
+fn measure_clip(session: &Session, entry: &ClipEntry, gravity: f64) -> Measured {
+    let clip = entry.open().map_err(|e| e.to_string())?;
+    let opts = ClipTracking {
+        ball_diameter_m: session.ball.diameter_m,
+        downslope_negative_x: entry.downslope == Downslope::MinusX,
+        read: ReadOptions::with_threads(1),
+        ..ClipTracking::default()
+    };
+    let started = std::time::Instant::now();
+    let track = track_clip(&clip, &opts, |_, _| {}).map_err(|e| format!("tracking: {e}"))?;
+    let conditions = Conditions {
+        incline_deg: entry.angle_deg,
+        gravity,
+        ball_diameter_m: session.ball.diameter_m,
+    };
+    let estimate = estimate_with_frames(&track, &clip, &conditions)
+        .map(|e| estimate_record(&e))
+        .map_err(|e| format!("estimating: {e}"));
+    Ok((track_record(&track, started.elapsed().as_secs_f64()), estimate))
+}
+
+fn track_record(track: &Track, seconds: f64) -> TrackRecord {
+    let rows = track.rows();
+    TrackRecord {
+        frames: track.fixes.len() as u64,
+        measured: track.fixes.iter().filter(|f| f.status.measured()).count() as u64,
+        scale_m_per_px: track.scale.map(|s| s.m_per_px),
+        scale_se: track.scale.map(|s| s.sigma_m_per_px),
+        surface_y_px: track.surface.map(|l| l.y0),
+        surface_tilt_deg: track.surface.map(|l| l.tilt_deg()),
+        warnings: track.warnings.clone(),
+        seconds,
+        rows: rows
+            .into_iter()
+            .map(|r| TrajectoryRecord {
+                frame: r.frame as u64,
+                t_s: r.t_s,
+                x_px: r.x_px,
+                y_px: r.y_px,
+                r_px: r.r_px,
+                sigma_px: r.sigma_px,
+                quality: r.quality,
+                status: r.status.to_string(),
+                x_m: r.x_m,
+                y_m: r.y_m,
+            })
+            .collect(),
+    }
+}
+
+fn estimate_record(e: &Estimate) -> EstimateRecord {
+    let v = |m: bouncelab_estimate::Measured| ValueSe::new(m.value, m.se);
+    EstimateRecord {
+        v_in_t: v(e.v_in[0]),
+        v_in_n: v(e.v_in[1]),
+        v_out_t: v(e.v_out[0]),
+        v_out_n: v(e.v_out[1]),
+        cor: v(e.cor),
+        mu: v(e.mu),
+        contact_ms: v(e.contact_ms),
+        spin_in: e.spin_in.map(v),
+        spin_out: e.spin_out.map(v),
+        delta_max_m: v(e.delta_max_m),
+        notes: e.notes.clone(),
+        detail: serde_json::to_string(e).ok(),
+    }
+}

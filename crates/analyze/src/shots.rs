@@ -1,0 +1,105 @@
+//! From stored tracks and estimates to what the fit compares the model with.
+
+use crate::AnalyzeError;
+use bouncelab_estimate::{Estimate, MIN_SIGMA_PX};
+use bouncelab_fit::{MeasuredFrame, MeasuredOutputs, MeasuredShot, StartState, State};
+use bouncelab_store::{ShotStatus, Store, TrackRecord};
+
+/// One measured shot with everything later stages show: its conditions, its track and its estimate.
+#[derive(Debug, Clone)]
+pub struct ShotData {
+    /// Clip name.
+    pub clip: String,
+    /// Surface name.
+    pub surface: String,
+    /// Incline, degrees.
+    pub angle_deg: f64,
+    /// Drop height from `clips.csv`, m.
+    pub drop_height_m: f64,
+    /// Extra `clips.csv` columns.
+    pub metadata: Vec<(String, String)>,
+    /// The stored track (per-frame rows with SPEC §5 columns).
+    pub track: TrackRecord,
+    /// The estimator's output.
+    pub estimate: Estimate,
+    /// What the fit uses: the frames from the first fitted incoming frame to the last fitted outgoing one.
+    pub measured: MeasuredShot,
+}
+
+/// The session's estimated shots, in `clips.csv` order of insertion, read back from the store.
+///
+/// A stored estimate without its detail (written by an older program) is an error naming the shot: re-run
+/// with the store removed, or touch the clip's folder, to measure it again.
+pub fn load_shots(store: &Store, session_id: i64) -> Result<Vec<ShotData>, AnalyzeError> {
+    let mut out = Vec::new();
+    for row in store.shots(session_id)? {
+        if row.status != ShotStatus::Estimated {
+            continue;
+        }
+        let clip = row.record.clip.clone();
+        let (Some(track), Some(est)) = (store.track(row.id)?, store.estimate(row.id)?) else {
+            continue;
+        };
+        let estimate: Estimate = est
+            .detail
+            .as_deref()
+            .and_then(|d| serde_json::from_str(d).ok())
+            .ok_or_else(|| AnalyzeError::StaleStore { clip: clip.clone() })?;
+        let measured = measured_shot(&clip, &row.record.surface, row.record.angle_deg, &track, &estimate);
+        out.push(ShotData {
+            clip,
+            surface: row.record.surface.clone(),
+            angle_deg: row.record.angle_deg,
+            drop_height_m: row.record.drop_height_m,
+            metadata: row.record.metadata.clone().into_iter().collect(),
+            track,
+            estimate,
+            measured,
+        });
+    }
+    Ok(out)
+}
+
+/// The fit's view of one shot: frames (local frame, m) from the first fitted incoming frame to the last
+/// fitted outgoing one, each weighted by the tracker's σ (floored as the estimator floors it), and the
+/// simulation's start taken from the incoming ballistic arc at the first of those frames.
+pub fn measured_shot(clip: &str, surface: &str, angle_deg: f64, track: &TrackRecord, e: &Estimate) -> MeasuredShot {
+    let scale = track.scale_m_per_px.unwrap_or(f64::NAN);
+    let (first, last) = (e.phases.flight_in.0 as u64, e.phases.flight_out.1 as u64);
+    let frames: Vec<MeasuredFrame> = track
+        .rows
+        .iter()
+        .filter(|r| r.frame >= first && r.frame <= last)
+        .filter(|r| matches!(r.status.as_str(), "ok" | "occluded"))
+        .filter(|r| r.x_m.is_finite() && r.y_m.is_finite() && r.sigma_px.is_finite())
+        .map(|r| MeasuredFrame {
+            t_s: r.t_s,
+            x_m: r.x_m,
+            y_m: r.y_m,
+            sigma_m: r.sigma_px.max(MIN_SIGMA_PX) * scale,
+        })
+        .collect();
+    let t0 = frames.first().map_or(e.t_touch.value, |f| f.t_s);
+    let p = e.flight_in.position(t0);
+    let v = e.flight_in.velocity(t0);
+    let state = State {
+        x: p[0],
+        y: p[1],
+        theta: 0.0,
+        vx: v[0],
+        vy: v[1],
+        omega: e.spin_in.map_or(0.0, |s| s.value),
+    };
+    MeasuredShot {
+        name: clip.to_string(),
+        surface: surface.to_string(),
+        incline_rad: angle_deg.to_radians(),
+        frames,
+        start: StartState { t_s: t0, state },
+        measured: Some(MeasuredOutputs {
+            v_out: [e.v_out[0].value, e.v_out[1].value],
+            cor: e.cor.value,
+            mu: e.mu.value,
+        }),
+    }
+}

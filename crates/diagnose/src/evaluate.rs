@@ -1,0 +1,422 @@
+//! One model against a set of shots: the weighted residuals a fit minimises, with the measured start taken
+//! as what the camera saw, and the fit's summary (values, standard errors, intervals, χ², RMS).
+//!
+//! This is the fit crate's [`Problem`] (it checks the shots and owns the parameter vector) with one change:
+//! each shot's measured start is first mapped back through the model's measurement effects, so a candidate
+//! such as camera roll starts from the state whose *observation* is the measured start. A measurement
+//! effect such as a roll turns positions about the local frame's origin, the contact point on the surface
+//! line, while the tracker's x origin is arbitrary: so the contact point is located in each shot's data
+//! (where the measured centre first comes within a radius of the surface line, less the offset the
+//! measurement effect gives a touching ball's centre) and the map is applied about it. Without a
+//! measurement effect the map is the identity and the residuals are exactly the fit crate's. Each shot's
+//! surface level can be profiled as a nuisance, as the fit crate does ([`profile_surface_level`]).
+
+use bouncelab_fit::{
+    FitError, LeastSquares, LevenbergMarquardt, MeasuredShot, NoObserver, Problem, SolverOutcome, Termination,
+    profile_surface_level,
+};
+use bouncelab_model::{Model, ModelSpec, Observation, SimOptions, Simulation, State, simulate};
+use nalgebra::DMatrix;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use statrs::distribution::{ContinuousCDF, StudentsT};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Shared parameters of a model against shots; residuals `(x_sim − x_m)/σ`, `(y_sim − y_m)/σ` per frame.
+#[derive(Debug)]
+pub(crate) struct Evaluator {
+    problem: Problem,
+    sim: SimOptions,
+    /// Index of each shot's surface in `surfaces`.
+    shot_surface: Vec<usize>,
+    surfaces: Vec<String>,
+    /// Per shot: the measured x of the centre when it touched the surface, m (data coordinates).
+    touch_x: Vec<f64>,
+    /// Per shot, when surface levels are fitted: the last profiled level (f64 bits), m.
+    levels: Option<Vec<AtomicU64>>,
+}
+
+impl Evaluator {
+    /// Checks the shots and builds the parameter vector of `spec` (see [`Problem::new`]); with
+    /// `surface_levels`, each shot's surface level is a nuisance profiled in every evaluation (as the fit
+    /// crate's `Problem::with_surface_offsets`).
+    pub fn new(
+        spec: &ModelSpec,
+        shots: Vec<MeasuredShot>,
+        sim: SimOptions,
+        surface_levels: bool,
+    ) -> Result<Evaluator, FitError> {
+        let mut surfaces: Vec<String> = Vec::new();
+        let mut shot_surface = Vec::with_capacity(shots.len());
+        for s in &shots {
+            let i = match surfaces.iter().position(|n| n == &s.surface) {
+                Some(i) => i,
+                None => {
+                    surfaces.push(s.surface.clone());
+                    surfaces.len() - 1
+                }
+            };
+            shot_surface.push(i);
+        }
+        let radius = spec.ball.radius_m;
+        let touch_x = shots.iter().map(|s| touch_x(s, radius)).collect();
+        let levels = surface_levels.then(|| shots.iter().map(|_| AtomicU64::new(0)).collect());
+        let problem = Problem::new(spec, shots, sim)?;
+        Ok(Evaluator {
+            problem,
+            sim,
+            shot_surface,
+            surfaces,
+            touch_x,
+            levels,
+        })
+    }
+
+    pub fn problem(&self) -> &Problem {
+        &self.problem
+    }
+
+    /// Parameter names, in vector order (`clay:spring.k`, `hertz.k_h`).
+    pub fn names(&self) -> Vec<String> {
+        self.problem.params().iter().map(|p| p.name.clone()).collect()
+    }
+
+    /// Simulates every shot with `theta` at its frame times, in shot order (parallel over shots); with
+    /// surface levels, each shot's level is profiled (warm-started at its last value).
+    pub fn simulate(&self, theta: &[f64]) -> Result<Vec<Simulation>, FitError> {
+        let models = self
+            .surfaces
+            .iter()
+            .map(|s| self.problem.model_for(s, theta))
+            .collect::<Result<Vec<_>, _>>()?;
+        let one = |i: usize| -> Result<Simulation, FitError> {
+            let model = &models[self.shot_surface[i]];
+            match &self.levels {
+                None => self.simulate_at(i, model, 0.0),
+                Some(levels) => {
+                    let start = f64::from_bits(levels[i].load(Ordering::Relaxed));
+                    let (sim, level) =
+                        profile_surface_level(&self.problem.shots()[i], start, |l| self.simulate_at(i, model, l))?;
+                    levels[i].store(level.to_bits(), Ordering::Relaxed);
+                    Ok(sim)
+                }
+            }
+        };
+        let all: Vec<Result<Simulation, FitError>> = (0..self.problem.shots().len()).into_par_iter().map(one).collect();
+        all.into_iter().collect()
+    }
+
+    /// Shot `i` with the true surface at height `level` in the measured frame (m): the measured start is
+    /// taken about the contact point on that surface, mapped back through the measurement effects, and
+    /// what the camera would see is mapped to the measured frame again.
+    fn simulate_at(&self, i: usize, model: &Model, level: f64) -> Result<Simulation, FitError> {
+        let shot = &self.problem.shots()[i];
+        let times: Vec<f64> = shot.frames.iter().map(|f| f.t_s).collect();
+        let measured = shot.start.state;
+        // The contact point in data coordinates (its x only matters with a measurement effect).
+        let origin_x = if observes(model) {
+            let touching = State {
+                y: model.ball.radius_m,
+                ..State::default()
+            };
+            self.touch_x[i] - observe(model, &touching).x
+        } else {
+            0.0
+        };
+        let start = true_start(
+            model,
+            &State {
+                x: measured.x - origin_x,
+                y: measured.y - level,
+                ..measured
+            },
+        );
+        let mut sim =
+            simulate(model, shot.incline_rad, shot.start.t_s, start, &times, &self.sim).map_err(|source| {
+                FitError::Simulation {
+                    shot: shot.name.clone(),
+                    source: Box::new(source),
+                }
+            })?;
+        if origin_x != 0.0 || level != 0.0 {
+            for s in &mut sim.samples {
+                s.observed.x += origin_x;
+                s.observed.y += level;
+            }
+        }
+        Ok(sim)
+    }
+
+    /// Nuisance parameters per shot (1 with surface levels, else 0).
+    pub fn nuisance_per_shot(&self) -> usize {
+        usize::from(self.levels.is_some())
+    }
+
+    /// Per shot: (Σ ((sim − meas)/σ)², Σ (sim − meas)² in m², residual count).
+    pub fn per_shot(&self, sims: &[Simulation]) -> Vec<ShotSums> {
+        self.problem
+            .shots()
+            .iter()
+            .zip(sims)
+            .map(|(shot, sim)| {
+                let mut s = ShotSums::default();
+                for (f, p) in shot.frames.iter().zip(&sim.samples) {
+                    let (dx, dy) = (p.observed.x - f.x_m, p.observed.y - f.y_m);
+                    s.chi2 += (dx * dx + dy * dy) / (f.sigma_m * f.sigma_m);
+                    s.sq_m2 += dx * dx + dy * dy;
+                    s.n += 2;
+                }
+                s
+            })
+            .collect()
+    }
+
+    /// Fits from `p0` (clamped into the bounds).
+    pub fn fit(&self, solver: &LevenbergMarquardt, p0: &[f64]) -> Result<SolverOutcome, FitError> {
+        solver.run(self, p0, &mut NoObserver)
+    }
+}
+
+impl LeastSquares for Evaluator {
+    fn n_params(&self) -> usize {
+        self.problem.params().len()
+    }
+
+    fn residuals(&self, theta: &[f64]) -> Result<Vec<f64>, FitError> {
+        let sims = self.simulate(theta)?;
+        let mut r = Vec::with_capacity(self.problem.n_residuals());
+        for (shot, sim) in self.problem.shots().iter().zip(&sims) {
+            for (f, s) in shot.frames.iter().zip(&sim.samples) {
+                r.push((s.observed.x - f.x_m) / f.sigma_m);
+                r.push((s.observed.y - f.y_m) / f.sigma_m);
+            }
+        }
+        Ok(r)
+    }
+
+    fn bounds(&self, j: usize) -> (f64, f64) {
+        let p = &self.problem.params()[j];
+        (p.min, p.max)
+    }
+
+    fn scale(&self, j: usize) -> f64 {
+        self.problem.params()[j].scale
+    }
+}
+
+/// A shot's sums of squared residuals.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct ShotSums {
+    /// Σ ((sim − meas)/σ)² over x and y.
+    pub chi2: f64,
+    /// Σ (sim − meas)², m².
+    pub sq_m2: f64,
+    /// Number of residuals (2 per frame).
+    pub n: usize,
+}
+
+/// The measured x of the centre where it first comes within a radius of the surface line (linear
+/// interpolation between the two frames around the crossing), or at its lowest frame without a crossing.
+fn touch_x(shot: &MeasuredShot, radius: f64) -> f64 {
+    let f = &shot.frames;
+    for k in 1..f.len() {
+        let (a, b) = (&f[k - 1], &f[k]);
+        if a.y_m > radius && b.y_m <= radius {
+            let w = (a.y_m - radius) / (a.y_m - b.y_m);
+            return a.x_m + w * (b.x_m - a.x_m);
+        }
+    }
+    f.iter()
+        .min_by(|a, b| a.y_m.total_cmp(&b.y_m))
+        .map(|l| l.x_m)
+        .unwrap_or(shot.start.state.x)
+}
+
+/// True if a measurement effect of `model` changes what the camera sees.
+fn observes(model: &Model) -> bool {
+    let probe = State {
+        x: 0.1,
+        y: 0.2,
+        theta: 0.3,
+        vx: 1.0,
+        vy: -2.0,
+        omega: 5.0,
+    };
+    obs_array(&observe(model, &probe)) != obs_array(&Observation::from(probe))
+}
+
+/// What the camera would see of `state` through the model's measurement effects.
+fn observe(model: &Model, state: &State) -> Observation {
+    let mut o = Observation::from(*state);
+    for e in model.effects() {
+        e.observe(&mut o);
+    }
+    o
+}
+
+fn obs_array(o: &Observation) -> [f64; 6] {
+    [o.x, o.y, o.theta, o.vx, o.vy, o.omega]
+}
+
+fn state_of(a: [f64; 6]) -> State {
+    State {
+        x: a[0],
+        y: a[1],
+        theta: a[2],
+        vx: a[3],
+        vy: a[4],
+        omega: a[5],
+    }
+}
+
+/// The true state whose observation through the model's measurement effects is `measured` (the identity
+/// when the model has none). Newton's method on the observation map with a finite-difference Jacobian;
+/// the maps of the library (a rotation) are linear, so one step is exact.
+pub(crate) fn true_start(model: &Model, measured: &State) -> State {
+    let target = obs_array(&Observation::from(*measured));
+    if !observes(model) {
+        return *measured;
+    }
+    let mut x = target;
+    for _ in 0..8 {
+        let f0 = obs_array(&observe(model, &state_of(x)));
+        let r: Vec<f64> = (0..6).map(|i| target[i] - f0[i]).collect();
+        if r.iter().zip(&target).all(|(d, t)| d.abs() <= 1e-14 * (1.0 + t.abs())) {
+            break;
+        }
+        let mut jac = DMatrix::zeros(6, 6);
+        for j in 0..6 {
+            let h = 1e-6 * (1.0 + x[j].abs());
+            let mut xp = x;
+            xp[j] += h;
+            let fp = obs_array(&observe(model, &state_of(xp)));
+            for i in 0..6 {
+                jac[(i, j)] = (fp[i] - f0[i]) / h;
+            }
+        }
+        let Some(step) = jac.lu().solve(&nalgebra::DVector::from_vec(r)) else {
+            break;
+        };
+        for j in 0..6 {
+            x[j] += step[j];
+        }
+    }
+    state_of(x)
+}
+
+/// One fitted parameter.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FittedValue {
+    /// `damping.b` (global) or `clay:spring.k` (one surface's value).
+    pub name: String,
+    /// The effect.
+    pub effect: String,
+    /// The parameter.
+    pub param: String,
+    /// The surface of a per-surface value, `None` for a global one.
+    pub surface: Option<String>,
+    /// Fitted value, in the parameter's unit (see `bouncelab effects`).
+    pub value: f64,
+    /// Standard error, same unit (covariance `(JᵀJ)⁻¹·max(1, χ²_red)` as in the fit crate); `None` when the
+    /// parameter is not determined by the shots.
+    pub std_error: Option<f64>,
+    /// 95 % interval `value ± t·se`; `None` with `std_error`.
+    pub interval: Option<[f64; 2]>,
+    /// True if the value ended on a bound of the fit.
+    pub at_bound: bool,
+}
+
+/// A model fitted to all shots.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FitSummary {
+    /// The model's effects, in order.
+    pub effects: Vec<String>,
+    /// Every free parameter.
+    pub parameters: Vec<FittedValue>,
+    /// χ² = Σ ((sim − meas)/σ)² with the tracker's σ.
+    pub chi2: f64,
+    /// Residuals (two per frame) minus free parameters.
+    pub dof: usize,
+    /// χ² / dof against the tracker's σ.
+    pub chi2_red: f64,
+    /// RMS of all position residuals (x and y), m.
+    pub rms_m: f64,
+    /// Solver iterations.
+    pub iterations: usize,
+    /// Simulations of every shot.
+    pub evaluations: usize,
+    /// Why the solver stopped.
+    pub termination: Termination,
+}
+
+impl FitSummary {
+    /// The parameter called `name`.
+    pub fn param(&self, name: &str) -> Option<&FittedValue> {
+        self.parameters.iter().find(|p| p.name == name)
+    }
+}
+
+/// Inverts `JᵀJ`, equilibrated; `None` when singular (as the fit crate does).
+fn inverse(jac: &DMatrix<f64>) -> Option<DMatrix<f64>> {
+    let a = jac.transpose() * jac;
+    let d: Vec<f64> = (0..a.ncols()).map(|j| a[(j, j)].sqrt()).collect();
+    if d.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
+        return None;
+    }
+    let scaled = DMatrix::from_fn(a.nrows(), a.ncols(), |i, j| a[(i, j)] / (d[i] * d[j]));
+    let eig = scaled.clone().symmetric_eigen();
+    let (min, max) = eig
+        .eigenvalues
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
+    if min.is_nan() || min <= 1e-12 * max {
+        return None;
+    }
+    let inv = scaled.cholesky()?.inverse();
+    Some(DMatrix::from_fn(a.nrows(), a.ncols(), |i, j| {
+        inv[(i, j)] / (d[i] * d[j])
+    }))
+}
+
+/// The summary of a solver outcome on `ev`.
+pub(crate) fn summarize(ev: &Evaluator, effects: Vec<String>, out: &SolverOutcome, sq_m2: f64) -> FitSummary {
+    let n = out.residuals.len();
+    let p = out.params.len() + ev.nuisance_per_shot() * ev.problem.shots().len();
+    let dof = n.saturating_sub(p).max(1);
+    let chi2_red = out.cost / dof as f64;
+    let t = StudentsT::new(0.0, 1.0, dof as f64)
+        .map(|t| t.inverse_cdf(0.975))
+        .unwrap_or(1.96);
+    let cov = out.jacobian.as_ref().and_then(inverse).map(|c| c * chi2_red.max(1.0));
+    let parameters = ev
+        .problem
+        .params()
+        .iter()
+        .enumerate()
+        .map(|(j, fp)| {
+            let value = out.params[j];
+            let se = cov.as_ref().map(|c| c[(j, j)].sqrt()).filter(|s| s.is_finite());
+            FittedValue {
+                name: fp.name.clone(),
+                effect: fp.effect.clone(),
+                param: fp.param.clone(),
+                surface: fp.surface.clone(),
+                value,
+                std_error: se,
+                interval: se.map(|s| [value - t * s, value + t * s]),
+                at_bound: value <= fp.min || value >= fp.max,
+            }
+        })
+        .collect();
+    FitSummary {
+        effects,
+        parameters,
+        chi2: out.cost,
+        dof,
+        chi2_red,
+        rms_m: (sq_m2 / n.max(1) as f64).sqrt(),
+        iterations: out.iterations,
+        evaluations: out.evaluations,
+        termination: out.termination.clone(),
+    }
+}

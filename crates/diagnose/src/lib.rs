@@ -1,0 +1,39 @@
+//! Which physical effect is missing from the contact model: every effect of the library that the model
+//! does not have is added in turn, fitted to all shots with the model's own parameters refitted, and judged
+//! against the current model by what it predicts of shots it was not fitted to.
+//!
+//! The main design choice is that no decision trusts the tracker's σ: real σ can be off by half, and
+//! tracked positions carry small systematic errors in contact. So the noise level is measured from the
+//! residuals themselves (their third differences), BIC uses the variance estimated from the residuals,
+//! the held-out comparison is a paired test across shots of *ratios* of held-out χ² (in which σ cancels),
+//! and a candidate must remove a material amount of error (more than a tolerance in metres, and most of
+//! the current model's systematic part), with its switch parameter clearly away from its neutral value.
+//! Candidates that explain the data about equally well are all named as ambiguous rather than one picked;
+//! when the current model misfits and none explains it, the residual's signature (where χ² sits, the
+//! trends across conditions) is shown instead of a name. Cross-validation is K-fold across shots
+//! (default 6 folds, each fit warm-started at the full fit), which costs a fixed number of refits however
+//! many shots a session has: leave-one-shot-out would cost one refit per shot per candidate.
+//!
+//! [`find_missing_effect`] returns a [`Diagnosis`] (`diagnosis.json`); [`add_effect_to_model_toml`] adds the
+//! named effect to the user's `model.toml`, comments kept. See `docs/diagnosis.md`.
+
+mod candidates;
+mod diagnosis;
+mod error;
+mod evaluate;
+mod model_file;
+mod options;
+mod search;
+mod stats;
+mod verdict;
+
+pub use candidates::CandidateSetup;
+pub use diagnosis::{
+    Baseline, Candidate, Checks, Diagnosis, Evidence, Noise, NoiseSource, PhaseResidual, Signature, Thresholds,
+    Verdict, VerdictKind,
+};
+pub use error::DiagnoseError;
+pub use evaluate::{FitSummary, FittedValue};
+pub use model_file::add_effect_to_model_toml;
+pub use options::{Progress, SearchOptions};
+pub use search::{find_missing_effect, find_missing_effect_with};

@@ -1,0 +1,436 @@
+//! The search: the current model and every candidate fitted to all shots and cross-validated across
+//! shots, then compared.
+
+use crate::candidates::{CandidateSetup, candidate_names, library_effect, set_values, with_candidate};
+use crate::diagnosis::{
+    Baseline, Candidate, Checks, Diagnosis, Evidence, Noise, NoiseSource, PhaseResidual, Signature, Thresholds,
+};
+use crate::evaluate::{Evaluator, ShotSums, summarize};
+use crate::options::{Progress, SearchOptions};
+use crate::verdict::decide;
+use crate::{DiagnoseError, FitSummary, stats};
+use bouncelab_compare::{Component, DiagnoseOptions, ShotExtras, compare, diagnose};
+use bouncelab_fit::{FitError, LevenbergMarquardt, MeasuredShot};
+use bouncelab_model::{ModelSpec, Simulation};
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// One model fitted to all shots and cross-validated.
+struct ModelRun {
+    summary: FitSummary,
+    sims: Vec<Simulation>,
+    per_shot: Vec<ShotSums>,
+    /// Per shot (input order): its residual sums when predicted by the model fitted without its fold.
+    heldout: Vec<Option<ShotSums>>,
+    n_params: usize,
+    seconds: f64,
+}
+
+fn effect_names(spec: &ModelSpec) -> Vec<String> {
+    spec.effects.iter().map(|e| e.name.clone()).collect()
+}
+
+/// Fits `spec` to every shot from the file's values, then once per fold without that fold's shots
+/// (warm-started at the full fit), predicting each left-out shot.
+fn run_model(
+    spec: &ModelSpec,
+    shots: &[MeasuredShot],
+    fold_of: &[usize],
+    k: usize,
+    opts: &SearchOptions,
+) -> Result<ModelRun, FitError> {
+    let clock = Instant::now();
+    let ev = Evaluator::new(spec, shots.to_vec(), opts.sim, opts.surface_levels)?;
+    let out = ev.fit(&opts.solver, &ev.problem().initial())?;
+    let sims = ev.simulate(&out.params)?;
+    let per_shot = ev.per_shot(&sims);
+    let sq: f64 = per_shot.iter().map(|s| s.sq_m2).sum();
+    let summary = summarize(&ev, effect_names(spec), &out, sq);
+    let fitted: Vec<(String, f64)> = ev.names().into_iter().zip(out.params.iter().copied()).collect();
+    // Folds in parallel (each fit also simulates its shots in parallel); collected in fold order.
+    let per_fold: Vec<Vec<(usize, Option<ShotSums>)>> = (0..k)
+        .into_par_iter()
+        .map(|f| heldout_fold(spec, shots, fold_of, f, &fitted, opts))
+        .collect();
+    let mut heldout = vec![None; shots.len()];
+    for (i, sums) in per_fold.into_iter().flatten() {
+        heldout[i] = sums;
+    }
+    Ok(ModelRun {
+        summary,
+        sims,
+        per_shot,
+        heldout,
+        n_params: out.params.len() + ev.nuisance_per_shot() * shots.len(),
+        seconds: clock.elapsed().as_secs_f64(),
+    })
+}
+
+/// The shots of fold `f` predicted by the model fitted to the other folds; `None` for a shot that cannot
+/// be predicted (its surface has no shot left to fit, or a fit or simulation failed).
+fn heldout_fold(
+    spec: &ModelSpec,
+    shots: &[MeasuredShot],
+    fold_of: &[usize],
+    f: usize,
+    full: &[(String, f64)],
+    opts: &SearchOptions,
+) -> Vec<(usize, Option<ShotSums>)> {
+    let test: Vec<usize> = (0..shots.len()).filter(|&i| fold_of[i] == f).collect();
+    let train: Vec<MeasuredShot> = (0..shots.len())
+        .filter(|&i| fold_of[i] != f)
+        .map(|i| shots[i].clone())
+        .collect();
+    let lookup = |table: &[(String, f64)], name: &str| table.iter().find(|(n, _)| n == name).map(|(_, v)| *v);
+    let fitted: Option<Vec<(String, f64)>> = (|| {
+        let ev = Evaluator::new(spec, train, opts.sim, opts.surface_levels).ok()?;
+        let names = ev.names();
+        let p0: Vec<f64> = names.iter().map(|n| lookup(full, n)).collect::<Option<_>>()?;
+        let solver = LevenbergMarquardt {
+            max_iterations: opts.fold_max_iterations,
+            ..opts.solver
+        };
+        let out = ev.fit(&solver, &p0).ok()?;
+        Some(names.into_iter().zip(out.params).collect())
+    })();
+    test.into_iter()
+        .map(|i| {
+            let sums = fitted.as_ref().and_then(|fitted| {
+                let ev = Evaluator::new(spec, vec![shots[i].clone()], opts.sim, opts.surface_levels).ok()?;
+                let theta: Vec<f64> = ev.names().iter().map(|n| lookup(fitted, n)).collect::<Option<_>>()?;
+                let sims = ev.simulate(&theta).ok()?;
+                ev.per_shot(&sims).first().copied()
+            });
+            (i, sums)
+        })
+        .collect()
+}
+
+/// Which physical effect is missing from `spec`, judged on `shots` (see the crate's documentation).
+///
+/// Fits the current model's free parameters to every shot (the baseline), then each candidate effect of
+/// the library added with its own parameters free (see [`CandidateSetup`]), each cross-validated across
+/// shots in [`SearchOptions::folds`] folds; `progress` is called before each model and at the end, on the
+/// calling thread. Errors when the options are out of range, there are fewer than
+/// [`SearchOptions::min_shots`] shots, or the current model cannot be fitted (naming the shot); a
+/// candidate whose fit fails is listed with the reason instead.
+pub fn find_missing_effect(
+    spec: &ModelSpec,
+    shots: &[MeasuredShot],
+    options: &SearchOptions,
+    progress: &dyn Fn(Progress),
+) -> Result<Diagnosis, DiagnoseError> {
+    find_missing_effect_with(spec, shots, &[], options, progress)
+}
+
+/// [`find_missing_effect`] with the evidence each shot carries besides its frames (drop height, measured
+/// contact time, camera roll, spin: one [`ShotExtras`] per shot, or none), used by the trend tests of the
+/// current model's failure report.
+pub fn find_missing_effect_with(
+    spec: &ModelSpec,
+    shots: &[MeasuredShot],
+    extras: &[ShotExtras],
+    options: &SearchOptions,
+    progress: &dyn Fn(Progress),
+) -> Result<Diagnosis, DiagnoseError> {
+    let clock = Instant::now();
+    options.check()?;
+    if shots.len() < options.min_shots {
+        return Err(DiagnoseError::TooFewShots {
+            shots: shots.len(),
+            needed: options.min_shots,
+        });
+    }
+    let setups = setups_for(spec, options)?;
+    let k = options.folds.min(shots.len());
+    let surfaces: Vec<&str> = shots.iter().map(|s| s.surface.as_str()).collect();
+    let fold_of = stats::folds(&surfaces, k);
+    let total = 1 + setups.len();
+    progress(Progress {
+        done: 0,
+        total,
+        what: "current model".into(),
+    });
+    let base = run_model(spec, shots, &fold_of, k, options).map_err(|e| DiagnoseError::Baseline {
+        model: spec.origin.clone(),
+        source: Box::new(e),
+    })?;
+
+    // The noise the decisions are measured against.
+    let stated = {
+        let (s2, n) = shots
+            .iter()
+            .flat_map(|s| &s.frames)
+            .fold((0.0, 0usize), |(a, n), f| (a + f.sigma_m * f.sigma_m, n + 1));
+        (s2 / n.max(1) as f64).sqrt()
+    };
+    let (noise_m, source) = match options.noise_m {
+        Some(s) => (s, NoiseSource::Given),
+        None => {
+            let series: Vec<(Vec<f64>, Vec<f64>)> = shots
+                .iter()
+                .zip(&base.sims)
+                .flat_map(|(shot, sim)| {
+                    let t: Vec<f64> = shot.frames.iter().map(|f| f.t_s).collect();
+                    let dx = shot.frames.iter().zip(&sim.samples).map(|(f, s)| f.x_m - s.observed.x);
+                    let dy = shot.frames.iter().zip(&sim.samples).map(|(f, s)| f.y_m - s.observed.y);
+                    [(t.clone(), dx.collect()), (t, dy.collect())]
+                })
+                .collect();
+            match stats::white_noise(&series) {
+                Some(s) if s > 0.0 => (s, NoiseSource::ThirdDifferences),
+                _ => (stated, NoiseSource::Stated),
+            }
+        }
+    };
+    let noise = Noise {
+        noise_m,
+        source,
+        stated_sigma_m: stated,
+        ratio: noise_m / stated,
+    };
+
+    // The signature of the current model's residual.
+    let cmp = compare(shots, &base.sims, extras, base.n_params)?;
+    let report = diagnose(
+        &cmp,
+        &DiagnoseOptions {
+            alpha: options.alpha,
+            ..DiagnoseOptions::default()
+        },
+    );
+    let mut phases: Vec<PhaseResidual> = cmp
+        .overall
+        .iter()
+        .filter(|s| s.component != Component::Spin)
+        .map(|s| PhaseResidual {
+            phase: s.phase,
+            component: s.component,
+            n: s.n,
+            rms_m: s.rms_m,
+            systematic_m: excess(s.rms_m * s.rms_m, noise_m),
+            chi2_share: if cmp.chi2 > 0.0 { s.chi2 / cmp.chi2 } else { 0.0 },
+            chi2_red: s.chi2_red,
+        })
+        .collect();
+    phases.sort_by(|a, b| b.chi2_share.total_cmp(&a.chi2_share));
+    let signature = Signature {
+        phases,
+        trends: report.trends.iter().filter(|t| t.significant).cloned().collect(),
+        sentences: report.sentences.clone(),
+    };
+
+    let base_ms = base.summary.rms_m * base.summary.rms_m;
+    let heldout_error_m = rms_of(base.heldout.iter().flatten());
+    let baseline = Baseline {
+        heldout_error_m,
+        systematic_m: excess(base_ms, noise_m),
+        misfit: false,
+        misfit_reasons: Vec::new(),
+        fit: base.summary.clone(),
+        seconds: base.seconds,
+    };
+
+    // Every candidate, started from the current model's fitted values.
+    let mut warm = spec.clone();
+    set_values(&mut warm, &base.summary.parameters);
+    let mut runs: Vec<(CandidateSetup, Result<ModelRun, String>)> = Vec::new();
+    for (j, setup) in setups.into_iter().enumerate() {
+        progress(Progress {
+            done: j + 1,
+            total,
+            what: format!("+ {}", setup.effect),
+        });
+        let run = with_candidate(&warm, &setup)
+            .map_err(|e| e.to_string())
+            .and_then(|cspec| run_model(&cspec, shots, &fold_of, k, options).map_err(|e| e.to_string()));
+        runs.push((setup, run));
+    }
+
+    let n_res = base.per_shot.iter().map(|s| s.n).sum::<usize>() as f64;
+    let mut candidates: Vec<Candidate> = runs
+        .iter()
+        .map(|(setup, run)| evidence_of(setup, run, &base, n_res, noise_m, options))
+        .collect();
+    // Holm over the candidates that have a held-out test.
+    let ps: Vec<f64> = candidates
+        .iter()
+        .map(|c| c.evidence.as_ref().map(|e| e.heldout_p).unwrap_or(1.0))
+        .collect();
+    for (c, p) in candidates.iter_mut().zip(stats::holm(&ps)) {
+        if let Some(e) = c.evidence.as_mut() {
+            e.heldout_p_holm = p;
+        }
+    }
+    let heldout_pairs: Vec<Vec<Option<f64>>> = runs
+        .iter()
+        .map(|(_, run)| match run {
+            Ok(r) => r.heldout.iter().map(|h| h.map(|h| h.chi2)).collect(),
+            Err(_) => vec![None; shots.len()],
+        })
+        .collect();
+    let verdict_inputs = crate::verdict::Inputs {
+        options,
+        noise_m,
+        baseline,
+        signature,
+        heldout_chi2: heldout_pairs,
+        heldout_ms: runs
+            .iter()
+            .map(|(_, run)| match run {
+                Ok(r) => r.heldout.iter().map(|h| h.map(|h| h.sq_m2 / h.n as f64)).collect(),
+                Err(_) => vec![None; shots.len()],
+            })
+            .collect(),
+    };
+    let (verdict, baseline, signature) = decide(&mut candidates, verdict_inputs);
+    progress(Progress {
+        done: total,
+        total,
+        what: "done".into(),
+    });
+    Ok(Diagnosis {
+        verdict,
+        candidates,
+        baseline,
+        signature,
+        noise,
+        shots: shots.len(),
+        folds: k,
+        thresholds: Thresholds {
+            alpha: options.alpha,
+            min_delta_bic: options.min_delta_bic,
+            min_param_z: options.min_param_z,
+            tolerance_m: options.tolerance_m,
+            phase_tolerance_m: options.phase_tolerance_m,
+            explained_fraction: options.explained_fraction,
+        },
+        seconds: clock.elapsed().as_secs_f64(),
+    })
+}
+
+/// The candidate setups of a search, in library order.
+fn setups_for(spec: &ModelSpec, options: &SearchOptions) -> Result<Vec<CandidateSetup>, DiagnoseError> {
+    let names: Vec<String> = match &options.candidates {
+        Some(list) => {
+            for n in list {
+                let info = library_effect(n)?;
+                if info.base {
+                    return Err(DiagnoseError::BaseEffect { effect: n.clone() });
+                }
+            }
+            list.iter().filter(|n| !spec.has_effect(n)).cloned().collect()
+        }
+        None => candidate_names(spec).into_iter().map(str::to_string).collect(),
+    };
+    for s in &options.setups {
+        library_effect(&s.effect)?;
+    }
+    names
+        .iter()
+        .map(|n| match options.setups.iter().find(|s| &s.effect == n) {
+            Some(s) => Ok(s.clone()),
+            None => CandidateSetup::default_for(n),
+        })
+        .collect()
+}
+
+/// `√max(0, ms − noise²)`: the systematic part of a mean square, m.
+pub(crate) fn excess(ms: f64, noise_m: f64) -> f64 {
+    (ms - noise_m * noise_m).max(0.0).sqrt()
+}
+
+/// RMS over the residuals of the given shots, m (0 when there are none).
+fn rms_of<'a>(sums: impl Iterator<Item = &'a ShotSums>) -> f64 {
+    let (sq, n) = sums.fold((0.0, 0usize), |(a, n), s| (a + s.sq_m2, n + s.n));
+    if n == 0 { 0.0 } else { (sq / n as f64).sqrt() }
+}
+
+/// A candidate's evidence against the baseline (Holm's adjustment and the checks come later).
+fn evidence_of(
+    setup: &CandidateSetup,
+    run: &Result<ModelRun, String>,
+    base: &ModelRun,
+    n_res: f64,
+    noise_m: f64,
+    opts: &SearchOptions,
+) -> Candidate {
+    let param = setup.primary().unwrap_or("-").to_string();
+    let neutral = library_effect(&setup.effect)
+        .ok()
+        .and_then(|i| i.params.iter().find(|p| p.name == param))
+        .map(|p| p.neutral)
+        .unwrap_or(0.0);
+    let mut cand = Candidate {
+        effect: setup.effect.clone(),
+        rank: 0,
+        explains: false,
+        checks: Checks::default(),
+        reasons: Vec::new(),
+        error_before: base.summary.rms_m,
+        heldout_error_before: rms_of(base.heldout.iter().flatten()),
+        param: param.clone(),
+        neutral,
+        evidence: None,
+        failed: None,
+        seconds: 0.0,
+    };
+    let run = match run {
+        Ok(r) => {
+            cand.seconds = r.seconds;
+            r
+        }
+        Err(e) => {
+            cand.failed = Some(e.clone());
+            return cand;
+        }
+    };
+    // Paired held-out comparison over the shots both predicted.
+    let pairs: Vec<(&ShotSums, &ShotSums)> = base
+        .heldout
+        .iter()
+        .zip(&run.heldout)
+        .filter_map(|(a, b)| Some((a.as_ref()?, b.as_ref()?)))
+        .collect();
+    let tiny = f64::MIN_POSITIVE;
+    let d: Vec<f64> = pairs
+        .iter()
+        .map(|(a, b)| (a.chi2.max(tiny) / b.chi2.max(tiny)).ln())
+        .collect();
+    let (log_ratio, p) = stats::one_sided_t(&d);
+    let before_ho = rms_of(pairs.iter().map(|(a, _)| *a));
+    let after_ho = rms_of(pairs.iter().map(|(_, b)| *b));
+    cand.heldout_error_before = before_ho;
+    let ms0 = before_ho * before_ho;
+    let ms1 = after_ho * after_ho;
+    let denom = (ms0 - noise_m * noise_m).max(opts.tolerance_m * opts.tolerance_m);
+    let s = &run.summary;
+    let chi0 = base.summary.chi2.max(tiny);
+    let delta_bic = n_res * (s.chi2.max(tiny) / chi0).ln() + (run.n_params as f64 - base.n_params as f64) * n_res.ln();
+    let primary = s
+        .parameters
+        .iter()
+        .find(|p| p.effect == setup.effect && p.param == param);
+    let param_z = primary
+        .and_then(|p| p.std_error.map(|se| (p.value - neutral).abs() / se))
+        .filter(|z| z.is_finite());
+    cand.evidence = Some(Evidence {
+        error_after: s.rms_m,
+        error_fall: base.summary.rms_m / s.rms_m,
+        delta_bic,
+        heldout_error_after: after_ho,
+        heldout_log_ratio: log_ratio,
+        heldout_p: p,
+        heldout_p_holm: p,
+        shots_improved: [d.iter().filter(|v| **v > 0.0).count(), d.len()],
+        explained_fraction: ((ms0 - ms1) / denom).min(1.0),
+        systematic_after_m: excess(s.rms_m * s.rms_m, noise_m),
+        chi2_red_after: s.chi2_red,
+        chi2_red_noise_after: s.rms_m * s.rms_m / (noise_m * noise_m),
+        param_value: primary.map(|p| p.value).unwrap_or(neutral),
+        param_interval: primary.and_then(|p| p.interval),
+        param_z,
+        fit: run.summary.clone(),
+    });
+    cand
+}

@@ -1,0 +1,451 @@
+//! The decision rule: which candidates explain the residual, their ranking, and the verdict in words.
+
+use crate::diagnosis::{Baseline, Candidate, Signature, Verdict, VerdictKind};
+use crate::options::SearchOptions;
+use crate::stats;
+use bouncelab_compare::Quantity;
+use bouncelab_model::builtin;
+
+/// What the decision needs besides the candidates.
+pub(crate) struct Inputs<'a> {
+    pub options: &'a SearchOptions,
+    pub noise_m: f64,
+    pub baseline: Baseline,
+    pub signature: Signature,
+    /// Per candidate (in the order given), per shot: held-out χ².
+    pub heldout_chi2: Vec<Vec<Option<f64>>>,
+    /// Per candidate, per shot: held-out mean square position residual, m².
+    pub heldout_ms: Vec<Vec<Option<f64>>>,
+}
+
+fn um(m: f64) -> String {
+    let v = m * 1e6;
+    if v >= 100.0 {
+        format!("{v:.0} µm")
+    } else {
+        format!("{v:.1} µm")
+    }
+}
+
+fn p_text(p: f64) -> String {
+    if p < 0.001 {
+        "p < 0.001".into()
+    } else {
+        format!("p = {p:.3}")
+    }
+}
+
+fn num(v: f64) -> String {
+    let a = v.abs();
+    if a != 0.0 && !(1e-3..1e5).contains(&a) {
+        format!("{v:.3e}")
+    } else if a >= 100.0 {
+        format!("{v:.0}")
+    } else {
+        format!("{v:.4}")
+    }
+}
+
+/// Marks the checks of every candidate, ranks them, and concludes; returns the verdict and the baseline
+/// and signature with the misfit filled in.
+pub(crate) fn decide(cands: &mut Vec<Candidate>, inp: Inputs<'_>) -> (Verdict, Baseline, Signature) {
+    let o = inp.options;
+    let noise = inp.noise_m;
+    let mut baseline = inp.baseline;
+    let signature = inp.signature;
+
+    // Does the current model misfit?
+    let mut reasons = Vec::new();
+    if baseline.systematic_m > o.tolerance_m {
+        reasons.push(format!(
+            "residual RMS {} against a noise level of {}: a systematic part of {}, above the {} tolerance",
+            um(baseline.fit.rms_m),
+            um(noise),
+            um(baseline.systematic_m),
+            um(o.tolerance_m)
+        ));
+    }
+    let heldout_systematic = crate::search::excess(baseline.heldout_error_m.powi(2), noise);
+    if baseline.systematic_m <= o.tolerance_m && heldout_systematic > o.tolerance_m {
+        reasons.push(format!(
+            "held-out error {} against a noise level of {}: a systematic part of {}, above the {} tolerance",
+            um(baseline.heldout_error_m),
+            um(noise),
+            um(heldout_systematic),
+            um(o.tolerance_m)
+        ));
+    }
+    for ph in &signature.phases {
+        if ph.systematic_m > o.phase_tolerance_m {
+            reasons.push(format!(
+                "{} {}: systematic residual {} (RMS {}), above the {} per-phase tolerance",
+                ph.component.name(),
+                ph.phase.words(),
+                um(ph.systematic_m),
+                um(ph.rms_m),
+                um(o.phase_tolerance_m)
+            ));
+        }
+    }
+    if o.use_trends {
+        for t in &signature.trends {
+            if t.quantity != Quantity::ResidualRms {
+                reasons.push(t.sentence.clone());
+            }
+        }
+    }
+    baseline.misfit = !reasons.is_empty();
+    baseline.misfit_reasons = reasons;
+
+    // The checks.
+    let index: Vec<usize> = (0..cands.len()).collect();
+    for c in cands.iter_mut() {
+        check(c, o, noise);
+    }
+
+    // Ranking: explaining candidates by ΔBIC, then the others by held-out error, failed fits last.
+    let mut order = index;
+    let key = |c: &Candidate| -> (u8, f64) {
+        match (&c.evidence, c.explains) {
+            (Some(e), true) => (0, e.delta_bic),
+            (Some(e), false) => (1, e.heldout_error_after),
+            (None, _) => (2, 0.0),
+        }
+    };
+    order.sort_by(|&a, &b| {
+        let (ka, kb) = (key(&cands[a]), key(&cands[b]));
+        ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1)).then(a.cmp(&b))
+    });
+
+    // Ties with the best explaining candidate.
+    let explaining: Vec<usize> = order.iter().copied().filter(|&i| cands[i].explains).collect();
+    let mut named: Vec<usize> = Vec::new();
+    let mut tie_words: Vec<String> = Vec::new();
+    if let Some(&best) = explaining.first() {
+        named.push(best);
+        for &j in &explaining[1..] {
+            let d: Vec<f64> = inp.heldout_chi2[j]
+                .iter()
+                .zip(&inp.heldout_chi2[best])
+                .filter_map(|(a, b)| {
+                    Some((a.as_ref()?.max(f64::MIN_POSITIVE) / b.as_ref()?.max(f64::MIN_POSITIVE)).ln())
+                })
+                .collect();
+            let (_, p) = stats::one_sided_t(&d);
+            // Mean held-out mean square of candidate `k` over the shots both predicted.
+            let ms = |k: usize| -> f64 {
+                let both = inp.heldout_ms[best].iter().zip(&inp.heldout_ms[j]);
+                let (s, n) = inp.heldout_ms[k]
+                    .iter()
+                    .zip(both)
+                    .filter(|(_, (a, b))| a.is_some() && b.is_some())
+                    .filter_map(|(v, _)| *v)
+                    .fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+                s / n.max(1) as f64
+            };
+            let gap = (ms(j) - ms(best)).max(0.0).sqrt();
+            if p >= o.alpha || gap < o.tolerance_m {
+                named.push(j);
+                tie_words.push(if p >= o.alpha {
+                    format!(
+                        "`{}` predicts held-out shots not significantly worse ({})",
+                        cands[j].effect,
+                        p_text(p)
+                    )
+                } else {
+                    format!(
+                        "`{}` leaves a held-out error only {} above it, within the {} tolerance",
+                        cands[j].effect,
+                        um(gap),
+                        um(o.tolerance_m)
+                    )
+                });
+            }
+        }
+    }
+
+    let ranked: Vec<Candidate> = order
+        .iter()
+        .enumerate()
+        .map(|(r, &i)| {
+            let mut c = cands[i].clone();
+            c.rank = r + 1;
+            c
+        })
+        .collect();
+    let names: Vec<String> = named.iter().map(|&i| cands[i].effect.clone()).collect();
+    let best_other = order.first().map(|&i| cands[i].clone());
+    *cands = ranked;
+
+    let verdict = match names.len() {
+        0 if baseline.misfit => Verdict {
+            kind: VerdictKind::NoneExplains,
+            effect: None,
+            effects: Vec::new(),
+            sentence: none_explains(&baseline, &signature, best_other.as_ref(), o),
+        },
+        0 => Verdict {
+            kind: VerdictKind::NoMissingEffect,
+            effect: None,
+            effects: Vec::new(),
+            sentence: no_missing(&baseline, noise, best_other.as_ref(), o),
+        },
+        1 => Verdict {
+            kind: VerdictKind::MissingEffect,
+            effect: Some(names[0].clone()),
+            effects: names.clone(),
+            sentence: missing(&cands[0], cands.get(1), noise),
+        },
+        _ => Verdict {
+            kind: VerdictKind::Ambiguous,
+            effect: Some(names[0].clone()),
+            effects: names.clone(),
+            sentence: ambiguous(cands, &names, &tie_words),
+        },
+    };
+    (verdict, baseline, signature)
+}
+
+fn check(c: &mut Candidate, o: &SearchOptions, noise: f64) {
+    let Some(e) = &c.evidence else {
+        c.reasons = vec![format!("the fit failed: {}", c.failed.as_deref().unwrap_or("unknown"))];
+        return;
+    };
+    let mut reasons = Vec::new();
+    c.checks.bic = e.delta_bic <= -o.min_delta_bic;
+    if !c.checks.bic {
+        reasons.push(format!("ΔBIC = {:.1}, not below −{}", e.delta_bic, o.min_delta_bic));
+    }
+    c.checks.heldout = e.heldout_p_holm < o.alpha && e.heldout_error_after < c.heldout_error_before;
+    if !c.checks.heldout {
+        reasons.push(format!(
+            "held-out error {} → {} on {} of {} shots better, {} after Holm's correction (needs < {})",
+            um(c.heldout_error_before),
+            um(e.heldout_error_after),
+            e.shots_improved[0],
+            e.shots_improved[1],
+            p_text(e.heldout_p_holm),
+            o.alpha
+        ));
+    }
+    let at_bound = e
+        .fit
+        .parameters
+        .iter()
+        .any(|p| p.effect == c.effect && p.param == c.param && p.at_bound);
+    let range = builtin(&c.effect)
+        .and_then(|i| i.params.iter().find(|p| p.name == c.param))
+        .map(|p| (p.min, p.max));
+    let unphysical = range.is_some_and(|(lo, hi)| e.param_value < lo || e.param_value > hi);
+    c.checks.parameter = e.param_z.is_some_and(|z| z >= o.min_param_z) && !at_bound && !unphysical;
+    if !c.checks.parameter {
+        reasons.push(match (e.param_z, range) {
+            (_, Some((lo, hi))) if unphysical => format!(
+                "{} = {} is outside its physical range [{}, {}]: the data pull it the other way",
+                c.param,
+                num(e.param_value),
+                num(lo),
+                num(hi)
+            ),
+            _ if at_bound => format!("{} = {} ended on a bound of its range", c.param, num(e.param_value)),
+            (Some(z), _) => format!(
+                "{} = {} is only {z:.1} standard errors from its neutral value {} (needs {})",
+                c.param,
+                num(e.param_value),
+                num(c.neutral),
+                o.min_param_z
+            ),
+            (None, _) => format!("{} = {} is not determined by the shots", c.param, num(e.param_value)),
+        });
+    }
+    // Held-out error removed (in quadrature), and the systematic part the candidate leaves held out.
+    let removed = (c.heldout_error_before.powi(2) - e.heldout_error_after.powi(2))
+        .max(0.0)
+        .sqrt();
+    let left = crate::search::excess(e.heldout_error_after.powi(2), noise);
+    let complete = left <= o.tolerance_m || e.explained_fraction >= o.explained_fraction;
+    c.checks.material = removed >= o.tolerance_m && complete;
+    if !c.checks.material {
+        reasons.push(if removed < o.tolerance_m {
+            format!(
+                "removes only {} of held-out error (in quadrature; needs {})",
+                um(removed),
+                um(o.tolerance_m)
+            )
+        } else {
+            format!(
+                "leaves a systematic held-out error of {} above the {} noise: it removes {:.0} % of the current model's systematic part (needs {:.0} %, or to leave less than {})",
+                um(left),
+                um(noise),
+                e.explained_fraction.max(0.0) * 100.0,
+                o.explained_fraction * 100.0,
+                um(o.tolerance_m)
+            )
+        });
+    }
+    c.explains = c.checks.all();
+    c.reasons = reasons;
+}
+
+fn doc_of(effect: &str) -> String {
+    builtin(effect).map(|i| i.doc.to_string()).unwrap_or_default()
+}
+
+fn unit_of(effect: &str, param: &str) -> String {
+    builtin(effect)
+        .and_then(|i| i.params.iter().find(|p| p.name == param))
+        .map(|p| {
+            if p.unit == "1" {
+                String::new()
+            } else {
+                format!(" {}", p.unit)
+            }
+        })
+        .unwrap_or_default()
+}
+
+fn param_words(c: &Candidate) -> String {
+    let Some(e) = &c.evidence else {
+        return String::new();
+    };
+    let unit = unit_of(&c.effect, &c.param);
+    match e.param_interval {
+        Some([lo, hi]) => format!(
+            "{} = {}{unit} (95 % interval {} to {})",
+            c.param,
+            num(e.param_value),
+            num(lo),
+            num(hi)
+        ),
+        None => format!("{} = {}{unit}", c.param, num(e.param_value)),
+    }
+}
+
+fn missing(c: &Candidate, next: Option<&Candidate>, noise: f64) -> String {
+    let e = c.evidence.as_ref().expect("a named candidate has evidence");
+    let mut s = format!(
+        "The model is missing `{}`: {} Adding it lowers the residual RMS from {} to {} ({:.1}× lower; reduced χ² {:.2} against the tracker's σ, {:.2} against the {} noise estimated from the residuals) and the held-out error from {} to {}, better on {} of {} shots ({} after Holm's correction); ΔBIC = {:.0}. Fitted {}.",
+        c.effect,
+        doc_of(&c.effect),
+        um(c.error_before),
+        um(e.error_after),
+        e.error_fall,
+        e.chi2_red_after,
+        e.chi2_red_noise_after,
+        um(noise),
+        um(c.heldout_error_before),
+        um(e.heldout_error_after),
+        e.shots_improved[0],
+        e.shots_improved[1],
+        p_text(e.heldout_p_holm),
+        e.delta_bic,
+        param_words(c)
+    );
+    if let Some(n) = next
+        && let Some(ne) = &n.evidence
+    {
+        s += &format!(
+            " The next candidate, `{}`, leaves a held-out error of {}.",
+            n.effect,
+            um(ne.heldout_error_after)
+        );
+    }
+    s += &format!(" Accept it with `bouncelab model add {} --model model.toml`.", c.effect);
+    s
+}
+
+fn ambiguous(cands: &[Candidate], names: &[String], ties: &[String]) -> String {
+    let list = names.iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(" or ");
+    let each = names
+        .iter()
+        .filter_map(|n| cands.iter().find(|c| &c.effect == n))
+        .filter_map(|c| {
+            c.evidence.as_ref().map(|e| {
+                format!(
+                    "`{}` lowers the residual RMS from {} to {} (held-out {}, ΔBIC {:.0}; {})",
+                    c.effect,
+                    um(c.error_before),
+                    um(e.error_after),
+                    um(e.heldout_error_after),
+                    e.delta_bic,
+                    param_words(c)
+                )
+            })
+        })
+        .collect::<Vec<_>>()
+        .join("; ");
+    format!(
+        "The model is missing {list}: these explain the residual about equally well and the shots cannot tell them apart, so none is picked. {each}. Against the best, {}. Shots that separate them (a wider range of impact speeds or inclines) would decide.",
+        ties.join("; ")
+    )
+}
+
+fn no_missing(b: &Baseline, noise: f64, best: Option<&Candidate>, o: &SearchOptions) -> String {
+    let mut s = format!(
+        "No missing effect: the current model fits to the noise (residual RMS {} against a noise level of {} estimated from the residuals; systematic part {}, within the {} tolerance; reduced χ² {:.2} against the tracker's σ).",
+        um(b.fit.rms_m),
+        um(noise),
+        um(b.systematic_m),
+        um(o.tolerance_m),
+        b.fit.chi2_red
+    );
+    if let Some(c) = best
+        && let Some(e) = &c.evidence
+    {
+        s += &format!(
+            " The best candidate, `{}`, changes the held-out error from {} to {}.",
+            c.effect,
+            um(c.heldout_error_before),
+            um(e.heldout_error_after)
+        );
+    }
+    s
+}
+
+fn none_explains(b: &Baseline, sig: &Signature, best: Option<&Candidate>, o: &SearchOptions) -> String {
+    let mut s = format!(
+        "No candidate explains the residual: the current model misfits ({}), but no library effect removes most of it.",
+        b.misfit_reasons.first().cloned().unwrap_or_default()
+    );
+    if let Some(c) = best
+        && let Some(e) = &c.evidence
+    {
+        s += &format!(
+            " The closest, `{}`, lowers the held-out error from {} to {} ({:.0} % of the systematic part; {:.0} % needed) and leaves a systematic {}{}.",
+            c.effect,
+            um(c.heldout_error_before),
+            um(e.heldout_error_after),
+            e.explained_fraction.max(0.0) * 100.0,
+            o.explained_fraction * 100.0,
+            um(e.systematic_after_m),
+            if c.reasons.is_empty() {
+                String::new()
+            } else {
+                format!(" ({})", c.reasons.join("; "))
+            }
+        );
+    }
+    let top: Vec<String> = sig
+        .phases
+        .iter()
+        .take(2)
+        .map(|p| {
+            format!(
+                "{} {} ({:.0} % of χ², systematic {})",
+                p.component.name(),
+                p.phase.words(),
+                p.chi2_share * 100.0,
+                um(p.systematic_m)
+            )
+        })
+        .collect();
+    if !top.is_empty() {
+        s += &format!(" The residual sits in {}.", top.join(" and "));
+    }
+    for t in sig.trends.iter().take(3) {
+        s += " ";
+        s += &t.sentence;
+    }
+    s += " A custom term (`kind = \"custom\"` in model.toml) acting there may be what is missing.";
+    s
+}

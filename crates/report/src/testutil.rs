@@ -1,0 +1,720 @@
+//! A synthetic session report for tests, the example and the browser check: drop shots on three surfaces
+//! whose COR falls with impact speed while the "fitted" model's does not (so the residuals and the
+//! diagnosis have something to show), with real ANCOVA and Tukey results from `bouncelab-stats`.
+
+use bouncelab_stats::{CorObservation, Dataset, PAPER_TERMS, ancova, tukey_hsd_factor};
+
+use crate::data::*;
+
+/// A small deterministic generator (SplitMix64) with Box–Muller normals.
+#[derive(Debug, Clone)]
+pub struct Rng(u64);
+
+impl Rng {
+    /// A generator from `seed`.
+    pub fn new(seed: u64) -> Rng {
+        Rng(seed)
+    }
+
+    /// Uniform in (0, 1).
+    pub fn uniform(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        ((z >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    }
+
+    /// Standard normal.
+    pub fn normal(&mut self) -> f64 {
+        let (u1, u2) = (self.uniform(), self.uniform());
+        (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+    }
+}
+
+/// Ball radius, m.
+const R: f64 = 0.0335;
+/// Gravity, m/s².
+const G: f64 = 9.81;
+/// Frame interval, s (10,000 fps).
+const DT: f64 = 1e-4;
+/// Tracking noise, m.
+const SIGMA: f64 = 8e-5;
+/// Touch time, s from the first frame.
+const T_TOUCH: f64 = 0.03;
+/// Contact time, s.
+const T_CONTACT: f64 = 0.0045;
+/// Frames per clip.
+const FRAMES: usize = 700;
+
+/// Surfaces: name, COR at 2 m/s, speed slope (1/(m/s)), k (N/m), b (N·s/m).
+const SURFACES: [(&str, f64, f64, f64, f64); 3] = [
+    ("clay", 0.80, -0.035, 25_650.0, 14.0),
+    ("tape1", 0.76, -0.030, 30_800.0, 15.0),
+    ("tape2", 0.735, -0.030, 31_825.0, 15.0),
+];
+
+/// Centre (x, y) in the local frame at time `t` for a shot touching at `T_TOUCH` with incoming
+/// (v_t, |v_n|), outgoing (v_t', v_n'), maximum penetration `dmax`, on an incline `theta` (rad).
+fn position(t: f64, v_t: f64, v_n: f64, out: (f64, f64), dmax: f64, theta: f64) -> (f64, f64) {
+    let (gt, gn) = (G * theta.sin(), G * theta.cos());
+    if t < T_TOUCH {
+        let tau = T_TOUCH - t;
+        (-v_t * tau + 0.5 * gt * tau * tau, R + v_n * tau - 0.5 * gn * tau * tau)
+    } else if t < T_TOUCH + T_CONTACT {
+        let s = t - T_TOUCH;
+        let x = v_t * s + (out.0 - v_t) * s * s / (2.0 * T_CONTACT);
+        (x, R - dmax * (std::f64::consts::PI * s / T_CONTACT).sin())
+    } else {
+        let x_end = v_t * T_CONTACT + (out.0 - v_t) * T_CONTACT / 2.0;
+        let tau = t - T_TOUCH - T_CONTACT;
+        (
+            x_end + out.0 * tau + 0.5 * gt * tau * tau,
+            R + out.1 * tau - 0.5 * gn * tau * tau,
+        )
+    }
+}
+
+/// The sample report: three surfaces, `per_surface` shots each (angles 0–22.5°, drop heights 0.3–0.9 m),
+/// deterministic for a given `seed`.
+pub fn sample_report_with(per_surface: usize, seed: u64) -> Report {
+    let mut rng = Rng::new(seed);
+    let angles = [0.0, 7.5, 15.0, 22.5];
+    let heights = [0.3, 0.5, 0.7, 0.9];
+    let mut shots = Vec::new();
+    let mut cor_points = Vec::new();
+    let mut oblique = Vec::new();
+    let mut before_after = Vec::new();
+    let mut errors: Vec<(String, f64)> = Vec::new();
+    for (si, &(surface, e2, slope, _, _)) in SURFACES.iter().enumerate() {
+        for j in 0..per_surface {
+            let angle = angles[j % angles.len()];
+            let h = heights[(j / angles.len() + j) % heights.len()] + 0.01 * si as f64;
+            let theta = f64::to_radians(angle);
+            let v = (2.0 * G * h).sqrt();
+            let (v_t, v_n) = (v * theta.sin(), v * theta.cos());
+            let e_true = e2 + slope * (v_n - 2.0) + 0.008 * rng.normal();
+            let e_model = e2 + slope * 0.6;
+            let out_true = (0.72 * v_t, e_true * v_n);
+            let out_model = (0.74 * v_t, e_model * v_n);
+            let dmax = v_n * T_CONTACT / std::f64::consts::PI * 0.9;
+            let clip = format!("S{:03}-{surface}", si * per_surface + j + 1);
+            let mut measured = Vec::with_capacity(FRAMES);
+            let mut residuals = Vec::with_capacity(FRAMES);
+            let gap = (j == 3).then_some(311..313);
+            for f in 0..FRAMES {
+                if gap.as_ref().is_some_and(|g| g.contains(&f)) {
+                    continue;
+                }
+                let t = f as f64 * DT;
+                let (x, y) = position(t, v_t, v_n, out_true, dmax, theta);
+                let (xm, ym) = position(t, v_t, v_n, out_model, dmax * 0.92, theta);
+                let p = MeasuredPoint {
+                    t_s: t,
+                    x_m: x + SIGMA * rng.normal(),
+                    y_m: y + SIGMA * rng.normal(),
+                    sigma_m: SIGMA,
+                };
+                residuals.push(Residual {
+                    t_s: t,
+                    dx_m: p.x_m - xm,
+                    dy_m: p.y_m - ym,
+                });
+                measured.push(p);
+            }
+            let model = (0..FRAMES * 2)
+                .map(|k| {
+                    let t = k as f64 * DT / 2.0;
+                    let (x, y) = position(t, v_t, v_n, out_model, dmax * 0.92, theta);
+                    ModelPoint { t_s: t, x_m: x, y_m: y }
+                })
+                .collect();
+            let phases = vec![
+                PhaseSpan {
+                    phase: Phase::FlightIn,
+                    t0_s: 0.0,
+                    t1_s: T_TOUCH,
+                },
+                PhaseSpan {
+                    phase: Phase::Compression,
+                    t0_s: T_TOUCH,
+                    t1_s: T_TOUCH + T_CONTACT / 2.0,
+                },
+                PhaseSpan {
+                    phase: Phase::Restitution,
+                    t0_s: T_TOUCH + T_CONTACT / 2.0,
+                    t1_s: T_TOUCH + T_CONTACT,
+                },
+                PhaseSpan {
+                    phase: Phase::FlightOut,
+                    t0_s: T_TOUCH + T_CONTACT,
+                    t1_s: (FRAMES - 1) as f64 * DT,
+                },
+            ];
+            let notes = if gap.is_some() {
+                vec!["2 frames without the ball (311–312)".to_string()]
+            } else {
+                vec![]
+            };
+            let shot = ShotPlot {
+                clip: clip.clone(),
+                surface: surface.into(),
+                angle_deg: angle,
+                drop_height_m: Some(h),
+                measured,
+                model,
+                phases,
+                residuals,
+                rms_m: None,
+                chi2_red: None,
+                notes,
+            };
+            let rms = crate::shots::rms_of(&shot).unwrap_or(f64::NAN);
+            let shot = ShotPlot {
+                chi2_red: Some((rms / SIGMA).powi(2)),
+                ..shot
+            };
+            let cor = e_true + 0.004 * rng.normal();
+            cor_points.push(CorPoint {
+                clip: clip.clone(),
+                surface: surface.into(),
+                angle_deg: angle,
+                v_in_n: -v_n + 0.01 * rng.normal(),
+                v_in_n_se: Some(0.012),
+                cor,
+                cor_se: Some(0.006),
+            });
+            errors.push((surface.into(), 100.0 * (e_model - cor).abs() / cor));
+            if angle > 0.0 {
+                let pct = |p: f64, m: f64| 100.0 * (p - m).abs() / m.abs();
+                oblique.push(ObliqueRow {
+                    clip: clip.clone(),
+                    surface: surface.into(),
+                    angle_deg: angle,
+                    v_out_measured: [out_true.0, out_true.1],
+                    v_out_predicted: [out_model.0, out_model.1],
+                    error_pct: [pct(out_model.0, out_true.0), pct(out_model.1, out_true.1)],
+                });
+            }
+            before_after.push(ShotBeforeAfter {
+                clip: clip.clone(),
+                surface: surface.into(),
+                rms_before_m: rms,
+                rms_after_m: SIGMA * (1.02 + 0.08 * rng.uniform()),
+            });
+            shots.push(shot);
+        }
+    }
+    let observations: Vec<CorObservation> = cor_points
+        .iter()
+        .map(|c| CorObservation {
+            surface: c.surface.clone(),
+            angle: c.angle_deg,
+            v_in_n: c.v_in_n,
+            cor: c.cor,
+        })
+        .collect();
+    let data = Dataset::from_cor(&observations);
+    let (anc, tukey) = match &data {
+        Ok(d) => (
+            ancova(d, &PAPER_TERMS).into(),
+            tukey_hsd_factor(d, "surface", 0.05).into(),
+        ),
+        Err(e) => (Section::unavailable(e.to_string()), Section::unavailable(e.to_string())),
+    };
+    let mut parameters = Vec::new();
+    for &(s, _, _, k, _) in &SURFACES {
+        parameters.push(FitParameter {
+            name: format!("{s}:spring.k"),
+            value: k,
+            std_error: Some(k * 0.012),
+            interval: Some([k * (1.0 - 0.024), k * (1.0 + 0.024)]),
+            unit: "N/m".into(),
+            at_bound: false,
+        });
+    }
+    for &(s, _, _, _, b) in &SURFACES {
+        parameters.push(FitParameter {
+            name: format!("{s}:damping.b"),
+            value: b,
+            std_error: Some(0.4),
+            interval: Some([b - 0.8, b + 0.8]),
+            unit: "N·s/m".into(),
+            at_bound: false,
+        });
+    }
+    parameters.push(FitParameter {
+        name: "coulomb.mu".into(),
+        value: 0.52,
+        std_error: Some(0.01),
+        interval: Some([0.50, 0.54]),
+        unit: String::new(),
+        at_bound: false,
+    });
+    let by_surface: Vec<SurfaceError> = SURFACES
+        .iter()
+        .map(|&(s, ..)| {
+            let e: Vec<f64> = errors.iter().filter(|x| x.0 == s).map(|x| x.1).collect();
+            SurfaceError {
+                surface: s.into(),
+                shots: e.len(),
+                mean_abs_error_pct: e.iter().sum::<f64>() / e.len().max(1) as f64,
+            }
+        })
+        .collect();
+    let all_err = errors.iter().map(|x| x.1).sum::<f64>() / errors.len().max(1) as f64;
+    let rms_all = (shots
+        .iter()
+        .filter_map(crate::shots::rms_of)
+        .map(|r| r * r)
+        .sum::<f64>()
+        / shots.len().max(1) as f64)
+        .sqrt();
+    let rms_after =
+        (before_after.iter().map(|b| b.rms_after_m.powi(2)).sum::<f64>() / before_after.len().max(1) as f64).sqrt();
+    Report {
+        title: "Drop tests on clay and two line tapes (synthetic)".into(),
+        session: SessionInfo {
+            path: "sessions/synthetic-2024-05-03".into(),
+            description: "Synthetic session: ball dropped from 0.3–0.9 m onto green clay and two court line tapes \
+                          at 0–22.5°, filmed at 10,000 fps."
+                .into(),
+            shots: shots.len(),
+            surfaces: SURFACES.iter().map(|s| s.0.to_string()).collect(),
+            generated_by: format!("bouncelab-report {}", env!("CARGO_PKG_VERSION")),
+            generated_at: None,
+            metadata: vec![
+                ("Ball".into(), "diameter 0.067 m, mass 0.0567 kg".into()),
+                ("Camera".into(), "10,000 fps, 512 × 512 px, down-slope +x".into()),
+            ],
+        },
+        shots,
+        cor_points,
+        ancova: anc,
+        tukey,
+        fit: Section::Available(FitSummary {
+            model_name: "paper (spring + damping + coulomb)".into(),
+            parameters,
+            confidence: 0.95,
+            reduced_chi2: Some((rms_all / SIGMA).powi(2)),
+            rms_m: Some(rms_all),
+            termination: "converged: relative cost change below 1e-10 after 14 iterations".into(),
+            mean_abs_error_pct: Some(all_err),
+            by_surface,
+            oblique,
+        }),
+        diagnosis: Section::Available(DiagnosisSection {
+            verdict_kind: VerdictKind::MissingEffect,
+            verdict_text: format!(
+                "Hunt–Crossley damping (b·δⁿ·δ̇, COR falling with impact speed) is missing: adding it lowers the \
+                 RMS residual from {:.3} mm to {:.3} mm and the BIC by 412.",
+                rms_all * 1e3,
+                rms_after * 1e3
+            ),
+            evidence: vec![
+                "COR falls with impact speed, slope −0.033 per m/s, p < 0.001; the model predicts none.".into(),
+                "72% of χ² is in flight out, normal component: the rebound height is wrong, not the contact shape."
+                    .into(),
+                "The residual does not trend with the angle (p = 0.41) or the surface (p = 0.22).".into(),
+            ],
+            error_metric: "leave-one-shot-out RMS position residual, mm".into(),
+            candidates: vec![
+                Candidate {
+                    effect: "hunt_crossley".into(),
+                    error_before: 0.412,
+                    error_after: 0.083,
+                    delta_bic: -412.0,
+                    heldout_before: Some(0.431),
+                    heldout_after: Some(0.091),
+                },
+                Candidate {
+                    effect: "hertz".into(),
+                    error_before: 0.412,
+                    error_after: 0.371,
+                    delta_bic: -35.2,
+                    heldout_before: Some(0.431),
+                    heldout_after: Some(0.398),
+                },
+                Candidate {
+                    effect: "restitution_damping".into(),
+                    error_before: 0.412,
+                    error_after: 0.402,
+                    delta_bic: -3.1,
+                    heldout_before: Some(0.431),
+                    heldout_after: Some(0.429),
+                },
+                Candidate {
+                    effect: "plastic_dent".into(),
+                    error_before: 0.412,
+                    error_after: 0.409,
+                    delta_bic: 6.5,
+                    heldout_before: Some(0.431),
+                    heldout_after: Some(0.433),
+                },
+                Candidate {
+                    effect: "air_drag".into(),
+                    error_before: 0.412,
+                    error_after: 0.412,
+                    delta_bic: 9.8,
+                    heldout_before: Some(0.431),
+                    heldout_after: None,
+                },
+            ],
+            model_before: "v1: paper".into(),
+            model_after: "v2: paper + hunt_crossley".into(),
+            before_after,
+            total_rms_before_m: Some(rms_all),
+            total_rms_after_m: Some(rms_after),
+            model_history: vec![
+                ModelVersion {
+                    version: 1,
+                    model: "paper (spring + damping + coulomb)".into(),
+                    created: "2024-05-03 14:02".into(),
+                    rms_m: Some(rms_all),
+                    chi2_red: Some((rms_all / SIGMA).powi(2)),
+                },
+                ModelVersion {
+                    version: 2,
+                    model: "paper + hunt_crossley".into(),
+                    created: "2024-05-03 14:31".into(),
+                    rms_m: Some(rms_after),
+                    chi2_red: Some((rms_after / SIGMA).powi(2)),
+                },
+            ],
+        }),
+        warnings: vec![
+            "S004-clay: 2 frames without the ball (311–312); timestamps follow the frame numbers".into(),
+            "fps not given on the command line or in clip.toml: 10000 from session.toml".into(),
+        ],
+        timings: vec![
+            ("decode frames".into(), 12.31),
+            ("track".into(), 40.12),
+            ("estimate".into(), 0.84),
+            ("fit".into(), 95.2),
+            ("diagnose".into(), 210.4),
+            ("stats".into(), 0.05),
+            ("report".into(), 0.31),
+        ],
+    }
+}
+
+/// [`sample_report_with`] eight shots per surface (24 shots), seed 7.
+pub fn sample_report() -> Report {
+    sample_report_with(8, 7)
+}
+
+/// The markup the brief's escaping test names: a surface that would run script if not escaped.
+pub const SCRIPT_SURFACE: &str = "<script>alert(1)</script>";
+/// A clip name with every character that must be escaped in an attribute.
+pub const AMP_CLIP: &str = "a&b\"<x>";
+/// A surface whose markup would log to the browser console if it were not escaped.
+pub const CONSOLE_SURFACE: &str = "<img src=x onerror=\"console.error('xss')\">";
+
+/// A report to break the renderer: every text field carries markup, numbers include NaN, infinities,
+/// ±1e308 and subnormals, series are empty, single points or constant, a clip name repeats, and the
+/// statistics' vectors disagree in length.
+pub fn hostile_report() -> Report {
+    use bouncelab_stats::{
+        AnovaRow, AnovaTable, AnovaType, Diagnostics, GroupSummary, LinearFit, NormalPlotPoint, TukeyHsd, TukeyPair,
+    };
+    let (nan, inf) = (f64::NAN, f64::INFINITY);
+    let m = |t: f64, x: f64, y: f64| MeasuredPoint {
+        t_s: t,
+        x_m: x,
+        y_m: y,
+        sigma_m: 1e-4,
+    };
+    let mp = |t: f64, x: f64, y: f64| ModelPoint { t_s: t, x_m: x, y_m: y };
+    let r = |t: f64, dx: f64, dy: f64| Residual {
+        t_s: t,
+        dx_m: dx,
+        dy_m: dy,
+    };
+    let span = |phase, t0_s, t1_s| PhaseSpan { phase, t0_s, t1_s };
+    let shot = |clip: &str, surface: &str| ShotPlot {
+        clip: clip.into(),
+        surface: surface.into(),
+        notes: vec!["<b>note</b> & \"quote\"".into()],
+        ..Default::default()
+    };
+    let shots = vec![
+        ShotPlot {
+            angle_deg: nan,
+            drop_height_m: Some(inf),
+            measured: vec![
+                m(0.0, 0.0, 0.1),
+                m(nan, 0.0, 0.1),
+                m(1e-3, inf, -inf),
+                m(2e-3, 0.01, nan),
+                m(3e-3, 0.02, 0.05),
+            ],
+            model: vec![mp(0.0, 0.0, 0.1), mp(nan, nan, nan), mp(3e-3, 0.02, 0.05)],
+            phases: vec![
+                span(Phase::FlightIn, 0.0, nan),
+                span(Phase::Compression, inf, -inf),
+                span(Phase::FlightOut, 2e-3, 1.0),
+            ],
+            residuals: vec![r(0.0, 0.0, 1e-4), r(1e-3, inf, nan), r(2e-3, -1e-4, 2e-4)],
+            rms_m: None,
+            chi2_red: Some(nan),
+            ..shot(AMP_CLIP, SCRIPT_SURFACE)
+        },
+        ShotPlot {
+            measured: vec![m(0.01, 0.0, 0.0)],
+            model: vec![mp(0.01, 0.0, 0.0)],
+            residuals: vec![r(0.01, 0.0, 0.0)],
+            phases: vec![span(Phase::Restitution, 0.01, 0.01)],
+            ..shot("single", CONSOLE_SURFACE)
+        },
+        ShotPlot {
+            angle_deg: 15.0,
+            measured: (0..50).map(|i| m(0.5, 0.25, 0.25 + 0.0 * i as f64)).collect(),
+            model: (0..50).map(|_| mp(0.5, 0.25, 0.25)).collect(),
+            residuals: (0..50).map(|_| r(0.5, 0.0, 0.0)).collect(),
+            rms_m: Some(0.0),
+            ..shot("flat", "plain")
+        },
+        shot("empty", "plain"),
+        ShotPlot {
+            measured: vec![m(0.0, 1.0, 2.0)],
+            ..shot(AMP_CLIP, "plain")
+        },
+        ShotPlot {
+            measured: vec![
+                m(-1e308, 1e308, -1e308),
+                m(1e308, -1e308, 1e308),
+                m(5e-324, 5e-324, 5e-324),
+            ],
+            model: vec![mp(f64::MIN, f64::MAX, 0.0), mp(f64::MAX, f64::MIN, 0.0)],
+            residuals: vec![r(-1e308, 1e308, -1e308), r(1e308, f64::MAX, f64::MIN)],
+            phases: vec![span(Phase::Compression, -1e308, 1e308)],
+            rms_m: Some(inf),
+            ..shot("huge", "plain")
+        },
+    ];
+    let cp = |clip: &str, surface: &str, angle_deg: f64, v_in_n: f64, cor: f64, se: Option<f64>| CorPoint {
+        clip: clip.into(),
+        surface: surface.into(),
+        angle_deg,
+        v_in_n,
+        v_in_n_se: se,
+        cor,
+        cor_se: se,
+    };
+    let cor_points = vec![
+        cp(AMP_CLIP, SCRIPT_SURFACE, 0.0, -2.0, 0.8, Some(0.01)),
+        cp("single", CONSOLE_SURFACE, nan, inf, nan, Some(nan)),
+        cp("flat", "plain", 15.0, -3.0, 0.7, None),
+        cp("flat2", "plain", 15.0, -3.0, 0.7, None),
+        cp("flat3", "plain", 15.0, -3.0, 0.7, Some(inf)),
+        cp("huge", "plain", 1e308, -1e308, 1e308, Some(1e308)),
+    ];
+    let row = |source: &str, ss: f64| AnovaRow {
+        source: source.into(),
+        ss,
+        df: 1,
+        ms: ss,
+        f: Some(nan),
+        p: Some(inf),
+    };
+    let table = |kind| AnovaTable {
+        kind,
+        terms: vec![row(SCRIPT_SURFACE, nan), row("surface", inf)],
+        error: AnovaRow {
+            f: None,
+            p: None,
+            ..row("Error", 0.0)
+        },
+        total: AnovaRow {
+            f: None,
+            p: None,
+            ..row("Total", -inf)
+        },
+    };
+    let ancova = bouncelab_stats::Ancova {
+        type1: table(AnovaType::TypeI),
+        type2: table(AnovaType::TypeII),
+        fit: LinearFit {
+            terms: vec![SCRIPT_SURFACE.into()],
+            coefficient_names: vec![AMP_CLIP.into(), "b".into()],
+            coefficients: vec![nan],
+            fitted: vec![nan, 0.5, inf],
+            residuals: vec![0.0; 3],
+            leverage: vec![],
+            rss: nan,
+            df_resid: 0,
+            n: 3,
+        },
+        diagnostics: Diagnostics {
+            fitted: vec![nan, 0.5, inf, 0.7, 0.7, 0.7],
+            residuals: vec![0.0; 2],
+            leverage: vec![],
+            studentized_internal: vec![nan],
+            studentized_external: vec![nan, 1.0, -inf, 2.5, 0.0, 0.0],
+            normal_plot: vec![
+                NormalPlotPoint {
+                    observation: 99,
+                    residual: nan,
+                    probability: 0.5,
+                    normal_quantile: 0.0,
+                },
+                NormalPlotPoint {
+                    observation: 0,
+                    residual: 1.0,
+                    probability: 0.1,
+                    normal_quantile: inf,
+                },
+                NormalPlotPoint {
+                    observation: 1,
+                    residual: 1.0,
+                    probability: 0.2,
+                    normal_quantile: -1.0,
+                },
+                NormalPlotPoint {
+                    observation: 2,
+                    residual: 1.0,
+                    probability: 0.3,
+                    normal_quantile: 1.0,
+                },
+                NormalPlotPoint {
+                    observation: 3,
+                    residual: 1.0,
+                    probability: 0.4,
+                    normal_quantile: 2.0,
+                },
+            ],
+            residual_skewness: nan,
+            residual_kurtosis: inf,
+        },
+    };
+    let tukey = TukeyHsd {
+        alpha: nan,
+        df: 0,
+        mse: inf,
+        q_crit: nan,
+        groups: vec![GroupSummary {
+            name: SCRIPT_SURFACE.into(),
+            n: 1,
+            mean: nan,
+        }],
+        pairs: vec![
+            TukeyPair {
+                group1: SCRIPT_SURFACE.into(),
+                group2: AMP_CLIP.into(),
+                mean_diff: nan,
+                std_err: inf,
+                q: nan,
+                p_adj: -1.0,
+                lower: -inf,
+                upper: inf,
+                reject: true,
+            },
+            TukeyPair {
+                group1: "x".into(),
+                group2: "y".into(),
+                mean_diff: 0.0,
+                std_err: 0.0,
+                q: 0.0,
+                p_adj: 1.0,
+                lower: 0.0,
+                upper: 0.0,
+                reject: false,
+            },
+        ],
+    };
+    Report {
+        title: "<b>title</b> & co".into(),
+        session: SessionInfo {
+            path: "C:\\data\\<session>".into(),
+            description: "<i>desc</i>\u{0}".into(),
+            shots: 7,
+            surfaces: vec![SCRIPT_SURFACE.into(), SCRIPT_SURFACE.into()],
+            generated_by: "<gen>".into(),
+            generated_at: Some("<now>".into()),
+            metadata: vec![("<k>".into(), "<v>".into())],
+        },
+        shots,
+        cor_points,
+        ancova: Section::Available(ancova),
+        tukey: Section::Available(tukey),
+        fit: Section::Available(FitSummary {
+            model_name: "<model>".into(),
+            parameters: vec![FitParameter {
+                name: AMP_CLIP.into(),
+                value: nan,
+                std_error: Some(inf),
+                interval: Some([-inf, nan]),
+                unit: "<unit>".into(),
+                at_bound: true,
+            }],
+            confidence: nan,
+            reduced_chi2: Some(inf),
+            rms_m: Some(nan),
+            termination: "<stop>".into(),
+            mean_abs_error_pct: Some(nan),
+            by_surface: vec![SurfaceError {
+                surface: SCRIPT_SURFACE.into(),
+                shots: 0,
+                mean_abs_error_pct: nan,
+            }],
+            oblique: vec![
+                ObliqueRow {
+                    clip: AMP_CLIP.into(),
+                    surface: SCRIPT_SURFACE.into(),
+                    angle_deg: nan,
+                    v_out_measured: [nan, inf],
+                    v_out_predicted: [1.0, 1.0],
+                    error_pct: [nan, -inf],
+                },
+                ObliqueRow {
+                    clip: "one".into(),
+                    v_out_measured: [1.0, 1.0],
+                    v_out_predicted: [1.0, 1.0],
+                    ..Default::default()
+                },
+            ],
+        }),
+        diagnosis: Section::Available(DiagnosisSection {
+            verdict_kind: VerdictKind::NoCandidateExplains,
+            verdict_text: "<verdict>".into(),
+            evidence: vec!["<evidence> & more".into()],
+            error_metric: "<metric>".into(),
+            candidates: vec![Candidate {
+                effect: SCRIPT_SURFACE.into(),
+                error_before: 0.0,
+                error_after: nan,
+                delta_bic: -inf,
+                heldout_before: None,
+                heldout_after: Some(nan),
+            }],
+            model_before: "<before>".into(),
+            model_after: "<after>".into(),
+            before_after: vec![
+                ShotBeforeAfter {
+                    clip: AMP_CLIP.into(),
+                    surface: SCRIPT_SURFACE.into(),
+                    rms_before_m: nan,
+                    rms_after_m: inf,
+                },
+                ShotBeforeAfter {
+                    clip: "flat".into(),
+                    surface: "plain".into(),
+                    rms_before_m: 0.0,
+                    rms_after_m: 0.0,
+                },
+            ],
+            total_rms_before_m: None,
+            total_rms_after_m: Some(nan),
+            model_history: vec![ModelVersion {
+                version: u32::MAX,
+                model: "<m>".into(),
+                created: "<c>".into(),
+                rms_m: Some(nan),
+                chi2_red: None,
+            }],
+        }),
+        warnings: vec![SCRIPT_SURFACE.into(), String::new()],
+        timings: vec![("<stage>".into(), nan), ("b".into(), inf), ("c".into(), -1.0)],
+    }
+}
