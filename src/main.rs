@@ -20,7 +20,7 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Simulate the paper's three surfaces at the paper's drop heights and print COR and contact time.
+    /// Render a small session with a hidden effect, analyse it, accept the verdict, analyse again.
     Demo(cmd::demo::Args),
     /// Simulate one impact with a model file and print its outputs.
     Simulate(cmd::simulate::Args),
@@ -34,6 +34,8 @@ enum Command {
     Track(cmd::track::Args),
     /// Everything over a session folder: track, estimate, fit, compare, diagnose, stats, report.
     Analyze(cmd::analyze::Args),
+    /// The missing-effect verdict over a session folder (runs `analyze`), with its evidence.
+    Diagnose(cmd::analyze::Args),
     /// Edit a model file: `model add EFFECT --model model.toml` accepts a diagnosis.
     Model(cmd::model::Args),
 }
@@ -48,6 +50,7 @@ fn main() -> ExitCode {
         Command::Track(a) => cmd::track::run(a),
         Command::Estimate(a) => cmd::estimate::run(a),
         Command::Analyze(a) => cmd::analyze::run(a),
+        Command::Diagnose(a) => cmd::diagnose::run(a),
         Command::Model(a) => cmd::model::run(a),
     };
     match result {

@@ -28,7 +28,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         return Ok(());
     }
     for e in builtin_effects() {
-        let tag = if e.base { " (base model)" } else { "" };
+        let tag = match (e.base, e.group) {
+            (true, "nuisance") => " (fitted with the base model; never a candidate)",
+            (true, _) => " (base model)",
+            _ => "",
+        };
         println!("{} [{}]{tag}\n    {}", e.name, e.group, e.doc);
         for p in e.params {
             let default = p

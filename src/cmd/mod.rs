@@ -2,6 +2,7 @@
 
 pub mod analyze;
 pub mod demo;
+pub mod diagnose;
 pub mod effects;
 pub mod estimate;
 pub mod model;

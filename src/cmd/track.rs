@@ -124,8 +124,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     if let Some(l) = &track.surface {
         summary += &format!(
-            "; surface line y = {:.2} px at x = {:.0}, tilt {:.3}° ± {:.3}°",
+            "; surface line y = {:.2} ± {:.2} px at x = {:.0}, tilt {:.3}° ± {:.3}°",
             l.y0,
+            l.sigma_y0,
             l.x0,
             l.tilt_deg(),
             l.sigma_tilt_deg

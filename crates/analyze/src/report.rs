@@ -104,9 +104,16 @@ fn shot_plot(a: &Analysis, c: &ShotComparison) -> r::ShotPlot {
         .collect();
     let fit = a.fit.shots.iter().find(|s| s.name == c.shot);
     let mut notes = data.map(|s| s.estimate.notes.clone()).unwrap_or_default();
-    if let Some(level) = fit.and_then(|f| f.surface_offset_m) {
+    let level = match (
+        crate::fitted_surface_level(&a.fit, &c.surface),
+        fit.and_then(|f| f.surface_offset_m),
+    ) {
+        (None, None) => None,
+        (a, b) => Some(a.unwrap_or(0.0) + b.unwrap_or(0.0)),
+    };
+    if let Some(level) = level {
         notes.push(format!(
-            "fitted surface level {:+.1} µm relative to the surface line found in the image",
+            "fitted surface level {:+.1} µm: the surface line found in the image lies that far above the plane the ball touches",
             level * 1e6
         ));
     }

@@ -101,5 +101,6 @@ pub fn measured_shot(clip: &str, surface: &str, angle_deg: f64, track: &TrackRec
             cor: e.cor.value,
             mu: e.mu.value,
         }),
+        surface_sigma_m: Some(e.surface_sigma_m).filter(|s| s.is_finite() && *s > 0.0),
     }
 }

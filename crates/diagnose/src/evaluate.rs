@@ -1,21 +1,15 @@
 //! One model against a set of shots: the weighted residuals a fit minimises, with the measured start taken
 //! as what the camera saw, and the fit's summary (values, standard errors, intervals, χ², RMS).
 //!
-//! This is the fit crate's [`Problem`] (it checks the shots and owns the parameter vector) with one change:
-//! each shot's measured start is first mapped back through the model's measurement effects, so a candidate
-//! such as camera roll starts from the state whose *observation* is the measured start. A measurement
-//! effect such as a roll turns positions about the local frame's origin, the contact point on the surface
-//! line, while the tracker's x origin is arbitrary: so the contact point is located in each shot's data
-//! (where the measured centre first comes within a radius of the surface line, less the offset the
-//! measurement effect gives a touching ball's centre) and the map is applied about it. Without a
-//! measurement effect the map is the identity and the residuals are exactly the fit crate's. Each shot's
-//! surface level can be profiled as a nuisance, as the fit crate does ([`profile_surface_level`]).
+//! This is the fit crate's [`Problem`] (it checks the shots, owns the parameter vector and maps each
+//! measured start through the model's measurement effects) with the surface levels held, profiled or
+//! neither, and the sums and summaries the search compares.
 
 use bouncelab_fit::{
     FitError, LeastSquares, LevenbergMarquardt, MeasuredShot, NoObserver, Problem, SolverOutcome, Termination,
-    profile_surface_level,
+    profile_surface_level, surface_prior,
 };
-use bouncelab_model::{Model, ModelSpec, Observation, SimOptions, Simulation, State, simulate};
+use bouncelab_model::{Model, ModelSpec, SimOptions, Simulation};
 use nalgebra::DMatrix;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -26,14 +20,22 @@ use std::sync::atomic::{AtomicU64, Ordering};
 #[derive(Debug)]
 pub(crate) struct Evaluator {
     problem: Problem,
-    sim: SimOptions,
     /// Index of each shot's surface in `surfaces`.
     shot_surface: Vec<usize>,
     surfaces: Vec<String>,
-    /// Per shot: the measured x of the centre when it touched the surface, m (data coordinates).
-    touch_x: Vec<f64>,
-    /// Per shot, when surface levels are fitted: the last profiled level (f64 bits), m.
-    levels: Option<Vec<AtomicU64>>,
+    /// Each shot's surface level, m: none, profiled, or held.
+    levels: Levels,
+}
+
+/// How each shot's surface level (the true surface's height in the measured frame) enters.
+#[derive(Debug)]
+enum Levels {
+    /// At the measured surface line.
+    None,
+    /// Profiled in every evaluation, warm-started at the last value (f64 bits).
+    Profiled(Vec<AtomicU64>),
+    /// Held at given values (a fold's training shots at the full fit's levels).
+    Held(Vec<f64>),
 }
 
 impl Evaluator {
@@ -58,18 +60,40 @@ impl Evaluator {
             };
             shot_surface.push(i);
         }
-        let radius = spec.ball.radius_m;
-        let touch_x = shots.iter().map(|s| touch_x(s, radius)).collect();
-        let levels = surface_levels.then(|| shots.iter().map(|_| AtomicU64::new(0)).collect());
+        let levels = if surface_levels {
+            Levels::Profiled(shots.iter().map(|_| AtomicU64::new(0)).collect())
+        } else {
+            Levels::None
+        };
         let problem = Problem::new(spec, shots, sim)?;
         Ok(Evaluator {
             problem,
-            sim,
             shot_surface,
             surfaces,
-            touch_x,
             levels,
         })
+    }
+
+    /// Surface levels start at `levels` (one per shot, m): profiled from there if they are profiled,
+    /// else held there (`profile = false`). Ignored without surface levels.
+    pub fn set_levels(&mut self, levels: &[f64], profile: bool) {
+        if matches!(self.levels, Levels::None) || levels.len() != self.problem.shots().len() {
+            return;
+        }
+        self.levels = if profile {
+            Levels::Profiled(levels.iter().map(|l| AtomicU64::new(l.to_bits())).collect())
+        } else {
+            Levels::Held(levels.to_vec())
+        };
+    }
+
+    /// Each shot's current surface level, m (`None` without surface levels).
+    pub fn levels(&self) -> Option<Vec<f64>> {
+        match &self.levels {
+            Levels::None => None,
+            Levels::Profiled(l) => Some(l.iter().map(|b| f64::from_bits(b.load(Ordering::Relaxed))).collect()),
+            Levels::Held(l) => Some(l.clone()),
+        }
     }
 
     pub fn problem(&self) -> &Problem {
@@ -92,8 +116,9 @@ impl Evaluator {
         let one = |i: usize| -> Result<Simulation, FitError> {
             let model = &models[self.shot_surface[i]];
             match &self.levels {
-                None => self.simulate_at(i, model, 0.0),
-                Some(levels) => {
+                Levels::None => self.simulate_at(i, model, 0.0),
+                Levels::Held(levels) => self.simulate_at(i, model, levels[i]),
+                Levels::Profiled(levels) => {
                     let start = f64::from_bits(levels[i].load(Ordering::Relaxed));
                     let (sim, level) =
                         profile_surface_level(&self.problem.shots()[i], start, |l| self.simulate_at(i, model, l))?;
@@ -106,50 +131,15 @@ impl Evaluator {
         all.into_iter().collect()
     }
 
-    /// Shot `i` with the true surface at height `level` in the measured frame (m): the measured start is
-    /// taken about the contact point on that surface, mapped back through the measurement effects, and
-    /// what the camera would see is mapped to the measured frame again.
+    /// Shot `i` with the true surface at height `level` in the measured frame (m), measurement effects
+    /// mapped as the fit crate does ([`Problem::simulate_shot`]).
     fn simulate_at(&self, i: usize, model: &Model, level: f64) -> Result<Simulation, FitError> {
-        let shot = &self.problem.shots()[i];
-        let times: Vec<f64> = shot.frames.iter().map(|f| f.t_s).collect();
-        let measured = shot.start.state;
-        // The contact point in data coordinates (its x only matters with a measurement effect).
-        let origin_x = if observes(model) {
-            let touching = State {
-                y: model.ball.radius_m,
-                ..State::default()
-            };
-            self.touch_x[i] - observe(model, &touching).x
-        } else {
-            0.0
-        };
-        let start = true_start(
-            model,
-            &State {
-                x: measured.x - origin_x,
-                y: measured.y - level,
-                ..measured
-            },
-        );
-        let mut sim =
-            simulate(model, shot.incline_rad, shot.start.t_s, start, &times, &self.sim).map_err(|source| {
-                FitError::Simulation {
-                    shot: shot.name.clone(),
-                    source: Box::new(source),
-                }
-            })?;
-        if origin_x != 0.0 || level != 0.0 {
-            for s in &mut sim.samples {
-                s.observed.x += origin_x;
-                s.observed.y += level;
-            }
-        }
-        Ok(sim)
+        self.problem.simulate_shot(i, model, level)
     }
 
     /// Nuisance parameters per shot (1 with surface levels, else 0).
     pub fn nuisance_per_shot(&self) -> usize {
-        usize::from(self.levels.is_some())
+        usize::from(!matches!(self.levels, Levels::None))
     }
 
     /// Per shot: (Σ ((sim − meas)/σ)², Σ (sim − meas)² in m², residual count).
@@ -191,6 +181,16 @@ impl LeastSquares for Evaluator {
                 r.push((s.observed.y - f.y_m) / f.sigma_m);
             }
         }
+        // Each shot's surface-level prior, as the fit crate adds it.
+        if let Some(levels) = self.levels() {
+            r.extend(
+                self.problem
+                    .shots()
+                    .iter()
+                    .zip(levels)
+                    .map(|(shot, l)| surface_prior(shot, l).unwrap_or(0.0)),
+            );
+        }
         Ok(r)
     }
 
@@ -213,95 +213,6 @@ pub(crate) struct ShotSums {
     pub sq_m2: f64,
     /// Number of residuals (2 per frame).
     pub n: usize,
-}
-
-/// The measured x of the centre where it first comes within a radius of the surface line (linear
-/// interpolation between the two frames around the crossing), or at its lowest frame without a crossing.
-fn touch_x(shot: &MeasuredShot, radius: f64) -> f64 {
-    let f = &shot.frames;
-    for k in 1..f.len() {
-        let (a, b) = (&f[k - 1], &f[k]);
-        if a.y_m > radius && b.y_m <= radius {
-            let w = (a.y_m - radius) / (a.y_m - b.y_m);
-            return a.x_m + w * (b.x_m - a.x_m);
-        }
-    }
-    f.iter()
-        .min_by(|a, b| a.y_m.total_cmp(&b.y_m))
-        .map(|l| l.x_m)
-        .unwrap_or(shot.start.state.x)
-}
-
-/// True if a measurement effect of `model` changes what the camera sees.
-fn observes(model: &Model) -> bool {
-    let probe = State {
-        x: 0.1,
-        y: 0.2,
-        theta: 0.3,
-        vx: 1.0,
-        vy: -2.0,
-        omega: 5.0,
-    };
-    obs_array(&observe(model, &probe)) != obs_array(&Observation::from(probe))
-}
-
-/// What the camera would see of `state` through the model's measurement effects.
-fn observe(model: &Model, state: &State) -> Observation {
-    let mut o = Observation::from(*state);
-    for e in model.effects() {
-        e.observe(&mut o);
-    }
-    o
-}
-
-fn obs_array(o: &Observation) -> [f64; 6] {
-    [o.x, o.y, o.theta, o.vx, o.vy, o.omega]
-}
-
-fn state_of(a: [f64; 6]) -> State {
-    State {
-        x: a[0],
-        y: a[1],
-        theta: a[2],
-        vx: a[3],
-        vy: a[4],
-        omega: a[5],
-    }
-}
-
-/// The true state whose observation through the model's measurement effects is `measured` (the identity
-/// when the model has none). Newton's method on the observation map with a finite-difference Jacobian;
-/// the maps of the library (a rotation) are linear, so one step is exact.
-pub(crate) fn true_start(model: &Model, measured: &State) -> State {
-    let target = obs_array(&Observation::from(*measured));
-    if !observes(model) {
-        return *measured;
-    }
-    let mut x = target;
-    for _ in 0..8 {
-        let f0 = obs_array(&observe(model, &state_of(x)));
-        let r: Vec<f64> = (0..6).map(|i| target[i] - f0[i]).collect();
-        if r.iter().zip(&target).all(|(d, t)| d.abs() <= 1e-14 * (1.0 + t.abs())) {
-            break;
-        }
-        let mut jac = DMatrix::zeros(6, 6);
-        for j in 0..6 {
-            let h = 1e-6 * (1.0 + x[j].abs());
-            let mut xp = x;
-            xp[j] += h;
-            let fp = obs_array(&observe(model, &state_of(xp)));
-            for i in 0..6 {
-                jac[(i, j)] = (fp[i] - f0[i]) / h;
-            }
-        }
-        let Some(step) = jac.lu().solve(&nalgebra::DVector::from_vec(r)) else {
-            break;
-        };
-        for j in 0..6 {
-            x[j] += step[j];
-        }
-    }
-    state_of(x)
 }
 
 /// One fitted parameter.

@@ -48,17 +48,19 @@ pub struct SearchOptions {
     /// The white-noise level of the tracked positions, m; `None` (default): estimated from the current
     /// model's residuals (their third differences), which does not depend on the σ the tracker stated.
     pub noise_m: Option<f64>,
-    /// Count significant trends of the output errors (COR, μ, outgoing velocity, contact time) across
+    /// Count significant and material trends of the output errors (COR, μ, outgoing velocity, contact time) across
     /// conditions as evidence that the current model misfits (default true).
     pub use_trends: bool,
-    /// Fit each shot's surface level as a nuisance, as the fit crate can (default false): the surface
-    /// line found in the image may be off by a fraction of a pixel on a grainy edge, which shifts the
-    /// moment of touch, a systematic residual that differs from shot to shot and that no candidate should
-    /// explain. Each evaluation then profiles the level shot by shot. Off by default because it is slow
-    /// (the 48-shot benchmark takes 117 s instead of 6 s: the profiled levels make the finite-difference
-    /// Jacobians noisy and the fits long) and because the level absorbs part of a missing contact effect
-    /// (Hertz's misfit falls from 123 µm to 27 µm). Turn it on when the current model misfits shot by
-    /// shot with no pattern the held-out test confirms.
+    /// Fit each shot's surface level as a nuisance, as the fit crate's surface offsets (default false;
+    /// `analyze` turns it on). Use it with the `surface_level` effect free per surface in the model and a
+    /// stated σ of each shot's surface line ([`MeasuredShot::surface_sigma_m`]): the shot's level is then
+    /// a deviation from its surface's within that σ. A free level per shot (no σ stated) also absorbs most
+    /// of a missing contact effect (restitution damping's 65 µm misfit falls to 16 µm on a tracked
+    /// session, the size of tracking artefacts). Every full fit alternates between the shared parameters
+    /// (levels held) and the levels (profiled shot by shot); a fold's fit holds its training shots at the
+    /// full fit's levels and profiles each left-out shot's own.
+    ///
+    /// [`MeasuredShot::surface_sigma_m`]: bouncelab_fit::MeasuredShot::surface_sigma_m
     pub surface_levels: bool,
     /// The solver of every fit to all shots: the fit crate's, with `ftol = xtol = 1e-7` (a relative change
     /// of χ² of 1e-7 decides nothing here, and stopping there makes the search three times faster) and at

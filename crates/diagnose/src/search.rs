@@ -10,7 +10,7 @@ use crate::options::{Progress, SearchOptions};
 use crate::verdict::decide;
 use crate::{DiagnoseError, FitSummary, stats};
 use bouncelab_compare::{Component, DiagnoseOptions, ShotExtras, compare, diagnose};
-use bouncelab_fit::{FitError, LevenbergMarquardt, MeasuredShot};
+use bouncelab_fit::{FitError, LevenbergMarquardt, MeasuredShot, SolverOutcome};
 use bouncelab_model::{ModelSpec, Simulation};
 use rayon::prelude::*;
 use std::time::Instant;
@@ -23,6 +23,8 @@ struct ModelRun {
     /// Per shot (input order): its residual sums when predicted by the model fitted without its fold.
     heldout: Vec<Option<ShotSums>>,
     n_params: usize,
+    /// Each shot's surface level at the full fit, m (with surface levels).
+    levels: Option<Vec<f64>>,
     seconds: f64,
 }
 
@@ -31,26 +33,35 @@ fn effect_names(spec: &ModelSpec) -> Vec<String> {
 }
 
 /// Fits `spec` to every shot from the file's values, then once per fold without that fold's shots
-/// (warm-started at the full fit), predicting each left-out shot.
+/// (warm-started at the full fit), predicting each left-out shot. With surface levels, the full fit
+/// profiles them from `seed` (the current model's, for a candidate); a fold's fit holds its training
+/// shots' levels at the full fit's values (profiling them again in every fold would multiply the
+/// search's time by ten and move them by a few µm), while each left-out shot's level is profiled on its
+/// own data, as its incoming state is.
 fn run_model(
     spec: &ModelSpec,
     shots: &[MeasuredShot],
     fold_of: &[usize],
     k: usize,
     opts: &SearchOptions,
+    seed: Option<&[f64]>,
 ) -> Result<ModelRun, FitError> {
     let clock = Instant::now();
-    let ev = Evaluator::new(spec, shots.to_vec(), opts.sim, opts.surface_levels)?;
-    let out = ev.fit(&opts.solver, &ev.problem().initial())?;
+    let mut ev = Evaluator::new(spec, shots.to_vec(), opts.sim, opts.surface_levels)?;
+    let out = match ev.levels() {
+        None => ev.fit(&opts.solver, &ev.problem().initial())?,
+        Some(zero) => fit_with_levels(&mut ev, seed.unwrap_or(&zero), opts)?,
+    };
     let sims = ev.simulate(&out.params)?;
     let per_shot = ev.per_shot(&sims);
     let sq: f64 = per_shot.iter().map(|s| s.sq_m2).sum();
     let summary = summarize(&ev, effect_names(spec), &out, sq);
     let fitted: Vec<(String, f64)> = ev.names().into_iter().zip(out.params.iter().copied()).collect();
+    let levels = ev.levels();
     // Folds in parallel (each fit also simulates its shots in parallel); collected in fold order.
     let per_fold: Vec<Vec<(usize, Option<ShotSums>)>> = (0..k)
         .into_par_iter()
-        .map(|f| heldout_fold(spec, shots, fold_of, f, &fitted, opts))
+        .map(|f| heldout_fold(spec, shots, fold_of, f, &fitted, levels.as_deref(), opts))
         .collect();
     let mut heldout = vec![None; shots.len()];
     for (i, sums) in per_fold.into_iter().flatten() {
@@ -62,8 +73,37 @@ fn run_model(
         per_shot,
         heldout,
         n_params: out.params.len() + ev.nuisance_per_shot() * shots.len(),
+        levels,
         seconds: clock.elapsed().as_secs_f64(),
     })
+}
+
+/// Fits the shared parameters and each shot's surface level by turns, from the levels `start`: the
+/// parameters with the levels held (a smooth problem for the finite-difference Jacobian), then each level
+/// profiled at those parameters, until no level moves by more than 0.5 µm (at most four rounds; the levels
+/// of a good seed move by a few µm). Profiling inside every evaluation instead finds the same optimum but
+/// takes eight times longer: the profiled levels make the Jacobian noisy and the fit long. Leaves `ev`
+/// profiling from the final levels.
+fn fit_with_levels(ev: &mut Evaluator, start: &[f64], opts: &SearchOptions) -> Result<SolverOutcome, FitError> {
+    let mut levels = start.to_vec();
+    let mut p = ev.problem().initial();
+    for _ in 0..4 {
+        ev.set_levels(&levels, false);
+        p = ev.fit(&opts.solver, &p)?.params;
+        ev.set_levels(&levels, true);
+        ev.simulate(&p)?;
+        let next = ev.levels().unwrap_or_default();
+        let moved = next.iter().zip(&levels).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+        levels = next;
+        if moved <= 0.5e-6 {
+            break;
+        }
+    }
+    // The outcome (χ², covariance) at the final levels.
+    ev.set_levels(&levels, false);
+    let out = ev.fit(&opts.solver, &p)?;
+    ev.set_levels(&levels, true);
+    Ok(out)
 }
 
 /// The shots of fold `f` predicted by the model fitted to the other folds; `None` for a shot that cannot
@@ -74,16 +114,19 @@ fn heldout_fold(
     fold_of: &[usize],
     f: usize,
     full: &[(String, f64)],
+    levels: Option<&[f64]>,
     opts: &SearchOptions,
 ) -> Vec<(usize, Option<ShotSums>)> {
     let test: Vec<usize> = (0..shots.len()).filter(|&i| fold_of[i] == f).collect();
-    let train: Vec<MeasuredShot> = (0..shots.len())
-        .filter(|&i| fold_of[i] != f)
-        .map(|i| shots[i].clone())
-        .collect();
+    let train_idx: Vec<usize> = (0..shots.len()).filter(|&i| fold_of[i] != f).collect();
+    let train: Vec<MeasuredShot> = train_idx.iter().map(|&i| shots[i].clone()).collect();
     let lookup = |table: &[(String, f64)], name: &str| table.iter().find(|(n, _)| n == name).map(|(_, v)| *v);
     let fitted: Option<Vec<(String, f64)>> = (|| {
-        let ev = Evaluator::new(spec, train, opts.sim, opts.surface_levels).ok()?;
+        let mut ev = Evaluator::new(spec, train, opts.sim, opts.surface_levels).ok()?;
+        if let Some(levels) = levels {
+            let held: Vec<f64> = train_idx.iter().map(|&i| levels[i]).collect();
+            ev.set_levels(&held, false);
+        }
         let names = ev.names();
         let p0: Vec<f64> = names.iter().map(|n| lookup(full, n)).collect::<Option<_>>()?;
         let solver = LevenbergMarquardt {
@@ -96,7 +139,10 @@ fn heldout_fold(
     test.into_iter()
         .map(|i| {
             let sums = fitted.as_ref().and_then(|fitted| {
-                let ev = Evaluator::new(spec, vec![shots[i].clone()], opts.sim, opts.surface_levels).ok()?;
+                let mut ev = Evaluator::new(spec, vec![shots[i].clone()], opts.sim, opts.surface_levels).ok()?;
+                if let Some(levels) = levels {
+                    ev.set_levels(&[levels[i]], true);
+                }
                 let theta: Vec<f64> = ev.names().iter().map(|n| lookup(fitted, n)).collect::<Option<_>>()?;
                 let sims = ev.simulate(&theta).ok()?;
                 ev.per_shot(&sims).first().copied()
@@ -151,7 +197,7 @@ pub fn find_missing_effect_with(
         total,
         what: "current model".into(),
     });
-    let base = run_model(spec, shots, &fold_of, k, options).map_err(|e| DiagnoseError::Baseline {
+    let base = run_model(spec, shots, &fold_of, k, options, None).map_err(|e| DiagnoseError::Baseline {
         model: spec.origin.clone(),
         source: Box::new(e),
     })?;
@@ -216,7 +262,14 @@ pub fn find_missing_effect_with(
     phases.sort_by(|a, b| b.chi2_share.total_cmp(&a.chi2_share));
     let signature = Signature {
         phases,
-        trends: report.trends.iter().filter(|t| t.significant).cloned().collect(),
+        // A trend counts only when it is both significant and larger than the measurement resolves
+        // (the compare crate's materiality: COR 0.002, contact time 0.05 ms, …).
+        trends: report
+            .trends
+            .iter()
+            .filter(|t| t.significant && t.material)
+            .cloned()
+            .collect(),
         sentences: report.sentences.clone(),
     };
 
@@ -243,7 +296,9 @@ pub fn find_missing_effect_with(
         });
         let run = with_candidate(&warm, &setup)
             .map_err(|e| e.to_string())
-            .and_then(|cspec| run_model(&cspec, shots, &fold_of, k, options).map_err(|e| e.to_string()));
+            .and_then(|cspec| {
+                run_model(&cspec, shots, &fold_of, k, options, base.levels.as_deref()).map_err(|e| e.to_string())
+            });
         runs.push((setup, run));
     }
 

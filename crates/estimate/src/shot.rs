@@ -87,6 +87,10 @@ pub struct Estimate {
     /// Reduced χ² of the flight fits (in x, in y, out x, out y): ≫ 1 means the tracker's σ is too small or the
     /// flight is not ballistic (drag, a bad frame).
     pub chi2_red: [f64; 4],
+    /// Standard error of the contact plane's height in the local frame, m: the surface line's (with the
+    /// correlation of its columns) and the scale's at one radius. 0 in estimates stored before it existed.
+    #[serde(default)]
+    pub surface_sigma_m: f64,
     /// Things a person should know.
     pub notes: Vec<String>,
 }
@@ -268,6 +272,7 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
         chi2_red: [fin.chi2_red[0], fin.chi2_red[1], fout.chi2_red[0], fout.chi2_red[1]],
         flight_in: fin,
         flight_out: fout,
+        surface_sigma_m: sigma_level,
         notes,
     })
 }

@@ -11,6 +11,7 @@
 //! shot order, so a fit is deterministic.
 
 mod error;
+mod measurement;
 mod params;
 mod problem;
 mod result;
@@ -21,8 +22,9 @@ pub mod testutil;
 
 pub use bouncelab_model::{ModelSpec, SimOptions, State};
 pub use error::FitError;
+pub use measurement::{observe, observes, true_start};
 pub use params::FreeParam;
-pub use problem::{Problem, profile_surface_level};
+pub use problem::{Problem, profile_surface_level, surface_prior};
 pub use result::{FitResult, FittedParam, ObliqueRow, ShotFit, SurfaceError};
 pub use shot::{MeasuredFrame, MeasuredOutputs, MeasuredShot, StartState};
 pub use solver::{

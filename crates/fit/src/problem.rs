@@ -1,10 +1,11 @@
 //! The fitting problem: measured shots, the free parameters, and the weighted residuals of the simulated
 //! trajectories against the measured ones.
 
+use crate::measurement::{observe, observes, true_start};
 use crate::params::{self, FreeParam, SurfaceModel};
 use crate::solver::LeastSquares;
 use crate::{FitError, MeasuredShot};
-use bouncelab_model::{Model, ModelSpec, SimOptions, Simulation, simulate};
+use bouncelab_model::{Model, ModelSpec, SimOptions, Simulation, State, simulate};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -33,6 +34,8 @@ pub struct Problem {
     parallel: bool,
     n_residuals: usize,
     offsets: Option<OffsetCache>,
+    /// Per shot: the measured x of the centre when it touched the surface line, m.
+    touch_x: Vec<f64>,
 }
 
 /// The last profiled surface level of each shot (f64 bits), the warm start of the next evaluation.
@@ -97,7 +100,9 @@ impl Problem {
                 params: params.len(),
             });
         }
+        let touch_x = shots.iter().map(|s| crate::measurement::touch_x(s, radius)).collect();
         Ok(Problem {
+            touch_x,
             shots,
             params,
             surfaces,
@@ -185,7 +190,7 @@ impl Problem {
         let one = |i: usize| -> Result<Simulation, FitError> {
             let model = &models[self.shot_surface[i]];
             match &self.offsets {
-                None => self.simulate_at(i, model, 0.0),
+                None => self.simulate_shot(i, model, 0.0),
                 Some(cache) => {
                     let start = f64::from_bits(cache.0[i].load(Ordering::Relaxed));
                     let (sim, level) = self.profile(i, model, start)?;
@@ -204,12 +209,31 @@ impl Problem {
         all.into_iter().collect()
     }
 
-    /// Shot `i` simulated with the true surface at height `level` in the measured frame: the start is lowered
-    /// by `level` and what the camera sees raised by it again.
-    fn simulate_at(&self, i: usize, model: &Model, level: f64) -> Result<Simulation, FitError> {
+    /// Shot `i` simulated with the true surface at height `level` in the measured frame (m): the measured
+    /// start is taken about the contact point on that surface, mapped back through the model's measurement
+    /// effects (so the simulation starts from the state whose observation was measured), and what the
+    /// camera would see is mapped to the measured frame again. Without measurement effects and at level 0
+    /// this is the plain simulation from the measured start.
+    pub fn simulate_shot(&self, i: usize, model: &Model, level: f64) -> Result<Simulation, FitError> {
         let shot = &self.shots[i];
-        let mut start = shot.start.state;
-        start.y -= level;
+        let measured = shot.start.state;
+        let observing = observes(model);
+        // The contact point in data coordinates (its x only matters with a measurement effect).
+        let origin_x = if observing {
+            let touching = State {
+                y: model.ball.radius_m,
+                ..State::default()
+            };
+            self.touch_x[i] - observe(model, &touching).x
+        } else {
+            0.0
+        };
+        let local = State {
+            x: measured.x - origin_x,
+            y: measured.y - level,
+            ..measured
+        };
+        let start = if observing { true_start(model, &local) } else { local };
         let mut sim = simulate(
             model,
             shot.incline_rad,
@@ -222,8 +246,9 @@ impl Problem {
             shot: shot.name.clone(),
             source: Box::new(source),
         })?;
-        if level != 0.0 {
+        if origin_x != 0.0 || level != 0.0 {
             for s in &mut sim.samples {
+                s.observed.x += origin_x;
                 s.observed.y += level;
             }
         }
@@ -232,7 +257,7 @@ impl Problem {
 
     /// The surface level that best fits shot `i` under `model`, from `start` (see [`profile_surface_level`]).
     fn profile(&self, i: usize, model: &Model, start: f64) -> Result<(Simulation, f64), FitError> {
-        profile_surface_level(&self.shots[i], start, |level| self.simulate_at(i, model, level))
+        profile_surface_level(&self.shots[i], start, |level| self.simulate_shot(i, model, level))
     }
 
     /// The weighted residuals of [`Problem::simulate`]'s trajectories (see the type's doc).
@@ -253,8 +278,21 @@ impl LeastSquares for Problem {
         self.params.len()
     }
 
+    /// The frames' residuals ([`Problem::residuals_of`]), then with surface offsets each shot's prior
+    /// residual ([`surface_prior`]; 0 for a shot without a stated σ), so the fit minimises what the
+    /// profile does.
     fn residuals(&self, theta: &[f64]) -> Result<Vec<f64>, FitError> {
-        Ok(self.residuals_of(&self.simulate(theta)?))
+        let mut r = self.residuals_of(&self.simulate(theta)?);
+        if self.offsets.is_some() {
+            let levels = self.offsets();
+            r.extend(
+                self.shots
+                    .iter()
+                    .zip(levels)
+                    .map(|(shot, l)| surface_prior(shot, l).unwrap_or(0.0)),
+            );
+        }
+        Ok(r)
     }
 
     fn bounds(&self, j: usize) -> (f64, f64) {
@@ -348,12 +386,20 @@ pub fn profile_surface_level(
     simulate_at: impl Fn(f64) -> Result<Simulation, FitError>,
 ) -> Result<(Simulation, f64), FitError> {
     let cost = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>();
+    // The shot's residuals and, with a stated σ of its surface line, the prior's (level / σ).
+    let resid = |sim: &Simulation, level: f64| {
+        let mut r = weighted_residuals(shot, sim);
+        if let Some(p) = surface_prior(shot, level) {
+            r.push(p);
+        }
+        r
+    };
     let mut level = start.clamp(-MAX_OFFSET_M, MAX_OFFSET_M);
     let mut sim = simulate_at(level)?;
-    let mut r = weighted_residuals(shot, &sim);
+    let mut r = resid(&sim, level);
     let mut c = cost(&r);
     // Slope of the residuals with respect to the level, from a forward difference.
-    let probe = weighted_residuals(shot, &simulate_at(level + OFFSET_STEP_M)?);
+    let probe = resid(&simulate_at(level + OFFSET_STEP_M)?, level + OFFSET_STEP_M);
     let mut slope: Vec<f64> = probe.iter().zip(&r).map(|(a, b)| (a - b) / OFFSET_STEP_M).collect();
     for _ in 0..10 {
         let jj: f64 = slope.iter().map(|j| j * j).sum();
@@ -369,7 +415,7 @@ pub fn profile_surface_level(
                 break;
             }
             let s2 = simulate_at(trial)?;
-            let r2 = weighted_residuals(shot, &s2);
+            let r2 = resid(&s2, trial);
             let c2 = cost(&r2);
             if c2 <= c {
                 let d = trial - level;
@@ -385,4 +431,11 @@ pub fn profile_surface_level(
         }
     }
     Ok((sim, level))
+}
+
+/// The prior residual of a shot's surface offset, `level / σ`, when the shot states the σ of its surface
+/// line: the offset is a deviation from the surface's level (the `surface_level` effect), as large as the
+/// line's error, not a free shift that could also absorb a missing contact effect.
+pub fn surface_prior(shot: &MeasuredShot, level: f64) -> Option<f64> {
+    shot.surface_sigma_m.filter(|s| *s > 0.0).map(|s| level / s)
 }

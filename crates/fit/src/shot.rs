@@ -52,4 +52,8 @@ pub struct MeasuredShot {
     pub start: StartState,
     /// Measured outputs, if the estimator produced them.
     pub measured: Option<MeasuredOutputs>,
+    /// Standard error of the surface line's height in this shot, m, if the tracker gave one. With
+    /// per-shot surface offsets ([`crate::Problem::with_surface_offsets`]), the shot's offset is a
+    /// deviation from the surface's level with this prior; without it, the offset is free.
+    pub surface_sigma_m: Option<f64>,
 }

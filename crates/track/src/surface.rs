@@ -170,8 +170,16 @@ fn refine_line(cands: &[(f64, f64, f64)], mut c: f64, mut slope: f64, tol: f64, 
         slope = sxy / sxx;
         let y0 = my - slope * mx;
         c = y0 - slope * xc;
-        let rss: f64 = pts.iter().map(|p| (p.1 - (y0 + slope * p.0)).powi(2)).sum();
-        let s2 = rss / (n - 2.0).max(1.0);
+        let res: Vec<f64> = pts.iter().map(|p| p.1 - (y0 + slope * p.0)).collect();
+        let rss: f64 = res.iter().map(|r| r * r).sum();
+        // Neighbouring columns share texture (each sample averages 2·HALF_BAND + 1 columns, grains and
+        // roughness span several): the residuals are correlated along the line, and the standard errors
+        // of independent residuals would be too small (3× on grainy clay). An AR(1) inflation from the
+        // lag-one correlation of the residuals in column order (n_eff = n·(1 − ρ)/(1 + ρ)).
+        let lag1: f64 = res.windows(2).map(|w| w[0] * w[1]).sum();
+        let rho = if rss > 0.0 { (lag1 / rss).clamp(0.0, 0.95) } else { 0.0 };
+        let inflation = (1.0 + rho) / (1.0 - rho);
+        let s2 = inflation * rss / (n - 2.0).max(1.0);
         let sigma_slope = (s2 / sxx).sqrt();
         result = Some(SurfaceLine {
             x0: xc,

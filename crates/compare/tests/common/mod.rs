@@ -71,6 +71,7 @@ pub fn synth_shot(
             cor: imp.restitution + SIGMA_COR * rng.normal(),
             mu: imp.effective_friction + SIGMA_MU * rng.normal(),
         }),
+        surface_sigma_m: None,
     };
     let extras = ShotExtras {
         drop_height_m: Some(height_m),

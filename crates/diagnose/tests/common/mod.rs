@@ -124,6 +124,7 @@ pub fn session(model: &Model, seed: u64, tracking: Tracking) -> Vec<MeasuredShot
                     },
                 },
                 measured: None,
+                surface_sigma_m: None,
             });
         }
     }

@@ -39,6 +39,7 @@ pub fn synth_shot(
             cor: imp.restitution,
             mu: imp.effective_friction,
         }),
+        surface_sigma_m: None,
     }
 }
 

@@ -46,3 +46,45 @@ impl Effect for CameraRoll {
         obs.theta -= phi;
     }
 }
+
+/// Surface level: the surface line found in the image lies `level_m` above the plane the ball touches.
+///
+/// The line a tracker finds is the band's visible top edge: on a grainy or lit edge it sits a fraction of
+/// a pixel off the contact plane, and a camera slightly above or below the surface sees a near or far edge.
+/// The pipeline measures heights from that line, so every measured height is `level_m` too large. A
+/// nuisance of the measurement rather than physics: `analyze` fits it per surface with the base model,
+/// and the missing-effect search never proposes it.
+#[derive(Debug, Clone)]
+pub struct SurfaceLevel {
+    /// Height of the found surface line above the contact plane, m.
+    pub level_m: f64,
+}
+
+impl SurfaceLevel {
+    /// Catalogue entry.
+    pub fn info() -> EffectInfo {
+        EffectInfo {
+            name: "surface_level",
+            doc: "Surface level: the surface line found in the image lies level_m above the plane the ball touches, so measured heights are level_m too large (a nuisance, fitted per surface).",
+            group: "nuisance",
+            base: true,
+            params: &[ParamSpec {
+                name: "level_m",
+                unit: "m",
+                doc: "height of the found surface line above the contact plane",
+                default: Some(0.0),
+                neutral: 0.0,
+                min: -0.005,
+                max: 0.005,
+            }],
+            build: |v| Box::new(SurfaceLevel { level_m: v[0] }),
+        }
+    }
+}
+
+impl Effect for SurfaceLevel {
+    effect_params!("surface_level", level_m);
+    fn observe(&self, obs: &mut Observation) {
+        obs.y += self.level_m;
+    }
+}

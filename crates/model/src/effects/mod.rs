@@ -13,7 +13,7 @@ mod tangential;
 pub use contact::{Hertz, HuntCrossley, LinearDamping, LinearSpring, PlasticDent, RestitutionDamping};
 pub use custom::{CustomPhase, CustomTerm, CustomTermSpec, FORMULA_VARIABLES, Target};
 pub use flight::QuadraticDrag;
-pub use measurement::CameraRoll;
+pub use measurement::{CameraRoll, SurfaceLevel};
 pub use tangential::{Coulomb, InertiaFactor, RollingResistance};
 
 use crate::{Ball, State};
@@ -202,7 +202,8 @@ pub struct EffectInfo {
     pub name: &'static str,
     /// One line on the physics.
     pub doc: &'static str,
-    /// Which group of SPEC §4 it belongs to ("normal", "tangential", "flight", "measurement").
+    /// Which group of SPEC §4 it belongs to ("normal", "tangential", "flight", "measurement"), or
+    /// "nuisance" for a property of the measurement fitted with the base model (the surface level).
     pub group: &'static str,
     /// True for the effects of the paper's base model.
     pub base: bool,
@@ -228,6 +229,7 @@ pub fn builtin_effects() -> &'static [EffectInfo] {
             InertiaFactor::info(),
             QuadraticDrag::info(),
             CameraRoll::info(),
+            SurfaceLevel::info(),
         ]
     })
 }

@@ -1,0 +1,90 @@
+//! `bouncelab diagnose SESSION_DIR`: the analysis of `analyze` (incremental, so measured shots are
+//! reused), printed as the missing-effect verdict with its evidence and the command that accepts it.
+
+use super::analyze::{Args, fail_on_failed_shots, run_quiet};
+use bouncelab_diagnose::VerdictKind;
+
+pub fn run(mut a: Args) -> anyhow::Result<()> {
+    a.no_diagnose = false;
+    let analysis = run_quiet(&a)?;
+    let d = match &analysis.diagnosis {
+        Ok(d) => d,
+        Err(why) => anyhow::bail!("{}: no diagnosis: {why}", a.session_dir.display()),
+    };
+    println!(
+        "{}: {} shot(s), model {}",
+        a.session_dir.display(),
+        d.shots,
+        analysis.model_origin
+    );
+    println!("verdict: {}", d.verdict.kind.name());
+    println!("{}", d.verdict.sentence);
+    println!();
+    println!("where the current model's residual sits (share of χ², systematic part above the noise):");
+    for p in d.signature.phases.iter().take(4) {
+        println!(
+            "  {:<28} {:>5.1} %  {:>7.1} µm",
+            format!("{} {}", p.component.name(), p.phase.name()),
+            100.0 * p.chi2_share,
+            p.systematic_m * 1e6
+        );
+    }
+    println!();
+    println!(
+        "  {:<22} {:>10} {:>10} {:>10} {:>9} {:>7}  checks (BIC, held-out, parameter, material)",
+        "candidate", "RMS µm", "held-out", "ΔBIC", "χ²_red", "names"
+    );
+    for c in &d.candidates {
+        match &c.evidence {
+            Some(e) => println!(
+                "  {:<22} {:>10.1} {:>10.1} {:>10.1} {:>9.2} {:>7}  {} {} {} {}",
+                c.effect,
+                e.error_after * 1e6,
+                e.heldout_error_after * 1e6,
+                e.delta_bic,
+                e.chi2_red_after,
+                if c.explains { "yes" } else { "no" },
+                mark(c.checks.bic),
+                mark(c.checks.heldout),
+                mark(c.checks.parameter),
+                mark(c.checks.material),
+            ),
+            None => println!(
+                "  {:<22} fit failed: {}",
+                c.effect,
+                c.failed.clone().unwrap_or_default()
+            ),
+        }
+    }
+    if let Some(c) = d.candidates.first() {
+        println!(
+            "  current model: RMS {:.1} µm, held-out {:.1} µm; noise {:.1} µm",
+            c.error_before * 1e6,
+            c.heldout_error_before * 1e6,
+            d.noise.noise_m * 1e6
+        );
+    }
+    let (out_dir, _) = a.paths();
+    let diagnosis = out_dir.join("diagnosis.json");
+    let model = a
+        .model
+        .as_ref()
+        .map_or_else(|| "model.toml".to_string(), |m| m.display().to_string());
+    match (d.verdict.kind, d.verdict.effect.as_deref()) {
+        (VerdictKind::MissingEffect, Some(effect)) => println!(
+            "\naccept it: bouncelab model add {effect} --model {model} --diagnosis {}",
+            diagnosis.display()
+        ),
+        (VerdictKind::Ambiguous, Some(_)) => println!(
+            "\nthe data cannot tell these apart; add one with: bouncelab model add EFFECT --model {model} --diagnosis {}",
+            diagnosis.display()
+        ),
+        _ => {}
+    }
+    println!("wrote {}", diagnosis.display());
+    fail_on_failed_shots(&analysis)
+}
+
+fn mark(ok: bool) -> &'static str {
+    if ok { "✓" } else { "✗" }
+}
