@@ -87,23 +87,25 @@ fn run_model(
 fn fit_with_levels(ev: &mut Evaluator, start: &[f64], opts: &SearchOptions) -> Result<SolverOutcome, FitError> {
     let mut levels = start.to_vec();
     let mut p = ev.problem().initial();
+    let mut last = None;
     for _ in 0..4 {
         ev.set_levels(&levels, false);
-        p = ev.fit(&opts.solver, &p)?.params;
+        let out = ev.fit(&opts.solver, &p)?;
+        p.clone_from(&out.params);
         ev.set_levels(&levels, true);
         ev.simulate(&p)?;
         let next = ev.levels().unwrap_or_default();
         let moved = next.iter().zip(&levels).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
         levels = next;
+        last = Some(out);
         if moved <= 0.5e-6 {
             break;
         }
     }
-    // The outcome (χ², covariance) at the final levels.
-    ev.set_levels(&levels, false);
-    let out = ev.fit(&opts.solver, &p)?;
+    // The outcome of the last round (its levels within 0.5 µm of the final ones, or after four rounds);
+    // `ev` profiles from the final levels.
     ev.set_levels(&levels, true);
-    Ok(out)
+    last.ok_or_else(|| FitError::BadResiduals("no round of the level fit ran".into()))
 }
 
 /// The shots of fold `f` predicted by the model fitted to the other folds; `None` for a shot that cannot

@@ -111,6 +111,9 @@ fn polar(f: &SpinFrame, o: &SpinOptions) -> Option<Polar> {
     let mut rings = Vec::with_capacity(o.rings);
     let mut energy = 0.0;
     let mut buf = vec![0.0f64; n];
+    // cos and sin of 2πj/n: the sampling angles, the low-pass's k·φ_j and the FFT's twiddles are all
+    // multiples of 2π/n (sin/cos was a quarter of a shot's measuring time).
+    let unit = UnitCircle::new(n);
     for i in 0..o.rings {
         let frac = if o.rings == 1 {
             0.5 * (o.r_inner + o.r_outer)
@@ -119,21 +122,19 @@ fn polar(f: &SpinFrame, o: &SpinOptions) -> Option<Polar> {
         };
         let rho = frac * f.r_px;
         for (j, v) in buf.iter_mut().enumerate() {
-            let phi = TAU * j as f64 / n as f64;
-            let (x, y) = (f.x_px + rho * phi.cos(), f.y_px - rho * phi.sin());
+            let (x, y) = (f.x_px + rho * unit.cos[j], f.y_px - rho * unit.sin[j]);
             if !(x >= 0.0 && y >= 0.0 && x < w - 1.0 && y < h - 1.0) {
                 return None;
             }
             *v = bilinear(f.pixels, x, y);
         }
-        let spec = fft_real(&buf);
+        let spec = fft_real_with(&buf, &unit);
         // Low-pass (harmonics 0..K_LOW) reconstruction: the shading along this ring.
         let low: Vec<f64> = (0..n)
             .map(|j| {
-                let phi = TAU * j as f64 / n as f64;
                 let mut s = spec[0].0 / n as f64;
                 for (k, c) in spec.iter().enumerate().take(K_LOW).skip(1) {
-                    let (sn, cs) = (k as f64 * phi).sin_cos();
+                    let (sn, cs) = (unit.sin[k * j % n], unit.cos[k * j % n]);
                     s += 2.0 / n as f64 * (c.0 * cs - c.1 * sn);
                 }
                 s
@@ -145,7 +146,7 @@ fn polar(f: &SpinFrame, o: &SpinOptions) -> Option<Polar> {
         for (v, l) in buf.iter_mut().zip(&low) {
             *v = *v / l - 1.0;
         }
-        let spec = fft_real(&buf);
+        let spec = fft_real_with(&buf, &unit);
         let k_max = ((TAU * rho / MIN_WAVELENGTH_PX) as usize).min(n / 2 - 1);
         let band: Vec<(f64, f64)> = if k_max > K_LOW {
             spec[K_LOW..=k_max].to_vec()
@@ -174,9 +175,29 @@ fn bilinear(p: &GrayPixels, x: f64, y: f64) -> f64 {
     top + fy * (bottom - top)
 }
 
+/// cos and sin of 2πj/n for j in 0..n.
+struct UnitCircle {
+    cos: Vec<f64>,
+    sin: Vec<f64>,
+}
+
+impl UnitCircle {
+    fn new(n: usize) -> UnitCircle {
+        let (sin, cos) = (0..n).map(|j| (TAU * j as f64 / n as f64).sin_cos()).unzip();
+        UnitCircle { cos, sin }
+    }
+}
+
 /// The DFT X_k = Σ x_j e^{−2πi jk/N} of a real sequence whose length is a power of two (radix-2).
+#[cfg(test)]
 fn fft_real(x: &[f64]) -> Vec<(f64, f64)> {
+    fft_real_with(x, &UnitCircle::new(x.len()))
+}
+
+/// [`fft_real`] with the twiddles taken from `unit` (of the same length).
+fn fft_real_with(x: &[f64], unit: &UnitCircle) -> Vec<(f64, f64)> {
     let n = x.len();
+    debug_assert_eq!(unit.cos.len(), n);
     assert!(n.is_power_of_two(), "FFT length must be a power of two");
     let bits = n.trailing_zeros();
     let mut a: Vec<(f64, f64)> = vec![(0.0, 0.0); n];
@@ -190,10 +211,11 @@ fn fft_real(x: &[f64]) -> Vec<(f64, f64)> {
     }
     let mut len = 2;
     while len <= n {
-        let ang = -TAU / len as f64;
+        let stride = n / len;
         for start in (0..n).step_by(len) {
             for m in 0..len / 2 {
-                let (s, c) = (ang * m as f64).sin_cos();
+                // e^{−2πi m/len} = e^{−2πi (m·stride)/n}.
+                let (s, c) = (-unit.sin[m * stride], unit.cos[m * stride]);
                 let (u, v) = (a[start + m], a[start + m + len / 2]);
                 let t = (v.0 * c - v.1 * s, v.0 * s + v.1 * c);
                 a[start + m] = (u.0 + t.0, u.1 + t.1);
@@ -223,9 +245,14 @@ fn correlate(a: &Polar, b: &Polar, n: usize) -> Option<Rotation> {
     // C and its derivatives at α.
     let eval = |alpha: f64| {
         let (mut c, mut d1, mut d2) = (0.0, 0.0, 0.0);
+        // e^{ikα} by rotation from k = K_LOW (two sin/cos per evaluation instead of one per harmonic).
+        let (s1, c1) = alpha.sin_cos();
+        let (mut sn, mut cs) = (K_LOW as f64 * alpha).sin_cos();
         for (i, sk) in s.iter().enumerate() {
             let k = (K_LOW + i) as f64;
-            let (sn, cs) = (k * alpha).sin_cos();
+            if i > 0 {
+                (sn, cs) = (sn * c1 + cs * s1, cs * c1 - sn * s1);
+            }
             let re = sk.0 * cs - sk.1 * sn;
             let im = sk.0 * sn + sk.1 * cs;
             c += re;
