@@ -534,8 +534,9 @@ pub fn diagnose(comparison: &Comparison, opts: &DiagnoseOptions) -> FailureRepor
     } else if significant.is_empty() {
         match trends.first() {
             Some(t) => sentences.push(format!(
-                "No trend across conditions (smallest p = {:.2} over {m} tests, {:.2} after Holm's correction).",
-                t.p, t.p_holm
+                "No trend across conditions (smallest {} over {m} tests, {:.3} after Holm's correction).",
+                p_text(t.p),
+                t.p_holm
             )),
             None => sentences.push("No trend could be tested (too few shots or conditions).".into()),
         }
