@@ -108,12 +108,18 @@ impl Evaluator {
     /// Simulates every shot with `theta` at its frame times, in shot order (parallel over shots); with
     /// surface levels, each shot's level is profiled (warm-started at its last value).
     pub fn simulate(&self, theta: &[f64]) -> Result<Vec<Simulation>, FitError> {
+        let all: Vec<usize> = (0..self.problem.shots().len()).collect();
+        self.simulate_some(theta, &all)
+    }
+
+    /// Simulates the shots `which` with `theta`, in that order (see [`Evaluator::simulate`]).
+    fn simulate_some(&self, theta: &[f64], which: &[usize]) -> Result<Vec<Simulation>, FitError> {
         let models = self
             .surfaces
             .iter()
             .map(|s| self.problem.model_for(s, theta))
             .collect::<Result<Vec<_>, _>>()?;
-        let one = |i: usize| -> Result<Simulation, FitError> {
+        let one = |&i: &usize| -> Result<Simulation, FitError> {
             let model = &models[self.shot_surface[i]];
             match &self.levels {
                 Levels::None => self.simulate_at(i, model, 0.0),
@@ -127,7 +133,7 @@ impl Evaluator {
                 }
             }
         };
-        let all: Vec<Result<Simulation, FitError>> = (0..self.problem.shots().len()).into_par_iter().map(one).collect();
+        let all: Vec<Result<Simulation, FitError>> = which.par_iter().map(one).collect();
         all.into_iter().collect()
     }
 
@@ -190,6 +196,30 @@ impl LeastSquares for Evaluator {
                     .zip(levels)
                     .map(|(shot, l)| surface_prior(shot, l).unwrap_or(0.0)),
             );
+        }
+        Ok(r)
+    }
+
+    /// Only the shots of parameter `j`'s surface are simulated again ([`Problem::shots_of_param`]).
+    fn residuals_changing(&self, theta: &[f64], j: usize, base: &[f64]) -> Result<Vec<f64>, FitError> {
+        let Some(which) = self.problem.shots_of_param(j) else {
+            return self.residuals(theta);
+        };
+        let sims = self.simulate_some(theta, &which)?;
+        let mut r = base.to_vec();
+        let levels = self.levels();
+        let n_frames = self.problem.n_residuals();
+        for (&i, sim) in which.iter().zip(&sims) {
+            let shot = &self.problem.shots()[i];
+            let mut at = self.problem.first_residual(i);
+            for (f, s) in shot.frames.iter().zip(&sim.samples) {
+                r[at] = (s.observed.x - f.x_m) / f.sigma_m;
+                r[at + 1] = (s.observed.y - f.y_m) / f.sigma_m;
+                at += 2;
+            }
+            if let Some(levels) = &levels {
+                r[n_frames + i] = surface_prior(shot, levels[i]).unwrap_or(0.0);
+            }
         }
         Ok(r)
     }

@@ -36,6 +36,8 @@ pub struct Problem {
     offsets: Option<OffsetCache>,
     /// Per shot: the measured x of the centre when it touched the surface line, m.
     touch_x: Vec<f64>,
+    /// Per shot: the index of its first residual.
+    first_residual: Vec<usize>,
 }
 
 /// The last profiled surface level of each shot (f64 bits), the warm start of the next evaluation.
@@ -101,8 +103,17 @@ impl Problem {
             });
         }
         let touch_x = shots.iter().map(|s| crate::measurement::touch_x(s, radius)).collect();
+        let first_residual = shots
+            .iter()
+            .scan(0, |at, s| {
+                let first = *at;
+                *at += 2 * s.frames.len();
+                Some(first)
+            })
+            .collect();
         Ok(Problem {
             touch_x,
+            first_residual,
             shots,
             params,
             surfaces,
@@ -186,8 +197,14 @@ impl Problem {
 
     /// Simulates every shot with `theta` at its frame times, in shot order.
     pub fn simulate(&self, theta: &[f64]) -> Result<Vec<Simulation>, FitError> {
+        let all: Vec<usize> = (0..self.shots.len()).collect();
+        self.simulate_some(theta, &all)
+    }
+
+    /// Simulates the shots `which` with `theta`, in that order (see [`Problem::simulate`]).
+    pub fn simulate_some(&self, theta: &[f64], which: &[usize]) -> Result<Vec<Simulation>, FitError> {
         let models: Vec<Model> = self.surfaces.iter().map(|s| s.model(theta)).collect::<Result<_, _>>()?;
-        let one = |i: usize| -> Result<Simulation, FitError> {
+        let one = |&i: &usize| -> Result<Simulation, FitError> {
             let model = &models[self.shot_surface[i]];
             match &self.offsets {
                 None => self.simulate_shot(i, model, 0.0),
@@ -202,11 +219,27 @@ impl Problem {
         // Collected in shot order either way, so the result does not depend on the scheduling; the first
         // failing shot in order is reported.
         let all: Vec<Result<Simulation, FitError>> = if self.parallel {
-            (0..self.shots.len()).into_par_iter().map(one).collect()
+            which.par_iter().map(one).collect()
         } else {
-            (0..self.shots.len()).map(one).collect()
+            which.iter().map(one).collect()
         };
         all.into_iter().collect()
+    }
+
+    /// The shots whose simulation parameter `j` changes: those of its surface for a per-surface parameter,
+    /// `None` (every shot) for a shared one.
+    pub fn shots_of_param(&self, j: usize) -> Option<Vec<usize>> {
+        let surface = self.params.get(j)?.surface.as_deref()?;
+        Some(
+            (0..self.shots.len())
+                .filter(|&i| self.shots[i].surface == surface)
+                .collect(),
+        )
+    }
+
+    /// Index of shot `i`'s first residual in [`Problem::residuals_of`]'s vector.
+    pub fn first_residual(&self, i: usize) -> usize {
+        self.first_residual[i]
     }
 
     /// Shot `i` simulated with the true surface at height `level` in the measured frame (m): the measured
@@ -291,6 +324,25 @@ impl LeastSquares for Problem {
                     .zip(levels)
                     .map(|(shot, l)| surface_prior(shot, l).unwrap_or(0.0)),
             );
+        }
+        Ok(r)
+    }
+
+    /// Only the shots of parameter `j`'s surface are simulated again (see [`Problem::shots_of_param`]).
+    fn residuals_changing(&self, theta: &[f64], j: usize, base: &[f64]) -> Result<Vec<f64>, FitError> {
+        let Some(which) = self.shots_of_param(j) else {
+            return self.residuals(theta);
+        };
+        let sims = self.simulate_some(theta, &which)?;
+        let mut r = base.to_vec();
+        let levels = self.offsets.as_ref().map(|_| self.offsets());
+        for (&i, sim) in which.iter().zip(&sims) {
+            let shot = &self.shots[i];
+            let at = self.first_residual[i];
+            r[at..at + 2 * shot.frames.len()].copy_from_slice(&weighted_residuals(shot, sim));
+            if let Some(levels) = &levels {
+                r[self.n_residuals + i] = surface_prior(shot, levels[i]).unwrap_or(0.0);
+            }
         }
         Ok(r)
     }

@@ -22,6 +22,12 @@ pub trait LeastSquares: Sync {
     fn scale(&self, _j: usize) -> f64 {
         1.0
     }
+    /// The residual vector at `p`, which differs from the point whose residuals are `base` only in
+    /// parameter `j`: a problem whose parameter touches only some residuals (a per-surface parameter and
+    /// that surface's shots) recomputes only those and copies the rest. By default, all of them.
+    fn residuals_changing(&self, p: &[f64], _j: usize, _base: &[f64]) -> Result<Vec<f64>, FitError> {
+        self.residuals(p)
+    }
 }
 
 /// What the solver reports after each iteration (iteration 0 is the starting point).
@@ -210,8 +216,18 @@ impl<P: LeastSquares> Eval<'_, P> {
     }
 
     fn residuals(&mut self, u: &[f64], n: Option<usize>) -> Result<DVector<f64>, FitError> {
-        self.count += 1;
         let r = self.problem.residuals(&self.params(u))?;
+        self.check(r, n)
+    }
+
+    /// The residuals at `u`, which differs from the point of `base` only in coordinate `j`.
+    fn residuals_changing(&mut self, u: &[f64], j: usize, base: &DVector<f64>) -> Result<DVector<f64>, FitError> {
+        let r = self.problem.residuals_changing(&self.params(u), j, base.as_slice())?;
+        self.check(r, Some(base.len()))
+    }
+
+    fn check(&mut self, r: Vec<f64>, n: Option<usize>) -> Result<DVector<f64>, FitError> {
+        self.count += 1;
         if let Some(n) = n
             && r.len() != n
         {
@@ -234,13 +250,13 @@ impl<P: LeastSquares> Eval<'_, P> {
             let col = if u[j] + h <= hi && u[j] - h >= lo {
                 up[j] += h;
                 dn[j] -= h;
-                (self.residuals(&up, Some(n))? - self.residuals(&dn, Some(n))?) / (2.0 * h)
+                (self.residuals_changing(&up, j, r0)? - self.residuals_changing(&dn, j, r0)?) / (2.0 * h)
             } else if u[j] + h <= hi {
                 up[j] += h;
-                (self.residuals(&up, Some(n))? - r0) / h
+                (self.residuals_changing(&up, j, r0)? - r0) / h
             } else {
                 dn[j] -= h;
-                (r0 - self.residuals(&dn, Some(n))?) / h
+                (r0 - self.residuals_changing(&dn, j, r0)?) / h
             };
             jac.set_column(j, &col);
         }
