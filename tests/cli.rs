@@ -38,7 +38,12 @@ fn demo_names_the_hidden_effect_and_the_error_falls() {
         .expect("a before/after total");
     let nums: Vec<f64> = total.split_whitespace().filter_map(|w| w.parse().ok()).collect();
     assert!(nums[0] / nums[1] >= 3.0, "the error must fall at least 3×: {total}");
-    assert!(dir.path().join("demo/results/report.html").exists());
+    // The report shows the verdict and the error before and after, per shot.
+    let report = std::fs::read_to_string(dir.path().join("demo/results/report.html")).unwrap();
+    assert!(report.contains("Diagnosis: which effect is missing"));
+    assert!(report.contains("hunt_crossley"));
+    assert!(report.contains("Fit error per shot, before and after"));
+    assert!(report.contains("before: built-in paper model (version 1)"));
 }
 
 #[test]
