@@ -66,10 +66,14 @@ pub(crate) fn session_key(session: &Session) -> String {
         .to_string()
 }
 
+/// Raised whenever the tracker or the estimator changes what they record for a shot, so that shots
+/// measured by an earlier build are measured again (2: estimates carry the surface line's σ).
+const MEASUREMENT_REVISION: u32 = 2;
+
 /// Everything besides the frame files that changes a shot's track or estimate.
 fn settings_text(session: &Session, entry: &ClipEntry, gravity: f64) -> String {
     format!(
-        "bouncelab {} | fps {} | downslope {:?} | diameter {} | angle {} | gravity {} | tracker {:?}",
+        "bouncelab {} rev {MEASUREMENT_REVISION} | fps {} | downslope {:?} | diameter {} | angle {} | gravity {} | tracker {:?}",
         env!("CARGO_PKG_VERSION"),
         entry.fps,
         entry.downslope,
