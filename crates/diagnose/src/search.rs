@@ -81,9 +81,13 @@ fn run_model(
 /// Fits the shared parameters and each shot's surface level by turns, from the levels `start`: the
 /// parameters with the levels held (a smooth problem for the finite-difference Jacobian), then each level
 /// profiled at those parameters, until no level moves by more than 0.5 µm (at most four rounds; the levels
-/// of a good seed move by a few µm). Profiling inside every evaluation instead finds the same optimum but
-/// takes eight times longer: the profiled levels make the Jacobian noisy and the fit long. Leaves `ev`
-/// profiling from the final levels.
+/// of a good seed move by a few µm). Profiling inside every evaluation instead (as the fit crate does)
+/// took eight times longer on the benchmark: the profiled levels make the Jacobian noisy and the fit
+/// long. Block-wise descent stops where neither block moves, which from levels at 0 can be a worse point
+/// than the fit crate's joint optimum (current model 35.5 µm here against the fit's 18.7 µm on a tracked
+/// plastic-dent session). Starting the search at the fit's levels instead left every candidate stuck
+/// at them (five effect sessions went `none_explains`), so every model starts from levels at 0 and is
+/// compared from the same start. Leaves `ev` profiling from the final levels.
 fn fit_with_levels(ev: &mut Evaluator, start: &[f64], opts: &SearchOptions) -> Result<SolverOutcome, FitError> {
     let mut levels = start.to_vec();
     let mut p = ev.problem().initial();
