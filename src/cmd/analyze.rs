@@ -2,6 +2,7 @@
 
 use anyhow::Context;
 use bouncelab_analyze::{Analysis, AnalyzeOptions, Progress, Stage, analyze};
+use bouncelab_diagnose::Diagnosis;
 use bouncelab_store::ClipFingerprint;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -131,6 +132,51 @@ pub fn fail_on_failed_shots(analysis: &Analysis) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The ranked candidates of a diagnosis (the first `limit`), with the four checks of each if `checks`.
+pub fn print_candidates(d: &Diagnosis, limit: usize, checks: bool) {
+    let legend = if checks {
+        "  checks (BIC, held-out, parameter, material)"
+    } else {
+        ""
+    };
+    println!(
+        "  {:<22} {:>10} {:>10} {:>10} {:>9} {:>9}{legend}",
+        "candidate", "RMS µm", "held-out", "ΔBIC", "χ²_red", "explains"
+    );
+    let mark = |ok: bool| if ok { "✓" } else { "✗" };
+    for c in d.candidates.iter().take(limit) {
+        match &c.evidence {
+            Some(e) => {
+                let marks = if checks {
+                    format!(
+                        "  {} {} {} {}",
+                        mark(c.checks.bic),
+                        mark(c.checks.heldout),
+                        mark(c.checks.parameter),
+                        mark(c.checks.material)
+                    )
+                } else {
+                    String::new()
+                };
+                println!(
+                    "  {:<22} {:>10.1} {:>10.1} {:>10.1} {:>9.2} {:>9}{marks}",
+                    c.effect,
+                    e.error_after * 1e6,
+                    e.heldout_error_after * 1e6,
+                    e.delta_bic,
+                    e.chi2_red_after,
+                    if c.explains { "yes" } else { "no" }
+                )
+            }
+            None => println!(
+                "  {:<22} fit failed: {}",
+                c.effect,
+                c.failed.clone().unwrap_or_default()
+            ),
+        }
+    }
+}
+
 pub fn print_summary(a: &Analysis) {
     println!(
         "{}: {} shot(s) listed, {} measured now, {} reused, {} failed",
@@ -161,28 +207,7 @@ pub fn print_summary(a: &Analysis) {
     }
     if let Ok(d) = &a.diagnosis {
         println!("diagnosis: {}", d.verdict.sentence);
-        println!(
-            "  {:<22} {:>10} {:>10} {:>9} {:>11} {:>9}",
-            "candidate", "RMS µm", "held-out", "ΔBIC", "χ²_red", "explains"
-        );
-        for c in d.candidates.iter().take(5) {
-            match &c.evidence {
-                Some(e) => println!(
-                    "  {:<22} {:>10.1} {:>10.1} {:>9.1} {:>11.2} {:>9}",
-                    c.effect,
-                    e.error_after * 1e6,
-                    e.heldout_error_after * 1e6,
-                    e.delta_bic,
-                    e.chi2_red_after,
-                    if c.explains { "yes" } else { "no" }
-                ),
-                None => println!(
-                    "  {:<22} fit failed: {}",
-                    c.effect,
-                    c.failed.clone().unwrap_or_default()
-                ),
-            }
-        }
+        print_candidates(d, 5, false);
         if let Some(c) = d.candidates.first() {
             println!(
                 "  (current model: RMS {:.1} µm, held-out {:.1} µm)",

@@ -1,7 +1,7 @@
 //! `bouncelab diagnose SESSION_DIR`: the analysis of `analyze` (incremental, so measured shots are
 //! reused), printed as the missing-effect verdict with its evidence and the command that accepts it.
 
-use super::analyze::{Args, fail_on_failed_shots, run_quiet};
+use super::analyze::{Args, fail_on_failed_shots, print_candidates, run_quiet};
 use bouncelab_diagnose::VerdictKind;
 
 pub fn run(mut a: Args) -> anyhow::Result<()> {
@@ -30,32 +30,7 @@ pub fn run(mut a: Args) -> anyhow::Result<()> {
         );
     }
     println!();
-    println!(
-        "  {:<22} {:>10} {:>10} {:>10} {:>9} {:>7}  checks (BIC, held-out, parameter, material)",
-        "candidate", "RMS µm", "held-out", "ΔBIC", "χ²_red", "names"
-    );
-    for c in &d.candidates {
-        match &c.evidence {
-            Some(e) => println!(
-                "  {:<22} {:>10.1} {:>10.1} {:>10.1} {:>9.2} {:>7}  {} {} {} {}",
-                c.effect,
-                e.error_after * 1e6,
-                e.heldout_error_after * 1e6,
-                e.delta_bic,
-                e.chi2_red_after,
-                if c.explains { "yes" } else { "no" },
-                mark(c.checks.bic),
-                mark(c.checks.heldout),
-                mark(c.checks.parameter),
-                mark(c.checks.material),
-            ),
-            None => println!(
-                "  {:<22} fit failed: {}",
-                c.effect,
-                c.failed.clone().unwrap_or_default()
-            ),
-        }
-    }
+    print_candidates(d, d.candidates.len(), true);
     if let Some(c) = d.candidates.first() {
         println!(
             "  current model: RMS {:.1} µm, held-out {:.1} µm; noise {:.1} µm",
@@ -83,8 +58,4 @@ pub fn run(mut a: Args) -> anyhow::Result<()> {
     }
     println!("wrote {}", diagnosis.display());
     fail_on_failed_shots(&analysis)
-}
-
-fn mark(ok: bool) -> &'static str {
-    if ok { "✓" } else { "✗" }
 }

@@ -7,10 +7,9 @@
 
 use bouncelab_fit::{
     FitError, LeastSquares, LevenbergMarquardt, MeasuredShot, NoObserver, Problem, SolverOutcome, Termination,
-    profile_surface_level, surface_prior,
+    normal_inverse, profile_surface_level, surface_prior, weighted_residuals,
 };
 use bouncelab_model::{Model, ModelSpec, SimOptions, Simulation};
-use nalgebra::DMatrix;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use statrs::distribution::{ContinuousCDF, StudentsT};
@@ -182,10 +181,7 @@ impl LeastSquares for Evaluator {
         let sims = self.simulate(theta)?;
         let mut r = Vec::with_capacity(self.problem.n_residuals());
         for (shot, sim) in self.problem.shots().iter().zip(&sims) {
-            for (f, s) in shot.frames.iter().zip(&sim.samples) {
-                r.push((s.observed.x - f.x_m) / f.sigma_m);
-                r.push((s.observed.y - f.y_m) / f.sigma_m);
-            }
+            r.extend(weighted_residuals(shot, sim));
         }
         // Each shot's surface-level prior, as the fit crate adds it.
         if let Some(levels) = self.levels() {
@@ -211,12 +207,8 @@ impl LeastSquares for Evaluator {
         let n_frames = self.problem.n_residuals();
         for (&i, sim) in which.iter().zip(&sims) {
             let shot = &self.problem.shots()[i];
-            let mut at = self.problem.first_residual(i);
-            for (f, s) in shot.frames.iter().zip(&sim.samples) {
-                r[at] = (s.observed.x - f.x_m) / f.sigma_m;
-                r[at + 1] = (s.observed.y - f.y_m) / f.sigma_m;
-                at += 2;
-            }
+            let at = self.problem.first_residual(i);
+            r[at..at + 2 * shot.frames.len()].copy_from_slice(&weighted_residuals(shot, sim));
             if let Some(levels) = &levels {
                 r[n_frames + i] = surface_prior(shot, levels[i]).unwrap_or(0.0);
             }
@@ -297,28 +289,6 @@ impl FitSummary {
     }
 }
 
-/// Inverts `JᵀJ`, equilibrated; `None` when singular (as the fit crate does).
-fn inverse(jac: &DMatrix<f64>) -> Option<DMatrix<f64>> {
-    let a = jac.transpose() * jac;
-    let d: Vec<f64> = (0..a.ncols()).map(|j| a[(j, j)].sqrt()).collect();
-    if d.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
-        return None;
-    }
-    let scaled = DMatrix::from_fn(a.nrows(), a.ncols(), |i, j| a[(i, j)] / (d[i] * d[j]));
-    let eig = scaled.clone().symmetric_eigen();
-    let (min, max) = eig
-        .eigenvalues
-        .iter()
-        .fold((f64::INFINITY, 0.0f64), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
-    if min.is_nan() || min <= 1e-12 * max {
-        return None;
-    }
-    let inv = scaled.cholesky()?.inverse();
-    Some(DMatrix::from_fn(a.nrows(), a.ncols(), |i, j| {
-        inv[(i, j)] / (d[i] * d[j])
-    }))
-}
-
 /// The summary of a solver outcome on `ev`.
 pub(crate) fn summarize(ev: &Evaluator, effects: Vec<String>, out: &SolverOutcome, sq_m2: f64) -> FitSummary {
     let n = out.residuals.len();
@@ -328,7 +298,11 @@ pub(crate) fn summarize(ev: &Evaluator, effects: Vec<String>, out: &SolverOutcom
     let t = StudentsT::new(0.0, 1.0, dof as f64)
         .map(|t| t.inverse_cdf(0.975))
         .unwrap_or(1.96);
-    let cov = out.jacobian.as_ref().and_then(inverse).map(|c| c * chi2_red.max(1.0));
+    let cov = out
+        .jacobian
+        .as_ref()
+        .and_then(normal_inverse)
+        .map(|c| c * chi2_red.max(1.0));
     let parameters = ev
         .problem
         .params()

@@ -24,8 +24,8 @@ pub use bouncelab_model::{ModelSpec, SimOptions, State};
 pub use error::FitError;
 pub use measurement::{observe, observes, true_start};
 pub use params::FreeParam;
-pub use problem::{Problem, profile_surface_level, surface_prior};
-pub use result::{FitResult, FittedParam, ObliqueRow, ShotFit, SurfaceError};
+pub use problem::{Problem, profile_surface_level, surface_prior, weighted_residuals};
+pub use result::{FitResult, FittedParam, ObliqueRow, ShotFit, SurfaceError, normal_inverse};
 pub use shot::{MeasuredFrame, MeasuredOutputs, MeasuredShot, StartState};
 pub use solver::{
     Iteration, LeastSquares, LevenbergMarquardt, LogObserver, NoObserver, Observer, SolverOutcome, Termination,

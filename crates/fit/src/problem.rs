@@ -297,10 +297,7 @@ impl Problem {
     pub fn residuals_of(&self, sims: &[Simulation]) -> Vec<f64> {
         let mut r = Vec::with_capacity(self.n_residuals);
         for (shot, sim) in self.shots.iter().zip(sims) {
-            for (f, s) in shot.frames.iter().zip(&sim.samples) {
-                r.push((s.observed.x - f.x_m) / f.sigma_m);
-                r.push((s.observed.y - f.y_m) / f.sigma_m);
-            }
+            r.extend(weighted_residuals(shot, sim));
         }
         r
     }
@@ -417,8 +414,9 @@ fn check_shot(shot: &MeasuredShot, radius: f64) -> Result<(), FitError> {
     Ok(())
 }
 
-/// Shot `shot`'s weighted residuals against a simulation sampled at its frame times.
-fn weighted_residuals(shot: &MeasuredShot, sim: &Simulation) -> Vec<f64> {
+/// Shot `shot`'s weighted residuals `(x_sim − x_m)/σ, (y_sim − y_m)/σ` frame by frame, against what the
+/// camera sees of a simulation sampled at its frame times.
+pub fn weighted_residuals(shot: &MeasuredShot, sim: &Simulation) -> Vec<f64> {
     let mut r = Vec::with_capacity(2 * sim.samples.len());
     for (f, s) in shot.frames.iter().zip(&sim.samples) {
         r.push((s.observed.x - f.x_m) / f.sigma_m);

@@ -145,8 +145,9 @@ impl FitResult {
     }
 }
 
-/// Inverts `JᵀJ` (symmetric positive definite when the parameters are determined).
-fn inverse(jac: &DMatrix<f64>) -> Option<DMatrix<f64>> {
+/// Inverts `JᵀJ` (symmetric positive definite when the parameters are determined), equilibrated so the
+/// condition test is about the parameters' correlation; `None` when singular or ill-conditioned.
+pub fn normal_inverse(jac: &DMatrix<f64>) -> Option<DMatrix<f64>> {
     let a = jac.transpose() * jac;
     // Equilibrate so the condition test is about the parameters' correlation, not their units.
     let d: Vec<f64> = (0..a.ncols()).map(|j| a[(j, j)].sqrt()).collect();
@@ -213,7 +214,7 @@ pub(crate) fn build(
     let t_quantile = StudentsT::new(0.0, 1.0, dof as f64)
         .map(|t| t.inverse_cdf(0.5 + confidence / 2.0))
         .unwrap_or(f64::NAN);
-    let cov = out.jacobian.as_ref().and_then(inverse).map(|c| {
+    let cov = out.jacobian.as_ref().and_then(normal_inverse).map(|c| {
         let classical = &c * covariance_scale;
         match cluster_robust(&c, out, problem) {
             // Residuals within a shot share systematic errors (the track's bias in contact, the scale), so
