@@ -266,23 +266,47 @@ impl Problem {
             y: measured.y - level,
             ..measured
         };
-        let start = if observing { true_start(model, &local) } else { local };
-        let mut sim = simulate(
-            model,
-            shot.incline_rad,
-            shot.start.t_s,
-            start,
-            &self.times[i],
-            &self.sim,
-        )
-        .map_err(|source| FitError::Simulation {
-            shot: shot.name.clone(),
-            source: Box::new(source),
-        })?;
-        if origin_x != 0.0 || level != 0.0 {
-            for s in &mut sim.samples {
-                s.observed.x += origin_x;
-                s.observed.y += level;
+        let run = |local: &State| -> Result<Simulation, FitError> {
+            let start = if observing { true_start(model, local) } else { *local };
+            let mut sim = simulate(
+                model,
+                shot.incline_rad,
+                shot.start.t_s,
+                start,
+                &self.times[i],
+                &self.sim,
+            )
+            .map_err(|source| FitError::Simulation {
+                shot: shot.name.clone(),
+                source: Box::new(source),
+            })?;
+            if origin_x != 0.0 || level != 0.0 {
+                for s in &mut sim.samples {
+                    s.observed.x += origin_x;
+                    s.observed.y += level;
+                }
+            }
+            Ok(sim)
+        };
+        let mut local = local;
+        let mut sim = run(&local)?;
+        // The measured start comes from a ballistic arc. Under a model whose flight is not ballistic (drag,
+        // a custom flight term) that arc's start is biased, and the model could never fit the flight it
+        // predicts; so its start is re-measured under the model itself: position and velocity corrected to
+        // fit the incoming frames, by Gauss–Newton with the ballistic Jacobian (exact without flight loads,
+        // within the loads' small share of gravity otherwise). A fixed number of steps keeps the residuals
+        // a smooth function of the parameters.
+        let loads = model.flight_loads(&local, shot.incline_rad);
+        if loads.force_x != 0.0 || loads.force_y != 0.0 {
+            for _ in 0..INCOMING_STEPS {
+                let Some([dx, dvx, dy, dvy]) = incoming_correction(shot, &sim) else {
+                    break;
+                };
+                local.x += dx;
+                local.vx += dvx;
+                local.y += dy;
+                local.vy += dvy;
+                sim = run(&local)?;
             }
         }
         Ok(sim)
@@ -488,4 +512,42 @@ pub fn profile_surface_level(
 /// line's error, not a free shift that could also absorb a missing contact effect.
 pub fn surface_prior(shot: &MeasuredShot, level: f64) -> Option<f64> {
     shot.surface_sigma_m.filter(|s| *s > 0.0).map(|s| level / s)
+}
+
+/// Gauss–Newton steps of the incoming state under a model with flight loads (one: its ballistic Jacobian
+/// leaves ~1 % of a correction that is itself a few mm/s) (see [`Problem::simulate_shot`]).
+const INCOMING_STEPS: usize = 1;
+
+/// The change of start position and velocity `[dx, dvx, dy, dvy]` that best fits the frames before the
+/// simulated touch, to first order (weighted by σ; per axis, position and velocity against `t − t_start`).
+/// `None` with fewer than 3 such frames.
+fn incoming_correction(shot: &MeasuredShot, sim: &Simulation) -> Option<[f64; 4]> {
+    let t0 = shot.start.t_s;
+    // Weighted sums for the two-parameter line fit of each axis' residual.
+    let (mut sw, mut st, mut stt, mut sx, mut stx, mut sy, mut sty) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    let mut n = 0;
+    for (f, s) in shot.frames.iter().zip(&sim.samples) {
+        if f.t_s >= sim.impact.t_touch || s.phase.in_contact() {
+            break;
+        }
+        let w = 1.0 / (f.sigma_m * f.sigma_m);
+        let tau = f.t_s - t0;
+        let (rx, ry) = (f.x_m - s.observed.x, f.y_m - s.observed.y);
+        sw += w;
+        st += w * tau;
+        stt += w * tau * tau;
+        sx += w * rx;
+        stx += w * tau * rx;
+        sy += w * ry;
+        sty += w * tau * ry;
+        n += 1;
+    }
+    let det = sw * stt - st * st;
+    if n < 3 || det.is_nan() || det <= 0.0 {
+        return None;
+    }
+    let line = |s: f64, ts: f64| ((stt * s - st * ts) / det, (sw * ts - st * s) / det);
+    let (dx, dvx) = line(sx, stx);
+    let (dy, dvy) = line(sy, sty);
+    Some([dx, dvx, dy, dvy])
 }

@@ -1,7 +1,7 @@
 //! A model: a ball, gravity and a list of effects.
 
-use crate::effects::{Coulomb, Effect, LinearDamping, LinearSpring};
-use crate::{Ball, ModelError};
+use crate::effects::{Context, Coulomb, Effect, LinearDamping, LinearSpring, Loads, Phase};
+use crate::{Ball, ModelError, State};
 
 /// Standard gravity, m/s² (the paper's value).
 pub const STANDARD_GRAVITY: f64 = 9.81;
@@ -97,6 +97,32 @@ impl Model {
     pub fn inertia(&self) -> f64 {
         self.ball.inertia(self.effects.iter().map(|e| e.inertia_shift()).sum())
     }
+
+    /// The loads the effects add on the ball in flight at `state` on a surface inclined by `incline` rad
+    /// (air drag, a custom flight term): all zero when the flight is ballistic. Lets a fit tell whether a
+    /// measured ballistic arc is still this model's flight.
+    pub fn flight_loads(&self, state: &State, incline: f64) -> Loads {
+        let r = self.ball.radius_m;
+        let ctx = Context {
+            t: 0.0,
+            state,
+            phase: Phase::Flight,
+            delta: r - state.y,
+            delta_dot: -state.vy,
+            slip: state.vx + state.omega * r,
+            ball: &self.ball,
+            gravity: self.gravity,
+            incline,
+            delta_max: 0.0,
+            force_max: 0.0,
+            normal_force: 0.0,
+        };
+        let mut total = Loads::default();
+        for e in &self.effects {
+            total.add(&e.loads(&ctx));
+        }
+        total
+    }
 }
 
 fn self_names(effects: &[Box<dyn Effect>]) -> String {
@@ -105,4 +131,30 @@ fn self_names(effects: &[Box<dyn Effect>]) -> String {
         .map(|e| e.name().to_string())
         .collect::<Vec<_>>()
         .join(", ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::effects::QuadraticDrag;
+
+    #[test]
+    fn flight_loads_are_zero_for_the_paper_model_and_oppose_the_velocity_with_drag() {
+        let state = State {
+            y: 0.1,
+            vx: 1.0,
+            vy: -3.0,
+            ..State::default()
+        };
+        let paper = Model::paper(25_650.0, 14.0, 0.5);
+        assert_eq!(paper.flight_loads(&state, 0.2), Loads::default());
+        let drag = paper.with(QuadraticDrag { cd: 0.55, rho: 1.204 });
+        let l = drag.flight_loads(&state, 0.2);
+        let r = drag.ball.radius_m;
+        let c = 0.5 * 1.204 * 0.55 * std::f64::consts::PI * r * r * 10f64.sqrt();
+        assert!(
+            (l.force_x + c).abs() < 1e-15 && (l.force_y - 3.0 * c).abs() < 1e-15,
+            "{l:?}"
+        );
+    }
 }

@@ -109,7 +109,10 @@ fn effect_session(name: &str, effect: Option<&str>) -> String {
         name.bytes()
             .fold(7u64, |h, b| h.wrapping_mul(31).wrapping_add(b as u64)),
     ) % 1_000_000;
+    // Drag acts in flight: its trace grows with the square of the flight filmed, so its session films
+    // longer flights (the other effects act in contact, where 10 ms either side suffice).
+    let flight_ms = if effect == Some("drag") { 35 } else { 10 };
     format!(
-        "name = \"{name}\"\ndescription = \"Diagnosis session: clay, {what}\"\nseed = {seed}\npre_contact_ms = 10\npost_separation_ms = 10\n\n[ball]\ndiameter_m = 0.067\nmass_kg = 0.0567\ninertia_factor = 0.6666666666666666\n\n{CAMERA_512}\n[model]\ngravity_m_s2 = 9.81\n[model.effects.spring]\nk = 25650\n[model.effects.damping]\nb = 14\n[model.effects.coulomb]\nmu = 0.5\n\n[surfaces.clay]\ntexture = \"clay\"\n\n{extra}\n[grid]\nsurfaces = [\"clay\"]\ndrop_heights_m = [0.2, 0.55, 0.9]\nangles_deg = [0, 7.5, 15, 22.5]\nrepeats = 1\neffects = {list}\n"
+        "name = \"{name}\"\ndescription = \"Diagnosis session: clay, {what}\"\nseed = {seed}\npre_contact_ms = {flight_ms}\npost_separation_ms = {flight_ms}\n\n[ball]\ndiameter_m = 0.067\nmass_kg = 0.0567\ninertia_factor = 0.6666666666666666\n\n{CAMERA_512}\n[model]\ngravity_m_s2 = 9.81\n[model.effects.spring]\nk = 25650\n[model.effects.damping]\nb = 14\n[model.effects.coulomb]\nmu = 0.5\n\n[surfaces.clay]\ntexture = \"clay\"\n\n{extra}\n[grid]\nsurfaces = [\"clay\"]\ndrop_heights_m = [0.2, 0.55, 0.9]\nangles_deg = [0, 7.5, 15, 22.5]\nrepeats = 1\neffects = {list}\n"
     )
 }

@@ -369,10 +369,20 @@ fn effect_presets_change_the_measurable_outputs() {
         for (i, b) in base.iter().enumerate() {
             let p = ShotPlan::new(&s, i).unwrap();
             let t = &p.truth;
+            // Drag's session films 35 ms of flight either side: from the highest drops the ball enters the
+            // frame during it (those frames are cut by the border, and the tracker flags them). Every other
+            // session keeps the ball whole in every frame.
+            let full = p.frames.iter().filter(|f| f.visible == Visibility::Full).count();
+            let needed = if e.name == "drag" {
+                p.frames.len() * 3 / 4
+            } else {
+                p.frames.len()
+            };
             assert!(
-                p.frames.iter().all(|f| f.visible == Visibility::Full),
-                "{}: ball leaves the frame",
-                t.clip
+                full >= needed,
+                "{}: ball whole in {full} of {} frames",
+                t.clip,
+                p.frames.len()
             );
             let rel = |a: f64, b: f64| ((a - b) / b.abs().max(0.05)).abs();
             for (a, bb) in [
