@@ -370,8 +370,8 @@ fn effect_presets_change_the_measurable_outputs() {
             let p = ShotPlan::new(&s, i).unwrap();
             let t = &p.truth;
             // Drag's session films 35 ms of flight either side: from the highest drops the ball enters the
-            // frame during it (those frames are cut by the border, and the tracker flags them). Every other
-            // session keeps the ball whole in every frame.
+            // frame during it (at most 34 of 747 frames, from 0.9 m at 0°; the tracker flags them as cut by
+            // the border). Every other session keeps the ball whole in every frame.
             let full = p.frames.iter().filter(|f| f.visible == Visibility::Full).count();
             let needed = if e.name == "drag" {
                 p.frames.len() * 3 / 4
