@@ -66,8 +66,9 @@ pub struct SearchOptions {
     /// of χ² of 1e-7 decides nothing here, and stopping there makes the search three times faster) and at
     /// most 50 iterations (a candidate that cannot fit the data creeps along its bound otherwise).
     pub solver: LevenbergMarquardt,
-    /// Most iterations of each cross-validation fit (default 15): they start at the fit to all shots, a
-    /// few iterations from their own optimum.
+    /// Most iterations of each warm-started fit (default 15): the cross-validation fits, which start at the
+    /// fit to all shots, a few iterations from their own optimum, and with surface levels the joint fit
+    /// that ends each fit to all shots, which starts where the fits by turns ended.
     pub fold_max_iterations: usize,
     /// Integration settings of every simulation.
     pub sim: SimOptions,

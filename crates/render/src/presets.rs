@@ -6,10 +6,10 @@ use bouncelab_model::{ModelSpec, builtin_effects};
 /// The magnitude each `effect-<name>` preset switches its effect on at, as `model.toml` parameter lines,
 /// chosen so the measurable outputs change clearly (see `docs/renderer.md`).
 pub const EFFECT_MAGNITUDES: &[(&str, &str)] = &[
-    ("hertz", "k_h = 400000"),
+    ("hertz", "k_h = 600000"),
     ("hunt_crossley", "lambda = 2000\nn = 1"),
-    ("restitution_damping", "b_r = 8"),
-    ("plastic_dent", "phi = 0.25"),
+    ("restitution_damping", "b_r = 20"),
+    ("plastic_dent", "phi = 0.5"),
     ("rolling_resistance", "c_rr = 0.02"),
     ("inertia_factor", "dc = -0.25"),
     ("drag", "cd = 1.5\nrho = 1.204"),

@@ -114,7 +114,7 @@ pub fn fit_circle(points: &[[f64; 2]], x: f64, y: f64, r: f64) -> Option<CircleF
 }
 
 /// Inverse of a symmetric positive-definite 3×3 matrix; `None` when (nearly) singular.
-fn invert3(a: &[[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
+pub(crate) fn invert3(a: &[[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
     let c00 = a[1][1] * a[2][2] - a[1][2] * a[2][1];
     let c01 = a[1][2] * a[2][0] - a[1][0] * a[2][2];
     let c02 = a[1][0] * a[2][1] - a[1][1] * a[2][0];

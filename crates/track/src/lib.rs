@@ -24,7 +24,7 @@ pub use clip::{ClipTracking, Scale, Track, TrackError, TrajectoryRow, track_clip
 pub use fit::{CircleFit, fit_circle};
 pub use hough::{Circle, CircleDetection, detect_circles, outermost};
 pub use plane::{Pixel, Plane};
-pub use refine::{EdgeSearch, Refined, refine_circle, refined_candidates};
+pub use refine::{EdgeSearch, Refined, RimShape, RimShapeLearner, refine_circle, refined_candidates, rim_residuals};
 pub use surface::{SurfaceLine, find_surface_line};
 pub use tracker::{BallFix, Status, TrackOptions, Tracker};
 

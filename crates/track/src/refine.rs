@@ -26,6 +26,9 @@ pub struct EdgeSearch {
     /// Also measure [`Refined::edge_definition_px`] (default false: it costs ≈ 3 µs a frame and the scale
     /// needs it in a few dozen frames only).
     pub edge_definition: bool,
+    /// The rim's own shape (see [`RimShape`]), subtracted from each ray's edge distance; `None` for a
+    /// perfect circle (default).
+    pub rim_shape: Option<RimShape>,
 }
 
 impl Default for EdgeSearch {
@@ -37,8 +40,142 @@ impl Default for EdgeSearch {
             min_contrast: 2.0,
             surface_margin: 2.0,
             edge_definition: false,
+            rim_shape: None,
         }
     }
+}
+
+/// How the ball's apparent rim departs from a circle, learned where the whole rim is seen.
+///
+/// Lighting and the limb's shading move the edge a little differently at each angle (0.1 px here and there
+/// on a lit felt ball). Over the whole rim the constant and first-harmonic parts of that are absorbed by the
+/// circle's radius and centre, and the rest averages out; but when the surface hides the bottom, the
+/// remaining arc's uneven offsets pull the centre (≈ 0.02 px on the renderer's clay: 8 µm, the size of a
+/// contact effect). So the mean residual per ray over free-flight frames, less its mean and first
+/// harmonic, is subtracted from the edge points of every later frame whose rim is partly hidden, which is
+/// then measured on the same rim as in flight (full-rim frames are measured without it). The shape is fixed to the camera (the light does not turn with
+/// the ball), and a texture turning with the ball averages out of it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RimShape {
+    /// Offset per ray, px (ray `i` at angle `i·2π/len` from +x towards +y), positive outward.
+    pub offsets_px: std::sync::Arc<[f64]>,
+}
+
+/// Highest harmonic of the rim's shape kept (see [`RimShapeLearner::shape`]).
+const RIM_HARMONICS: usize = 8;
+
+/// Accumulates per-ray edge residuals of full-rim frames into a [`RimShape`].
+#[derive(Debug, Clone, Default)]
+pub struct RimShapeLearner {
+    sum: Vec<f64>,
+    count: Vec<u32>,
+    frames: usize,
+}
+
+impl RimShapeLearner {
+    /// Frames added so far.
+    pub fn frames(&self) -> usize {
+        self.frames
+    }
+
+    /// Adds one frame's residuals `(ray, edge distance − radius)` from [`rim_residuals`].
+    pub fn add(&mut self, rays: usize, residuals: &[(usize, f64)]) {
+        if self.sum.len() != rays {
+            *self = RimShapeLearner {
+                sum: vec![0.0; rays],
+                count: vec![0; rays],
+                frames: 0,
+            };
+        }
+        for &(i, e) in residuals {
+            if i < rays {
+                self.sum[i] += e;
+                self.count[i] += 1;
+            }
+        }
+        self.frames += 1;
+    }
+
+    /// The shape so far: the mean residual per ray less its least-squares mean and first harmonic, then
+    /// its harmonics 2 to 8 only. `None` before any frame, or when fewer than half the rays were measured.
+    pub fn shape(&self) -> Option<RimShape> {
+        let n = self.sum.len();
+        let seen = self.count.iter().filter(|&&c| c > 0).count();
+        if n == 0 || seen * 2 < n {
+            return None;
+        }
+        let angle = |i: usize| std::f64::consts::TAU * i as f64 / n as f64;
+        let mean = |i: usize| self.sum[i] / self.count[i] as f64;
+        // Least squares of m_i ≈ a + b·cos θ_i + c·sin θ_i over the measured rays.
+        let mut ata = [[0.0f64; 3]; 3];
+        let mut atb = [0.0f64; 3];
+        for i in (0..n).filter(|&i| self.count[i] > 0) {
+            let (s, c) = angle(i).sin_cos();
+            let row = [1.0, c, s];
+            for (j, rj) in row.iter().enumerate() {
+                atb[j] += rj * mean(i);
+                for (k, rk) in row.iter().enumerate() {
+                    ata[j][k] += rj * rk;
+                }
+            }
+        }
+        let inv = crate::fit::invert3(&ata)?;
+        let coef: Vec<f64> = (0..3).map(|j| (0..3).map(|k| inv[j][k] * atb[k]).sum()).collect();
+        let rest: Vec<f64> = (0..n)
+            .map(|i| {
+                if self.count[i] == 0 {
+                    return 0.0;
+                }
+                let (s, c) = angle(i).sin_cos();
+                mean(i) - coef[0] - coef[1] * c - coef[2] * s
+            })
+            .collect();
+        // Light and shading vary slowly round the rim; the felt's texture does not. Only harmonics 2 to
+        // RIM_HARMONICS are kept, so the shape is not the texture seen in the learning frames.
+        let mut offsets = vec![0.0; n];
+        for k in 2..=RIM_HARMONICS.min(n / 2 - 1) {
+            let (mut a, mut b) = (0.0, 0.0);
+            for (i, r) in rest.iter().enumerate() {
+                let (s, c) = (k as f64 * angle(i)).sin_cos();
+                a += r * c;
+                b += r * s;
+            }
+            let (a, b) = (2.0 * a / seen as f64, 2.0 * b / seen as f64);
+            for (i, o) in offsets.iter_mut().enumerate() {
+                let (s, c) = (k as f64 * angle(i)).sin_cos();
+                *o += a * c + b * s;
+            }
+        }
+        Some(RimShape {
+            offsets_px: offsets.into(),
+        })
+    }
+}
+
+/// Per-ray edge residuals `(ray, distance from the fitted centre − fitted radius)` around `fit`, px, with
+/// the rays of `search` but no rim shape applied; points beyond 3 robust RMS of the fit are left out (a seam
+/// crossing the rim). Cost: one edge search (≈ 10 µs).
+pub fn rim_residuals<P: Pixel>(
+    img: &Plane<P>,
+    fit: &CircleFit,
+    search: &EdgeSearch,
+    surface: Option<&SurfaceLine>,
+) -> Vec<(usize, f64)> {
+    let raw = EdgeSearch {
+        rim_shape: None,
+        edge_definition: false,
+        ..search.clone()
+    };
+    let mut rays = Vec::new();
+    let Some(refit) = refine_once(img, fit.x, fit.y, fit.r, &raw, 2.0, surface, Some(&mut rays)) else {
+        return Vec::new();
+    };
+    let f = refit.fit;
+    let limit = 3.0 * f.rms.max(0.02);
+    rays.into_iter()
+        .map(|(i, p)| (i, (p[0] - f.x).hypot(p[1] - f.y) - f.r))
+        .filter(|(_, e)| e.abs() < limit)
+        .collect()
 }
 
 /// A refined circle and what it was made of.
@@ -82,7 +219,7 @@ pub fn refine_circle<P: Pixel>(
     search: &EdgeSearch,
     surface: Option<&SurfaceLine>,
 ) -> Option<Refined> {
-    let mut fit = refine_once(img, x, y, r, search, search.half_width, surface)?;
+    let mut fit = refine_once(img, x, y, r, search, search.half_width, surface, None)?;
     // A guess far off the rim puts the window astride the wrong places: re-centre until it settles.
     for _ in 0..3 {
         let moved = (fit.fit.x - x).hypot(fit.fit.y - y).max((fit.fit.r - r).abs());
@@ -90,7 +227,7 @@ pub fn refine_circle<P: Pixel>(
             break;
         }
         let (x, y, r) = (fit.fit.x, fit.fit.y, fit.fit.r);
-        match refine_once(img, x, y, r, search, search.half_width, surface) {
+        match refine_once(img, x, y, r, search, search.half_width, surface, None) {
             Some(f) => fit = f,
             None => break,
         }
@@ -99,9 +236,10 @@ pub fn refine_circle<P: Pixel>(
     if narrow >= search.half_width {
         return Some(fit);
     }
-    refine_once(img, fit.fit.x, fit.fit.y, fit.fit.r, search, narrow, surface).or(Some(fit))
+    refine_once(img, fit.fit.x, fit.fit.y, fit.fit.r, search, narrow, surface, None).or(Some(fit))
 }
 
+#[allow(clippy::too_many_arguments)] // private; `raw_points` is only for rim_residuals
 fn refine_once<P: Pixel>(
     img: &Plane<P>,
     x: f64,
@@ -110,11 +248,19 @@ fn refine_once<P: Pixel>(
     search: &EdgeSearch,
     half_width: f64,
     surface: Option<&SurfaceLine>,
+    mut raw_points: Option<&mut Vec<(usize, [f64; 2])>>,
 ) -> Option<Refined> {
     let n = search.rays.max(8);
+    let shape = search
+        .rim_shape
+        .as_ref()
+        .map(|s| &s.offsets_px[..])
+        .filter(|o| o.len() == n);
     let samples = ((2.0 * half_width / search.step).round() as usize).max(4) + 1;
     let mut profile = vec![0.0f32; samples];
     let mut points = Vec::with_capacity(n);
+    // The rim-shape offset of each point's ray (0 without a shape) and the ray's direction.
+    let mut shifts: Vec<(f64, f64, f64)> = Vec::with_capacity(n);
     let mut contrasts = Vec::with_capacity(n);
     let mut offsets: Vec<f64> = Vec::with_capacity(n);
     let (mut outside, mut hidden) = (0, 0);
@@ -123,7 +269,7 @@ fn refine_once<P: Pixel>(
     let (dc, ds) = (ds, dc); // (cos Δ, sin Δ)
     let (mut c, mut s) = (1.0f64, 0.0f64);
     let (wmax, hmax) = ((img.width - 1) as f64, (img.height - 1) as f64);
-    for _ in 0..n {
+    for ray in 0..n {
         let (c0, s0) = (c, s);
         (c, s) = (c0 * dc - s0 * ds, s0 * dc + c0 * ds);
         let (c, s) = (c0, s0);
@@ -187,7 +333,11 @@ fn refine_once<P: Pixel>(
             0.0
         };
         let d = start + (best_j as f64 + off) * search.step;
+        if let Some(raw) = raw_points.as_deref_mut() {
+            raw.push((ray, [x + d * c, y + d * s]));
+        }
         points.push([x + d * c, y + d * s]);
+        shifts.push((shape.map_or(0.0, |o| o[ray]), c, s));
         contrasts.push(per_px);
         if search.edge_definition
             && let Some(o) = half_level_offset(profile, best_j, best_j as f64 + off)
@@ -195,21 +345,42 @@ fn refine_once<P: Pixel>(
             offsets.push(o * search.step);
         }
     }
+    // The shape matters only when part of the rim is hidden (a full rim's fit absorbs what it corrects), so
+    // full-rim frames are measured exactly as without it.
+    if hidden > 0 {
+        for (p, &(sh, c, s)) in points.iter_mut().zip(&shifts) {
+            p[0] -= sh * c;
+            p[1] -= sh * s;
+        }
+    } else {
+        shifts.iter_mut().for_each(|s| s.0 = 0.0);
+    }
     let mut fit = fit_circle(&points, x, y, r)?;
     // Neighbouring rays see overlapping texture, so their edge errors are correlated and the fit's σ (which
     // assumes independent points) is optimistic. Inflate it by the AR(1) factor √((1+ρ)/(1−ρ)), with ρ the
     // lag-1 correlation of the residuals around the rim (points are in ray order), measured on this frame.
-    let res: Vec<f64> = points
+    //
+    // With a rim shape the residuals are taken before its correction: the part of the rim's departure from a
+    // circle that the shape cannot hold (its mean and first harmonic, which move the radius and centre
+    // exactly as a shift would) is of the size of the part it corrects, so σ keeps both.
+    let (res, corrected): (Vec<f64>, Vec<f64>) = points
         .iter()
-        .map(|p| (p[0] - fit.x).hypot(p[1] - fit.y) - fit.r)
-        .filter(|e| e.abs() < 3.0 * fit.rms.max(0.02))
-        .collect();
+        .zip(&shifts)
+        .map(|(p, (sh, _, _))| {
+            let e = (p[0] - fit.x).hypot(p[1] - fit.y) - fit.r;
+            (e + sh, e)
+        })
+        .filter(|(_, e)| e.abs() < 3.0 * fit.rms.max(0.02))
+        .unzip();
     if res.len() > 8 {
         let m = res.iter().sum::<f64>() / res.len() as f64;
         let var: f64 = res.iter().map(|e| (e - m).powi(2)).sum();
         let lag: f64 = res.windows(2).map(|w| (w[0] - m) * (w[1] - m)).sum();
         let rho = (lag / var.max(1e-300)).clamp(0.0, 0.8);
-        let k = ((1.0 + rho) / (1.0 - rho)).sqrt();
+        let mc = corrected.iter().sum::<f64>() / corrected.len() as f64;
+        let var_corrected: f64 = corrected.iter().map(|e| (e - mc).powi(2)).sum();
+        let spread = (var / var_corrected.max(1e-300)).sqrt().max(1.0);
+        let k = ((1.0 + rho) / (1.0 - rho)).sqrt() * spread;
         fit.sigma_x *= k;
         fit.sigma_y *= k;
         fit.sigma_r *= k;
@@ -369,4 +540,107 @@ fn silhouette_contrast<P: Pixel>(img: &Plane<P>, c: &crate::Circle) -> f64 {
     }
     let mid = diffs.len() / 2;
     *diffs.select_nth_unstable_by(mid, f64::total_cmp).1
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SIZE: usize = 220;
+
+    /// A bright disc on a dark backdrop whose rim departs from the circle (`cx`, `cy`, `r`) by
+    /// 0.3·cos 2θ + 0.15·sin 3θ px (no mean, no first harmonic: the circle is its best fit), an edge ramp
+    /// 1.5 px wide, and a flat band below `line_y` hiding the disc there.
+    fn lit_ball(cx: f64, cy: f64, r: f64, line_y: Option<f64>) -> Vec<u8> {
+        let mut img = vec![0u8; SIZE * SIZE];
+        for (k, v) in img.iter_mut().enumerate() {
+            let (x, y) = ((k % SIZE) as f64, (k / SIZE) as f64);
+            if line_y.is_some_and(|l| y >= l) {
+                *v = 110;
+                continue;
+            }
+            let (dx, dy) = (x - cx, y - cy);
+            let th = dy.atan2(dx);
+            let edge = r + 0.3 * (2.0 * th).cos() + 0.15 * (3.0 * th).sin();
+            let inside = (0.5 - (dx.hypot(dy) - edge) / 1.5).clamp(0.0, 1.0);
+            *v = (40.0 + 160.0 * inside).round() as u8;
+        }
+        img
+    }
+
+    fn line_at(y: f64) -> SurfaceLine {
+        SurfaceLine {
+            x0: SIZE as f64 / 2.0,
+            y0: y,
+            slope: 0.0,
+            sigma_y0: 0.0,
+            sigma_tilt_deg: 0.0,
+            columns: SIZE,
+        }
+    }
+
+    #[test]
+    fn a_learned_rim_shape_keeps_a_partly_hidden_ball_on_its_full_rim_centre() {
+        let search = EdgeSearch::default();
+        let mut learner = RimShapeLearner::default();
+        for k in 0..8 {
+            let (cx, cy) = (105.0 + 0.37 * k as f64, 90.0 + 0.21 * k as f64);
+            let img = lit_ball(cx, cy, 60.0, None);
+            let plane = Plane::new(&img, SIZE, SIZE);
+            let f = refine_circle(&plane, cx + 0.4, cy - 0.3, 60.0, &search, None).unwrap();
+            learner.add(search.rays, &rim_residuals(&plane, &f.fit, &search, None));
+        }
+        let shaped = EdgeSearch {
+            rim_shape: learner.shape(),
+            ..search.clone()
+        };
+        assert!(shaped.rim_shape.is_some());
+        let (cx, cy) = (110.3, 100.6);
+        let err = |f: CircleFit| (f.x - cx).hypot(f.y - cy);
+        // Full rim: the shape is not applied (the fit absorbs what it would correct).
+        let img = lit_ball(cx, cy, 60.0, None);
+        let plane = Plane::new(&img, SIZE, SIZE);
+        let plain = refine_circle(&plane, cx, cy, 60.0, &search, None).unwrap().fit;
+        let with = refine_circle(&plane, cx, cy, 60.0, &shaped, None).unwrap().fit;
+        assert_eq!((plain.x, plain.y, plain.r), (with.x, with.y, with.r));
+        assert!(err(plain) < 0.04, "{plain:?}");
+        // The bottom fifth hidden: without the shape the remaining arc's offsets pull the centre.
+        let line = line_at(cy + 0.6 * 60.0);
+        let img = lit_ball(cx, cy, 60.0, Some(line.y0));
+        let plane = Plane::new(&img, SIZE, SIZE);
+        let plain = refine_circle(&plane, cx, cy, 60.0, &search, Some(&line)).unwrap().fit;
+        let with = refine_circle(&plane, cx, cy, 60.0, &shaped, Some(&line)).unwrap().fit;
+        eprintln!(
+            "hidden bottom: centre error {:.4} px plain, {:.4} px with the shape",
+            err(plain),
+            err(with)
+        );
+        assert!(
+            err(plain) > 0.05,
+            "the test's rim should pull a partial fit: {}",
+            err(plain)
+        );
+        assert!(err(with) < 0.25 * err(plain), "{} vs {}", err(with), err(plain));
+    }
+
+    #[test]
+    fn the_learner_needs_half_the_rays() {
+        let mut learner = RimShapeLearner::default();
+        assert!(learner.shape().is_none());
+        learner.add(16, &[(0, 0.1), (1, 0.2), (2, -0.1)]);
+        assert!(learner.shape().is_none());
+        learner.add(16, &(0..16).map(|i| (i, 0.1 * (i as f64).sin())).collect::<Vec<_>>());
+        let s = learner.shape().unwrap();
+        assert_eq!(s.offsets_px.len(), 16);
+        // Mean and first harmonic removed.
+        let n = 16.0;
+        let mean: f64 = s.offsets_px.iter().sum::<f64>() / n;
+        let c1: f64 = s
+            .offsets_px
+            .iter()
+            .enumerate()
+            .map(|(i, o)| o * (std::f64::consts::TAU * i as f64 / n).cos())
+            .sum();
+        assert!(mean.abs() < 1e-12 && c1.abs() < 1e-12, "{mean} {c1}");
+    }
 }

@@ -3,7 +3,7 @@
 
 use crate::hough::{Circle, CircleDetection};
 use crate::plane::{Pixel, Plane};
-use crate::refine::{EdgeSearch, Refined, refine_circle, refined_candidates};
+use crate::refine::{EdgeSearch, Refined, RimShapeLearner, refine_circle, refined_candidates, rim_residuals};
 use crate::surface::{SurfaceLine, find_surface_line};
 use serde::{Deserialize, Serialize};
 
@@ -113,6 +113,9 @@ pub struct Tracker {
     flight_radii: Vec<f64>,
     /// Edge-definition spread (see [`Refined::edge_definition_px`]) in the first free-flight frames, px.
     flight_edges: Vec<f64>,
+    /// The rim's shape, learned from full-rim free-flight frames until the first partly hidden one.
+    rim: RimShapeLearner,
+    rim_frozen: bool,
     surface: Option<SurfaceLine>,
     surface_tries: usize,
     warnings: Vec<String>,
@@ -124,6 +127,10 @@ pub struct Tracker {
 
 /// Free-flight frames in which the edge definition is measured (its median enters the scale's error).
 const EDGE_SAMPLES: usize = 64;
+
+/// Full-rim free-flight frames the rim's shape is learned from (at most), and before it is used (at least).
+const RIM_SAMPLES: usize = 64;
+const RIM_MIN_SAMPLES: usize = 16;
 
 /// Search half-width around a confident prediction, px.
 const CONFIDENT_HALF_WIDTH: f64 = 2.0;
@@ -139,6 +146,8 @@ impl Tracker {
             history: Vec::new(),
             flight_radii: Vec::new(),
             flight_edges: Vec::new(),
+            rim: RimShapeLearner::default(),
+            rim_frozen: false,
             surface: None,
             surface_tries: 0,
             warnings: Vec::new(),
@@ -348,6 +357,16 @@ impl Tracker {
             if f.edge_definition_px.is_finite() && self.flight_edges.len() < EDGE_SAMPLES {
                 self.flight_edges.push(f.edge_definition_px);
             }
+            if !self.rim_frozen && f.rays_outside == 0 && self.rim.frames() < RIM_SAMPLES {
+                let res = rim_residuals(img, &fit, &self.opts.search, self.surface.as_ref());
+                self.rim.add(self.opts.search.rays.max(8), &res);
+                if self.rim.frames() >= RIM_MIN_SAMPLES {
+                    self.opts.search.rim_shape = self.rim.shape();
+                }
+            }
+        } else if f.rays_hidden > 0 && self.rim.frames() >= RIM_MIN_SAMPLES {
+            // From the first partly hidden frame on, every frame is measured on the same rim.
+            self.rim_frozen = true;
         }
         // Seeds from later frames give way to real measurements.
         self.history.retain(|h| h.0 < t_s);
