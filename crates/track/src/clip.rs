@@ -296,6 +296,29 @@ pub fn track_clip(
         )
     })?;
     warnings.extend(tracker.warnings().iter().cloned());
+    let mut fixes = fixes;
+    let mut back = Tracker::new(TrackOptions {
+        radius_px: Some(radius),
+        ..opts.tracker.clone()
+    });
+    if let Some(line) = tracker.surface() {
+        back.set_surface(*line);
+    }
+    let retracked = retrack_start(&mut fixes, &mut back, |tr, k, frame, t_back| {
+        let image = clip.read(k, opts.read.png_decoder).expect("index in range")?;
+        Ok(with_plane(
+            &image.pixels,
+            |p| on_plane!(p, p => observe(tr, frame, t_back, &p)),
+        ))
+    })?;
+    if let Some((settled, replaced)) = retracked
+        && replaced > 0
+    {
+        warnings.push(format!(
+            "the track settled at frame {}: {replaced} of the {settled} frames before it re-measured by tracking backward from there",
+            fixes[settled].frame
+        ));
+    }
     let measured = fixes.iter().filter(|f| f.status.measured()).count();
     if measured == 0 {
         return Err(TrackError::NoBall {
@@ -323,6 +346,53 @@ pub fn track_clip(
         seconds_tracking: tracking,
         downslope_negative_x: opts.downslope_negative_x,
     })
+}
+
+/// Consecutive clean fixes (status ok, quality ≥ [`CLEAN_QUALITY`]) from which a track counts as settled.
+const SETTLED_RUN: usize = 5;
+
+/// Quality of a clean circle: at least 85 % of the rays kept (as acquisition asks of both frames of a pair).
+const CLEAN_QUALITY: f64 = 0.85;
+
+/// The frames before the track first settled, tracked again backward from there.
+///
+/// A track can start on the wrong circle and only later lock onto the ball: a seam drawn nearly as large
+/// as the ball and a few px off its centre (clip S095 of the `paper` preset) out-votes the rim in the
+/// first frames, its fixes a weak circle (quality 0.25–0.65 against the rim's 0.97). Tracking is
+/// symmetric in time, so `back` (a fresh tracker) runs over the frames before the first run of
+/// [`SETTLED_RUN`] clean fixes in reverse order, in negated time, seeded by the two settled fixes;
+/// `measure(back, k, frame, −t)` measures file `k`. A frame takes the backward fix when the forward one
+/// is not measured or is a clearly weaker circle (quality lower by more than 0.1). Returns the settled
+/// position and how many fixes were replaced, `None` when the track never settles or settled at once.
+fn retrack_start(
+    fixes: &mut [BallFix],
+    back: &mut Tracker,
+    mut measure: impl FnMut(&mut Tracker, usize, usize, f64) -> Result<BallFix, TrackError>,
+) -> Result<Option<(usize, usize)>, TrackError> {
+    let clean = |f: &BallFix| f.status == Status::Ok && f.quality >= CLEAN_QUALITY;
+    let Some(settled) =
+        (0..fixes.len().saturating_sub(SETTLED_RUN - 1)).find(|&i| fixes[i..i + SETTLED_RUN].iter().all(clean))
+    else {
+        return Ok(None);
+    };
+    if settled == 0 {
+        return Ok(None);
+    }
+    let (a, b) = (fixes[settled + 1], fixes[settled]);
+    back.seed((-a.t_s, a.x_px, a.y_px), (-b.t_s, b.x_px, b.y_px));
+    let mut replaced = 0;
+    for k in (0..settled).rev() {
+        let forward = fixes[k];
+        let fix = measure(back, k, forward.frame, -forward.t_s)?;
+        if fix.status.measured() && (!forward.status.measured() || fix.quality > forward.quality + 0.1) {
+            fixes[k] = BallFix {
+                t_s: forward.t_s,
+                ..fix
+            };
+            replaced += 1;
+        }
+    }
+    Ok(Some((settled, replaced)))
 }
 
 /// Streams the clip's frames in order through `fix_of`, reporting progress and timing how long was spent
@@ -383,4 +453,77 @@ pub(crate) fn scale_from(
         radius_px: mean,
         frames: radii.len(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testutil::{Scene, render};
+
+    /// The ball falling through 30 frames (px, frame k at t = k·0.1 ms).
+    fn ball_at(k: usize) -> (f64, f64) {
+        let t = k as f64;
+        (100.3 + 0.4 * t, 60.7 + 1.1 * t + 0.02 * t * t)
+    }
+
+    fn frame(k: usize) -> Vec<u8> {
+        let (x, y) = ball_at(k);
+        render(&Scene {
+            ball: (x, y, 40.0),
+            seed: k as u64,
+            ..Scene::default()
+        })
+    }
+
+    #[test]
+    fn frames_before_the_track_settled_are_measured_again_backward() {
+        let opts = TrackOptions {
+            radius_px: Some((34.0, 46.0)),
+            ..TrackOptions::default()
+        };
+        let mut forward = Tracker::new(opts.clone());
+        let mut fixes: Vec<BallFix> = (0..30)
+            .map(|k| {
+                let img = frame(k);
+                forward.observe(k, k as f64 * 1e-4, &Plane::new(&img, 256, 256))
+            })
+            .collect();
+        assert!(
+            fixes
+                .iter()
+                .all(|f| f.status == Status::Ok && f.quality >= CLEAN_QUALITY)
+        );
+        // The first 8 frames as if the track had followed a weaker circle 7 px off, or lost the ball.
+        for (k, f) in fixes.iter_mut().enumerate().take(8) {
+            if k == 3 {
+                *f = BallFix::absent(k, f.t_s, Status::Absent);
+            } else {
+                f.x_px += 7.0;
+                f.quality = 0.4;
+            }
+        }
+        let mut back = Tracker::new(opts);
+        let out = retrack_start(&mut fixes, &mut back, |tr, k, frame_index, t| {
+            let img = frame(k);
+            Ok(tr.observe(frame_index, t, &Plane::new(&img, 256, 256)))
+        })
+        .unwrap();
+        assert_eq!(out, Some((8, 8)));
+        for (k, f) in fixes.iter().enumerate().take(8) {
+            let (x, y) = ball_at(k);
+            assert_eq!(f.t_s, k as f64 * 1e-4);
+            assert!(
+                (f.x_px - x).hypot(f.y_px - y) < 0.2,
+                "frame {k}: {f:?} against ({x}, {y})"
+            );
+        }
+        // A track that is clean from its first frame is left alone.
+        let before = fixes.clone();
+        let mut back = Tracker::new(TrackOptions::default());
+        assert_eq!(
+            retrack_start(&mut fixes, &mut back, |_, _, _, _| unreachable!()).unwrap(),
+            None
+        );
+        assert_eq!(fixes, before);
+    }
 }

@@ -357,7 +357,8 @@ impl Tracker {
             if f.edge_definition_px.is_finite() && self.flight_edges.len() < EDGE_SAMPLES {
                 self.flight_edges.push(f.edge_definition_px);
             }
-            if !self.rim_frozen && f.rays_outside == 0 && self.rim.frames() < RIM_SAMPLES {
+            // Only clean circles teach the rim's shape (a seam circle fits its edges less well).
+            if !self.rim_frozen && f.rays_outside == 0 && f.quality() >= 0.85 && self.rim.frames() < RIM_SAMPLES {
                 let res = rim_residuals(img, &fit, &self.opts.search, self.surface.as_ref());
                 self.rim.add(self.opts.search.rays.max(8), &res);
                 if self.rim.frames() >= RIM_MIN_SAMPLES {
