@@ -314,6 +314,14 @@ pub fn track_clip(
     if let Some((settled, replaced)) = retracked
         && replaced > 0
     {
+        // What the forward pass said of the frames now measured again no longer describes the track.
+        let first = fixes[settled].frame;
+        warnings.retain(|w| {
+            w.strip_prefix("frame ")
+                .and_then(|rest| rest.split(':').next())
+                .and_then(|n| n.parse::<usize>().ok())
+                .is_none_or(|n| n >= first)
+        });
         warnings.push(format!(
             "the track settled at frame {}: {replaced} of the {settled} frames before it re-measured by tracking backward from there",
             fixes[settled].frame
