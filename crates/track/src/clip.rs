@@ -10,7 +10,7 @@ use crate::hough::CircleDetection;
 use crate::plane::{Pixel, Plane};
 use crate::refine::refined_candidates;
 use crate::surface::SurfaceLine;
-use crate::tracker::{BallFix, Status, TrackOptions, Tracker};
+use crate::tracker::{BallFix, CLEAN_QUALITY, Status, TrackOptions, Tracker};
 use bouncelab_frames::{Clip, FramesError, GrayPixels, ReadOptions};
 use serde::Serialize;
 use std::time::Instant;
@@ -223,7 +223,7 @@ fn acquire(clip: &Clip, opts: &ClipTracking, warnings: &mut Vec<String>) -> Resu
         let (a, b) = (circles_in(k)?, circles_in(k + gap)?);
         // Both ends of a pair must be clean circles (a ball's rim refines to a quality near 1; a seam or a
         // texture ghost does not), or the seed would start the track on the wrong circle.
-        let good = |c: &&crate::Circle| c.support > 0.85;
+        let good = |c: &&crate::Circle| c.support > CLEAN_QUALITY;
         // Circles that moved between the two frames, with their positions in both.
         let mut moving: Vec<(crate::Circle, crate::Circle)> = Vec::new();
         for ca in a.iter().filter(good) {
@@ -358,9 +358,6 @@ pub fn track_clip(
 
 /// Consecutive clean fixes (status ok, quality ≥ [`CLEAN_QUALITY`]) from which a track counts as settled.
 const SETTLED_RUN: usize = 5;
-
-/// Quality of a clean circle: at least 85 % of the rays kept (as acquisition asks of both frames of a pair).
-const CLEAN_QUALITY: f64 = 0.85;
 
 /// The frames before the track first settled, tracked again backward from there.
 ///

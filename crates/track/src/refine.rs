@@ -53,8 +53,9 @@ impl Default for EdgeSearch {
 /// remaining arc's uneven offsets pull the centre (≈ 0.02 px on the renderer's clay: 8 µm, the size of a
 /// contact effect). So the mean residual per ray over free-flight frames, less its mean and first
 /// harmonic, is subtracted from the edge points of every later frame whose rim is partly hidden, which is
-/// then measured on the same rim as in flight (full-rim frames are measured without it). The shape is fixed to the camera (the light does not turn with
-/// the ball), and a texture turning with the ball averages out of it.
+/// then measured on the same rim as in flight (full-rim frames are measured without it). The shape is
+/// fixed to the camera (the light does not turn with the ball), and a texture turning with the ball
+/// averages out of it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RimShape {
     /// Offset per ray, px (ray `i` at angle `i·2π/len` from +x towards +y), positive outward.

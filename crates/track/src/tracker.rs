@@ -132,6 +132,10 @@ const EDGE_SAMPLES: usize = 64;
 const RIM_SAMPLES: usize = 64;
 const RIM_MIN_SAMPLES: usize = 16;
 
+/// Quality of a clean circle: about 85 % of the rays kept at full contrast (a ball's rim refines to near
+/// 1; a seam or a texture ghost does not).
+pub(crate) const CLEAN_QUALITY: f64 = 0.85;
+
 /// Search half-width around a confident prediction, px.
 const CONFIDENT_HALF_WIDTH: f64 = 2.0;
 
@@ -358,7 +362,11 @@ impl Tracker {
                 self.flight_edges.push(f.edge_definition_px);
             }
             // Only clean circles teach the rim's shape (a seam circle fits its edges less well).
-            if !self.rim_frozen && f.rays_outside == 0 && f.quality() >= 0.85 && self.rim.frames() < RIM_SAMPLES {
+            if !self.rim_frozen
+                && f.rays_outside == 0
+                && f.quality() >= CLEAN_QUALITY
+                && self.rim.frames() < RIM_SAMPLES
+            {
                 let res = rim_residuals(img, &fit, &self.opts.search, self.surface.as_ref());
                 self.rim.add(self.opts.search.rays.max(8), &res);
                 if self.rim.frames() >= RIM_MIN_SAMPLES {
