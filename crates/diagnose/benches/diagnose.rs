@@ -46,11 +46,7 @@ fn session() -> Vec<MeasuredShot> {
                         t_s: sim.samples[0].t,
                         state: State {
                             x: o.x + offset,
-                            y: o.y,
-                            theta: o.theta,
-                            vx: o.vx,
-                            vy: o.vy,
-                            omega: o.omega,
+                            ..o.into()
                         },
                     },
                     measured: None,

@@ -183,25 +183,7 @@ impl Evaluator {
         theta: &[f64],
         levels: &[f64],
     ) -> Result<DMatrix<f64>, FitError> {
-        let params = self.problem.params();
-        let r0 = self.residuals_held(theta, levels)?;
-        let mut jac = DMatrix::zeros(r0.len(), theta.len());
-        for (j, fp) in params.iter().enumerate() {
-            let h = solver.fd_step * fp.scale;
-            let (mut up, mut dn) = (theta.to_vec(), theta.to_vec());
-            let col = if theta[j] + h <= fp.max && theta[j] - h >= fp.min {
-                up[j] += h;
-                dn[j] -= h;
-                (self.residuals_held(&up, levels)? - self.residuals_held(&dn, levels)?) / (2.0 * h)
-            } else if theta[j] + h <= fp.max {
-                up[j] += h;
-                (self.residuals_held(&up, levels)? - &r0) / h
-            } else {
-                dn[j] -= h;
-                (&r0 - self.residuals_held(&dn, levels)?) / h
-            };
-            jac.set_column(j, &col);
-        }
+        let mut jac = solver.jacobian_at(&HeldLevels { ev: self, levels }, theta)?;
         let h = LEVEL_STEP_M;
         let up: Vec<f64> = levels.iter().map(|l| l + h).collect();
         let dn: Vec<f64> = levels.iter().map(|l| l - h).collect();
@@ -311,6 +293,31 @@ impl LeastSquares for Evaluator {
 
     fn scale(&self, j: usize) -> f64 {
         self.problem.params()[j].scale
+    }
+}
+
+/// The evaluator's residuals with every shot's surface level held at `levels` (m), as a least-squares
+/// problem in the shared parameters only.
+struct HeldLevels<'a> {
+    ev: &'a Evaluator,
+    levels: &'a [f64],
+}
+
+impl LeastSquares for HeldLevels<'_> {
+    fn n_params(&self) -> usize {
+        self.ev.n_params()
+    }
+
+    fn residuals(&self, theta: &[f64]) -> Result<Vec<f64>, FitError> {
+        Ok(self.ev.residuals_held(theta, self.levels)?.data.into())
+    }
+
+    fn bounds(&self, j: usize) -> (f64, f64) {
+        self.ev.bounds(j)
+    }
+
+    fn scale(&self, j: usize) -> f64 {
+        self.ev.scale(j)
     }
 }
 
@@ -430,8 +437,8 @@ pub(crate) fn summarize(ev: &Evaluator, effects: Vec<String>, out: &SolverOutcom
 #[cfg(test)]
 mod tests {
     use super::*;
+    use bouncelab_fit::StartState;
     use bouncelab_fit::testutil::{Rng, noisy_frames, simulate_shot, spec_toml};
-    use bouncelab_fit::{StartState, State};
 
     fn shots() -> Vec<MeasuredShot> {
         let model = Model::paper(25_650.0, 14.0, 0.5);
@@ -442,7 +449,6 @@ mod tests {
             .map(|(k, &(h, a))| {
                 let sim = simulate_shot(&model, h, a, &mut rng);
                 let frames = noisy_frames(&sim, 0.0, &mut rng);
-                let o = sim.samples[0].observed;
                 MeasuredShot {
                     name: format!("s{k}"),
                     surface: "clay".into(),
@@ -450,14 +456,7 @@ mod tests {
                     frames,
                     start: StartState {
                         t_s: sim.samples[0].t,
-                        state: State {
-                            x: o.x,
-                            y: o.y,
-                            theta: o.theta,
-                            vx: o.vx,
-                            vy: o.vy,
-                            omega: o.omega,
-                        },
+                        state: sim.samples[0].observed.into(),
                     },
                     measured: None,
                     surface_sigma_m: Some(20e-6),

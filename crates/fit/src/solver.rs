@@ -210,7 +210,26 @@ struct Eval<'a, P: LeastSquares> {
     count: usize,
 }
 
-impl<P: LeastSquares> Eval<'_, P> {
+impl<'a, P: LeastSquares> Eval<'a, P> {
+    fn new(problem: &'a P) -> Self {
+        let np = problem.n_params();
+        let scale: Vec<f64> = (0..np)
+            .map(|j| {
+                let s = problem.scale(j);
+                if s.is_finite() && s > 0.0 { s } else { 1.0 }
+            })
+            .collect();
+        let lo: Vec<f64> = (0..np).map(|j| problem.bounds(j).0 / scale[j]).collect();
+        let hi: Vec<f64> = (0..np).map(|j| problem.bounds(j).1 / scale[j]).collect();
+        Eval {
+            problem,
+            scale,
+            lo,
+            hi,
+            count: 0,
+        }
+    }
+
     fn params(&self, u: &[f64]) -> Vec<f64> {
         u.iter().zip(&self.scale).map(|(u, s)| u * s).collect()
     }
@@ -262,6 +281,15 @@ impl<P: LeastSquares> Eval<'_, P> {
         }
         Ok(jac)
     }
+
+    /// [`Eval::jacobian`] back in the parameters' own units: ∂r/∂p = ∂r/∂u / scale.
+    fn jacobian_unscaled(&mut self, u: &[f64], r0: &DVector<f64>, h: f64) -> Result<DMatrix<f64>, FitError> {
+        let mut j = self.jacobian(u, r0, h)?;
+        for (k, s) in self.scale.iter().enumerate() {
+            j.column_mut(k).scale_mut(1.0 / s);
+        }
+        Ok(j)
+    }
 }
 
 fn failure(e: &FitError) -> Option<Termination> {
@@ -275,6 +303,16 @@ fn failure(e: &FitError) -> Option<Termination> {
 }
 
 impl LevenbergMarquardt {
+    /// The finite-difference Jacobian `∂r/∂p` of `problem` at `p` (in the parameters' own units), as the
+    /// solver computes it: central differences of `fd_step` relative to each parameter's scale, one-sided
+    /// at a bound.
+    pub fn jacobian_at<P: LeastSquares>(&self, problem: &P, p: &[f64]) -> Result<DMatrix<f64>, FitError> {
+        let mut ev = Eval::new(problem);
+        let u: Vec<f64> = p.iter().zip(&ev.scale).map(|(p, s)| p / s).collect();
+        let r0 = ev.residuals(&u, None)?;
+        ev.jacobian_unscaled(&u, &r0, self.fd_step)
+    }
+
     /// Minimises `problem` from `p0` (clamped into the bounds), reporting each iteration to `observer`.
     ///
     /// Errors only when the starting point itself cannot be evaluated (e.g. a shot's simulation fails
@@ -288,21 +326,7 @@ impl LevenbergMarquardt {
     ) -> Result<SolverOutcome, FitError> {
         let np = problem.n_params();
         assert_eq!(p0.len(), np, "starting point has the wrong length");
-        let scale: Vec<f64> = (0..np)
-            .map(|j| {
-                let s = problem.scale(j);
-                if s.is_finite() && s > 0.0 { s } else { 1.0 }
-            })
-            .collect();
-        let lo: Vec<f64> = (0..np).map(|j| problem.bounds(j).0 / scale[j]).collect();
-        let hi: Vec<f64> = (0..np).map(|j| problem.bounds(j).1 / scale[j]).collect();
-        let mut ev = Eval {
-            problem,
-            scale,
-            lo,
-            hi,
-            count: 0,
-        };
+        let mut ev = Eval::new(problem);
         let project = |u: &mut [f64], lo: &[f64], hi: &[f64]| {
             for j in 0..u.len() {
                 u[j] = u[j].clamp(lo[j], hi[j]);
@@ -399,13 +423,7 @@ impl LevenbergMarquardt {
                 nu *= 2.0;
             }
         };
-        let jacobian = ev.jacobian(&u, &r, self.fd_step).ok().map(|mut j| {
-            // Back to the parameters' own units: ∂r/∂p = ∂r/∂u / scale.
-            for (k, s) in ev.scale.iter().enumerate() {
-                j.column_mut(k).scale_mut(1.0 / s);
-            }
-            j
-        });
+        let jacobian = ev.jacobian_unscaled(&u, &r, self.fd_step).ok();
         Ok(SolverOutcome {
             params: ev.params(&u),
             residuals: r.as_slice().to_vec(),

@@ -102,21 +102,7 @@ impl Model {
     /// (air drag, a custom flight term): all zero when the flight is ballistic. Lets a fit tell whether a
     /// measured ballistic arc is still this model's flight.
     pub fn flight_loads(&self, state: &State, incline: f64) -> Loads {
-        let r = self.ball.radius_m;
-        let ctx = Context {
-            t: 0.0,
-            state,
-            phase: Phase::Flight,
-            delta: r - state.y,
-            delta_dot: -state.vy,
-            slip: state.vx + state.omega * r,
-            ball: &self.ball,
-            gravity: self.gravity,
-            incline,
-            delta_max: 0.0,
-            force_max: 0.0,
-            normal_force: 0.0,
-        };
+        let ctx = Context::of(0.0, state, Phase::Flight, &self.ball, self.gravity, incline);
         let mut total = Loads::default();
         for e in &self.effects {
             total.add(&e.loads(&ctx));

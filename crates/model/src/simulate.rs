@@ -186,21 +186,12 @@ impl<'a> Dynamics<'a> {
         let ball = &self.model.ball;
         let (m, r) = (ball.mass_kg, ball.radius_m);
         let state = State::from_array(*y);
-        let slip = state.vx + state.omega * r;
         let mut ctx = Context {
-            t,
-            state: &state,
-            phase: mode.phase,
-            delta: r - state.y,
-            delta_dot: -state.vy,
-            slip,
-            ball,
-            gravity: self.model.gravity,
-            incline: self.incline,
             delta_max: mode.delta_max,
             force_max: mode.force_max,
-            normal_force: 0.0,
+            ..Context::of(t, &state, mode.phase, ball, self.model.gravity, self.incline)
         };
+        let slip = ctx.slip;
         let effects = self.model.effects();
         let normal = if mode.phase.in_contact() {
             effects.iter().map(|e| e.normal_force(&ctx)).sum()

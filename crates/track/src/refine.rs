@@ -71,6 +71,9 @@ pub struct RimShapeLearner {
     sum: Vec<f64>,
     count: Vec<u32>,
     frames: usize,
+    /// `(sin kθ_i, cos kθ_i)` for k = 1..=RIM_HARMONICS (row k − 1) and every ray i: the shape is rebuilt
+    /// after every learning frame, and these would otherwise be most of its cost.
+    harmonics: Vec<Vec<(f64, f64)>>,
 }
 
 impl RimShapeLearner {
@@ -82,10 +85,14 @@ impl RimShapeLearner {
     /// Adds one frame's residuals `(ray, edge distance − radius)` from [`rim_residuals`].
     pub fn add(&mut self, rays: usize, residuals: &[(usize, f64)]) {
         if self.sum.len() != rays {
+            let angle = |i: usize| std::f64::consts::TAU * i as f64 / rays as f64;
             *self = RimShapeLearner {
                 sum: vec![0.0; rays],
                 count: vec![0; rays],
                 frames: 0,
+                harmonics: (1..=RIM_HARMONICS)
+                    .map(|k| (0..rays).map(|i| (k as f64 * angle(i)).sin_cos()).collect())
+                    .collect(),
             };
         }
         for &(i, e) in residuals {
@@ -105,13 +112,13 @@ impl RimShapeLearner {
         if n == 0 || seen * 2 < n {
             return None;
         }
-        let angle = |i: usize| std::f64::consts::TAU * i as f64 / n as f64;
+        let trig = |k: usize, i: usize| self.harmonics[k - 1][i];
         let mean = |i: usize| self.sum[i] / self.count[i] as f64;
         // Least squares of m_i ≈ a + b·cos θ_i + c·sin θ_i over the measured rays.
         let mut ata = [[0.0f64; 3]; 3];
         let mut atb = [0.0f64; 3];
         for i in (0..n).filter(|&i| self.count[i] > 0) {
-            let (s, c) = angle(i).sin_cos();
+            let (s, c) = trig(1, i);
             let row = [1.0, c, s];
             for (j, rj) in row.iter().enumerate() {
                 atb[j] += rj * mean(i);
@@ -127,7 +134,7 @@ impl RimShapeLearner {
                 if self.count[i] == 0 {
                     return 0.0;
                 }
-                let (s, c) = angle(i).sin_cos();
+                let (s, c) = trig(1, i);
                 mean(i) - coef[0] - coef[1] * c - coef[2] * s
             })
             .collect();
@@ -137,13 +144,13 @@ impl RimShapeLearner {
         for k in 2..=RIM_HARMONICS.min(n / 2 - 1) {
             let (mut a, mut b) = (0.0, 0.0);
             for (i, r) in rest.iter().enumerate() {
-                let (s, c) = (k as f64 * angle(i)).sin_cos();
+                let (s, c) = trig(k, i);
                 a += r * c;
                 b += r * s;
             }
             let (a, b) = (2.0 * a / seen as f64, 2.0 * b / seen as f64);
             for (i, o) in offsets.iter_mut().enumerate() {
-                let (s, c) = (k as f64 * angle(i)).sin_cos();
+                let (s, c) = trig(k, i);
                 *o += a * c + b * s;
             }
         }

@@ -47,11 +47,7 @@ pub fn synth_shot(
     let o = sim.samples[0].observed;
     let start = State {
         x: o.x + x_offset_m,
-        y: o.y,
-        theta: o.theta,
-        vx: o.vx,
-        vy: o.vy,
-        omega: o.omega,
+        ..o.into()
     };
     let imp = &sim.impact;
     let shot = MeasuredShot {

@@ -120,10 +120,7 @@ pub fn session(model: &Model, seed: u64, tracking: Tracking) -> Vec<MeasuredShot
                     state: State {
                         x: o.x + offset,
                         y: o.y + level,
-                        theta: o.theta,
-                        vx: o.vx,
-                        vy: o.vy,
-                        omega: o.omega,
+                        ..o.into()
                     },
                 },
                 measured: None,

@@ -79,6 +79,28 @@ pub struct Context<'a> {
     pub normal_force: f64,
 }
 
+impl<'a> Context<'a> {
+    /// The context of `state` in `phase` at time `t`: penetration, its rate and the slip derived from the
+    /// state; nothing known yet of a maximum compression, and no normal force summed.
+    pub fn of(t: f64, state: &'a State, phase: Phase, ball: &'a Ball, gravity: f64, incline: f64) -> Self {
+        let r = ball.radius_m;
+        Context {
+            t,
+            state,
+            phase,
+            delta: r - state.y,
+            delta_dot: -state.vy,
+            slip: state.vx + state.omega * r,
+            ball,
+            gravity,
+            incline,
+            delta_max: 0.0,
+            force_max: 0.0,
+            normal_force: 0.0,
+        }
+    }
+}
+
 /// Loads an effect adds besides the normal contact force, in the local frame. All default to zero.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Loads {
@@ -118,6 +140,20 @@ pub struct Observation {
     pub vy: f64,
     /// Spin, rad/s.
     pub omega: f64,
+}
+
+impl From<Observation> for State {
+    /// The state the camera saw, read as a local-frame state (what a measured start is).
+    fn from(o: Observation) -> Self {
+        State {
+            x: o.x,
+            y: o.y,
+            theta: o.theta,
+            vx: o.vx,
+            vy: o.vy,
+            omega: o.omega,
+        }
+    }
 }
 
 impl From<State> for Observation {
