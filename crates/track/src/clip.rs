@@ -190,6 +190,10 @@ struct Acquired {
     seed: Option<(Sighting, Sighting)>,
 }
 
+/// The least quality of a circle that acquisition considers (the clearest such circle is tracked when none
+/// is seen to move); a ball in free flight refines to near 1.
+const FALLBACK_QUALITY: f64 = 0.6;
+
 /// The ball's radius range in px, told from other circles by its motion between two frames.
 fn acquire(clip: &Clip, opts: &ClipTracking, warnings: &mut Vec<String>) -> Result<Option<Acquired>, TrackError> {
     if let Some(scale) = opts.scale_hint_m_per_px {
@@ -201,56 +205,64 @@ fn acquire(clip: &Clip, opts: &ClipTracking, warnings: &mut Vec<String>) -> Resu
     }
     let n = clip.len();
     let (w, h) = clip.dimensions();
-    let det = CircleDetection {
-        min_radius: 8.0,
-        max_radius: w.min(h) as f64 / 2.0,
-        // A seam drawn as a dark line can out-vote the rim: keep enough candidates for the rim to be among them.
-        max_candidates: 24,
-        ..CircleDetection::default()
-    };
-    let circles_in = |k: usize| -> Result<Vec<crate::Circle>, TrackError> {
-        let frame = clip.read(k, opts.read.png_decoder).expect("index in range")?;
-        let found = with_plane(
-            &frame.pixels,
-            |p| on_plane!(p, p => refined_candidates(&p, &det, &opts.tracker.search, None, 0.3)),
-        );
-        Ok(found.into_iter().map(|(c, _)| c).collect())
-    };
+    let (min_radius, max_radius) = (8.0, w.min(h) as f64 / 2.0);
+    let read = |k: usize| clip.read(k, opts.read.png_decoder).expect("index in range");
     let gap = 10.min(n.saturating_sub(1)).max(1);
     let mut k = 0;
     let mut fallback = None;
     while k + gap < n && k <= n / 2 {
-        let (a, b) = (circles_in(k)?, circles_in(k + gap)?);
-        // Both ends of a pair must be clean circles (a ball's rim refines to a quality near 1; a seam or a
-        // texture ghost does not), or the seed would start the track on the wrong circle.
-        let good = |c: &&crate::Circle| c.support > CLEAN_QUALITY;
-        // Circles that moved between the two frames, with their positions in both.
-        let mut moving: Vec<(crate::Circle, crate::Circle)> = Vec::new();
-        for ca in a.iter().filter(good) {
-            for cb in b.iter().filter(good) {
-                let same_size = (ca.r - cb.r).abs() <= 0.05 * ca.r + 1.0;
-                let moved = (ca.x - cb.x).hypot(ca.y - cb.y);
-                if same_size && moved > 1.5 && moved < 0.5 * w as f64 {
-                    moving.push((*ca, *cb));
+        let (frame_a, frame_b) = (read(k)?, read(k + gap)?);
+        // An octave of radii at a time, largest first: the large bands are searched on coarse images and
+        // cost little, so a ball of any usual size is found before the full-resolution search for small
+        // circles is needed; and the ball's rim comes before the smaller circles drawn on it (a seam).
+        for (lo, hi) in crate::hough::radius_bands(min_radius, max_radius) {
+            let det = CircleDetection {
+                min_radius: lo,
+                max_radius: hi,
+                // A seam drawn as a dark line can out-vote the rim: keep enough candidates for the rim to be
+                // among them.
+                max_candidates: 24,
+                ..CircleDetection::default()
+            };
+            let circles_in = |frame: &bouncelab_frames::Frame| -> Vec<crate::Circle> {
+                let found = with_plane(
+                    &frame.pixels,
+                    |p| on_plane!(p, p => refined_candidates(&p, &det, &opts.tracker.search, None, FALLBACK_QUALITY)),
+                );
+                found.into_iter().map(|(c, _)| c).collect()
+            };
+            let (a, b) = (circles_in(&frame_a), circles_in(&frame_b));
+            // Both ends of a pair must be clean circles (a ball's rim refines to a quality near 1; a seam or a
+            // texture ghost does not), or the seed would start the track on the wrong circle.
+            let good = |c: &&crate::Circle| c.support > CLEAN_QUALITY;
+            // Circles that moved between the two frames, with their positions in both.
+            let mut moving: Vec<(crate::Circle, crate::Circle)> = Vec::new();
+            for ca in a.iter().filter(good) {
+                for cb in b.iter().filter(good) {
+                    let same_size = (ca.r - cb.r).abs() <= 0.05 * ca.r + 1.0;
+                    let moved = (ca.x - cb.x).hypot(ca.y - cb.y);
+                    if same_size && moved > 1.5 && moved < 0.5 * w as f64 {
+                        moving.push((*ca, *cb));
+                    }
                 }
             }
-        }
-        let best = moving
-            .iter()
-            .max_by(|p, q| p.0.support.min(p.1.support).total_cmp(&q.0.support.min(q.1.support)))
-            .map(|(ca, cb)| (ca.support, *ca, *cb));
-        if let Some((_, ca, cb)) = best {
-            let r = 0.5 * (ca.r + cb.r);
-            // `k` counts files; time follows frame indices, which count dropped frames too.
-            let t = |pos: usize| clip.time_of(clip.files()[pos].index);
-            let seed = ((t(k), ca.x, ca.y), (t(k + gap), cb.x, cb.y));
-            return Ok(Some(Acquired {
-                radius: (0.85 * r, 1.15 * r),
-                seed: Some(seed),
-            }));
-        }
-        if fallback.is_none() {
-            fallback = a.iter().find(|c| c.support > 0.6).map(|c| c.r);
+            let best = moving
+                .iter()
+                .max_by(|p, q| p.0.support.min(p.1.support).total_cmp(&q.0.support.min(q.1.support)))
+                .map(|(ca, cb)| (ca.support, *ca, *cb));
+            if let Some((_, ca, cb)) = best {
+                let r = 0.5 * (ca.r + cb.r);
+                // `k` counts files; time follows frame indices, which count dropped frames too.
+                let t = |pos: usize| clip.time_of(clip.files()[pos].index);
+                let seed = ((t(k), ca.x, ca.y), (t(k + gap), cb.x, cb.y));
+                return Ok(Some(Acquired {
+                    radius: (0.85 * r, 1.15 * r),
+                    seed: Some(seed),
+                }));
+            }
+            if fallback.is_none() {
+                fallback = a.iter().find(|c| c.support > FALLBACK_QUALITY).map(|c| c.r);
+            }
         }
         k += gap;
     }
@@ -273,6 +285,8 @@ pub fn track_clip(
     mut progress: impl FnMut(usize, usize),
 ) -> Result<Track, TrackError> {
     let mut warnings = Vec::new();
+    // The stream starts decoding at once, so its first frames are ready when acquisition is done.
+    let frames = clip.frames_with(&opts.read)?;
     let acquired = acquire(clip, opts, &mut warnings)?;
     let Some(Acquired { radius, seed }) = acquired else {
         let (w, h) = clip.dimensions();
@@ -289,7 +303,7 @@ pub fn track_clip(
     if let Some((a, b)) = seed {
         tracker.seed(a, b);
     }
-    let (fixes, waiting, tracking) = stream_fixes(clip, opts, &mut progress, |frame| {
+    let (fixes, waiting, tracking) = stream_fixes(frames, clip.len(), &mut progress, |frame| {
         with_plane(
             &frame.pixels,
             |p| on_plane!(p, p => observe(&mut tracker, frame.index as usize, frame.t_s, &p)),
@@ -400,19 +414,18 @@ fn retrack_start(
     Ok(Some((settled, replaced)))
 }
 
-/// Streams the clip's frames in order through `fix_of`, reporting progress and timing how long was spent
-/// waiting for decoded frames and how long on the frames themselves (seconds).
+/// Streams the `total` frames of `frames` in order through `fix_of`, reporting progress and timing how long
+/// was spent waiting for decoded frames and how long on the frames themselves (seconds).
 pub(crate) fn stream_fixes(
-    clip: &Clip,
-    opts: &ClipTracking,
+    frames: bouncelab_frames::FrameStream<'_>,
+    total: usize,
     progress: &mut impl FnMut(usize, usize),
     mut fix_of: impl FnMut(&bouncelab_frames::Frame) -> BallFix,
 ) -> Result<(Vec<BallFix>, f64, f64), TrackError> {
-    let mut fixes = Vec::with_capacity(clip.len());
+    let mut fixes = Vec::with_capacity(total);
     let (mut waiting, mut working) = (0.0, 0.0);
-    let total = clip.len();
     let mut t_wait = Instant::now();
-    for frame in clip.frames_with(&opts.read)? {
+    for frame in frames {
         let frame = frame?;
         let t_work = Instant::now();
         waiting += (t_work - t_wait).as_secs_f64();

@@ -22,7 +22,7 @@ mod tracker;
 
 pub use clip::{ClipTracking, Scale, Track, TrackError, TrajectoryRow, track_clip};
 pub use fit::{CircleFit, fit_circle};
-pub use hough::{Circle, CircleDetection, detect_circles, outermost};
+pub use hough::{Circle, CircleDetection, detect_circles, outermost, radius_bands};
 pub use plane::{Pixel, Plane};
 pub use refine::{EdgeSearch, Refined, RimShape, RimShapeLearner, refine_circle, refined_candidates, rim_residuals};
 pub use surface::{SurfaceLine, find_surface_line};

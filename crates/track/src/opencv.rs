@@ -347,35 +347,40 @@ pub fn track_clip_opencv(
     let mut surface: Option<SurfaceLine> = None;
     let mut surface_tries = 0;
     let mut previous: Option<(f64, f64)> = None;
-    let (fixes, waiting, tracking) = crate::clip::stream_fixes(clip, opts, &mut progress, |frame| {
-        if surface.is_none() && surface_tries < 5 {
-            surface_tries += 1;
-            surface = with_plane(&frame.pixels, find_surface_line, find_surface_line);
-        }
-        let (index, t_s) = (frame.index as usize, frame.t_s);
-        let cands = match detect_frame(&frame.pixels, &det, &params) {
-            Ok(c) => c,
-            Err(e) => {
-                warnings.push(format!("frame {index}: {e}"));
-                Vec::new()
+    let (fixes, waiting, tracking) = crate::clip::stream_fixes(
+        clip.frames_with(&opts.read)?,
+        clip.len(),
+        &mut progress,
+        |frame| {
+            if surface.is_none() && surface_tries < 5 {
+                surface_tries += 1;
+                surface = with_plane(&frame.pixels, find_surface_line, find_surface_line);
             }
-        };
-        let (w, h) = (frame.pixels.width() as f64, frame.pixels.height() as f64);
-        let fix = pick(&cands, previous, index, t_s, (w, h));
-        if fix.status == Status::Ambiguous {
-            warnings.push(format!(
+            let (index, t_s) = (frame.index as usize, frame.t_s);
+            let cands = match detect_frame(&frame.pixels, &det, &params) {
+                Ok(c) => c,
+                Err(e) => {
+                    warnings.push(format!("frame {index}: {e}"));
+                    Vec::new()
+                }
+            };
+            let (w, h) = (frame.pixels.width() as f64, frame.pixels.height() as f64);
+            let fix = pick(&cands, previous, index, t_s, (w, h));
+            if fix.status == Status::Ambiguous {
+                warnings.push(format!(
                 "frame {index}: {} ball-like circles and no track yet to tell which is the ball; taking OpenCV's first at ({:.1}, {:.1})",
                 cands.len(),
                 fix.x_px,
                 fix.y_px
             ));
-        }
-        if fix.status == Status::Absent && previous.is_some() {
-            warnings.push(format!("frame {index}: ball lost"));
-        }
-        previous = fix.status.measured().then_some((fix.x_px, fix.y_px));
-        fix
-    })?;
+            }
+            if fix.status == Status::Absent && previous.is_some() {
+                warnings.push(format!("frame {index}: ball lost"));
+            }
+            previous = fix.status.measured().then_some((fix.x_px, fix.y_px));
+            fix
+        },
+    )?;
     if !fixes.iter().any(|f| f.status.measured()) {
         return Err(TrackError::NoBall {
             clip: clip.dir().display().to_string(),

@@ -162,7 +162,8 @@ impl RimShapeLearner {
 
 /// Per-ray edge residuals `(ray, distance from the fitted centre − fitted radius)` around `fit`, px, with
 /// the rays of `search` but no rim shape applied; points beyond 3 robust RMS of the fit are left out (a seam
-/// crossing the rim). Cost: one edge search (≈ 10 µs).
+/// crossing the rim). Cost: one edge search (≈ 10 µs); the tracker takes them from its own search instead
+/// ([`refine_circle_with_rays`]).
 pub fn rim_residuals<P: Pixel>(
     img: &Plane<P>,
     fit: &CircleFit,
@@ -178,10 +179,15 @@ pub fn rim_residuals<P: Pixel>(
     let Some(refit) = refine_once(img, fit.x, fit.y, fit.r, &raw, 2.0, surface, Some(&mut rays)) else {
         return Vec::new();
     };
-    let f = refit.fit;
-    let limit = 3.0 * f.rms.max(0.02);
-    rays.into_iter()
-        .map(|(i, p)| (i, (p[0] - f.x).hypot(p[1] - f.y) - f.r))
+    residuals_about(&refit.fit, &rays)
+}
+
+/// The residuals `(ray, distance from the centre − radius)` of edge points `(ray, point)` about `fit`, px,
+/// without those beyond 3 robust RMS of the fit.
+pub(crate) fn residuals_about(fit: &CircleFit, rays: &[(usize, [f64; 2])]) -> Vec<(usize, f64)> {
+    let limit = 3.0 * fit.rms.max(0.02);
+    rays.iter()
+        .map(|&(i, p)| (i, (p[0] - fit.x).hypot(p[1] - fit.y) - fit.r))
         .filter(|(_, e)| e.abs() < limit)
         .collect()
 }
@@ -227,7 +233,34 @@ pub fn refine_circle<P: Pixel>(
     search: &EdgeSearch,
     surface: Option<&SurfaceLine>,
 ) -> Option<Refined> {
-    let mut fit = refine_once(img, x, y, r, search, search.half_width, surface, None)?;
+    refine_circle_with_rays(img, x, y, r, search, surface, None)
+}
+
+/// [`refine_circle`], leaving in `rays` the edge points `(ray, [x, y])` the returned fit was made of, as
+/// found (before any rim-shape correction); empty when there is no fit.
+pub(crate) fn refine_circle_with_rays<P: Pixel>(
+    img: &Plane<P>,
+    x: f64,
+    y: f64,
+    r: f64,
+    search: &EdgeSearch,
+    surface: Option<&SurfaceLine>,
+    mut rays: Option<&mut Vec<(usize, [f64; 2])>>,
+) -> Option<Refined> {
+    // Each search starts the points afresh; a search that fails leaves none (its points are not the fit's).
+    let mut once = |x: f64, y: f64, r: f64, half_width: f64| {
+        if let Some(v) = rays.as_deref_mut() {
+            v.clear();
+        }
+        let found = refine_once(img, x, y, r, search, half_width, surface, rays.as_deref_mut());
+        if found.is_none()
+            && let Some(v) = rays.as_deref_mut()
+        {
+            v.clear();
+        }
+        found
+    };
+    let mut fit = once(x, y, r, search.half_width)?;
     // A guess far off the rim puts the window astride the wrong places: re-centre until it settles.
     for _ in 0..3 {
         let moved = (fit.fit.x - x).hypot(fit.fit.y - y).max((fit.fit.r - r).abs());
@@ -235,19 +268,19 @@ pub fn refine_circle<P: Pixel>(
             break;
         }
         let (x, y, r) = (fit.fit.x, fit.fit.y, fit.fit.r);
-        match refine_once(img, x, y, r, search, search.half_width, surface, None) {
+        match once(x, y, r, search.half_width) {
             Some(f) => fit = f,
-            None => break,
+            None => return Some(fit),
         }
     }
     let narrow = (search.half_width * 0.5).max(2.0);
     if narrow >= search.half_width {
         return Some(fit);
     }
-    refine_once(img, fit.fit.x, fit.fit.y, fit.fit.r, search, narrow, surface, None).or(Some(fit))
+    once(fit.fit.x, fit.fit.y, fit.fit.r, narrow).or(Some(fit))
 }
 
-#[allow(clippy::too_many_arguments)] // private; `raw_points` is only for rim_residuals
+#[allow(clippy::too_many_arguments)] // private; `raw_points` is only for the rim shape's residuals
 fn refine_once<P: Pixel>(
     img: &Plane<P>,
     x: f64,
@@ -443,6 +476,18 @@ pub fn refined_candidates<P: Pixel>(
         half_width: search.half_width.max(6.0),
         ..search.clone()
     };
+    // Most vote peaks are texture, not circles. Each is first followed to where it settles with a quarter of
+    // the rays (the wide, re-centring searches are most of the cost), and only a peak that is still a
+    // plausible circle there (half the quality asked for: a quarter of the rays measures the kept fraction to
+    // about ±0.08) is measured with every ray.
+    let screen = EdgeSearch {
+        rays: (search.rays / 4).max(16),
+        ..wide.clone()
+    };
+    let settled = EdgeSearch {
+        half_width: 0.5 * wide.half_width,
+        ..search.clone()
+    };
     let mut out: Vec<(crate::Circle, Refined)> = Vec::new();
     for c in crate::detect_circles(img, detection) {
         // A vote peak next to a circle already refined would converge onto it again.
@@ -452,10 +497,16 @@ pub fn refined_candidates<P: Pixel>(
         {
             continue;
         }
-        let Some(f) = refine_circle(img, c.x, c.y, c.r, &wide, surface) else {
+        let Some(f) = refine_circle(img, c.x, c.y, c.r, &screen, surface) else {
             continue;
         };
-        let f = grow_outward(img, f, &wide, surface, detection.max_radius);
+        if f.quality() < 0.5 * min_quality {
+            continue;
+        }
+        let f = grow_outward(img, f, &screen, surface, detection.max_radius);
+        let Some(f) = refine_circle(img, f.fit.x, f.fit.y, f.fit.r, &settled, surface) else {
+            continue;
+        };
         let (q, fit) = (f.quality(), f.fit);
         if q < min_quality || fit.r < detection.min_radius * 0.95 || fit.r > detection.max_radius * 1.05 {
             continue;

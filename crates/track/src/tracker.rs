@@ -3,7 +3,9 @@
 
 use crate::hough::{Circle, CircleDetection};
 use crate::plane::{Pixel, Plane};
-use crate::refine::{EdgeSearch, Refined, RimShapeLearner, refine_circle, refined_candidates, rim_residuals};
+use crate::refine::{
+    EdgeSearch, Refined, RimShapeLearner, refine_circle_with_rays, refined_candidates, residuals_about, rim_residuals,
+};
 use crate::surface::{SurfaceLine, find_surface_line};
 use serde::{Deserialize, Serialize};
 
@@ -116,6 +118,9 @@ pub struct Tracker {
     /// The rim's shape, learned from full-rim free-flight frames until the first partly hidden one.
     rim: RimShapeLearner,
     rim_frozen: bool,
+    /// The edge points `(ray, [x, y])` of this frame's search around the prediction while the rim's shape
+    /// is being learned (its residuals teach the shape without a second search); empty otherwise.
+    rim_rays: Vec<(usize, [f64; 2])>,
     surface: Option<SurfaceLine>,
     surface_tries: usize,
     warnings: Vec<String>,
@@ -152,6 +157,7 @@ impl Tracker {
             flight_edges: Vec::new(),
             rim: RimShapeLearner::default(),
             rim_frozen: false,
+            rim_rays: Vec::new(),
             surface: None,
             surface_tries: 0,
             warnings: Vec::new(),
@@ -251,14 +257,25 @@ impl Tracker {
             ..self.opts.search.clone()
         };
         let max_jump = self.opts.max_jump_px.max(2.0 * self.last_innovation + 2.0);
-        if let (Some((px, py)), Some(r)) = (self.predict(t_s), self.expected_radius())
-            && let Some(found) = refine_circle(img, px, py, r, &search, self.surface.as_ref())
+        let learning = !self.rim_frozen && self.rim.frames() < RIM_SAMPLES;
+        let mut rays = std::mem::take(&mut self.rim_rays);
+        rays.clear();
+        let found = match (self.predict(t_s), self.expected_radius()) {
+            (Some((px, py)), Some(r)) => {
+                let rays = learning.then_some(&mut rays);
+                refine_circle_with_rays(img, px, py, r, &search, self.surface.as_ref(), rays).map(|f| (f, px, py, r))
+            }
+            _ => None,
+        };
+        self.rim_rays = rays;
+        if let Some((found, px, py, r)) = found
             && self.plausible(&found, px, py, r, max_jump)
         {
             self.last_innovation = (found.fit.x - px).hypot(found.fit.y - py);
             return self.accept(frame, t_s, img, found, Status::Ok);
         }
         self.last_innovation = 0.0;
+        self.rim_rays.clear();
         // 2. Detection in the whole frame.
         let (lo, hi) = match (self.expected_radius(), self.opts.radius_px) {
             (Some(r), _) => (0.85 * r, 1.15 * r),
@@ -367,7 +384,13 @@ impl Tracker {
                 && f.quality() >= CLEAN_QUALITY
                 && self.rim.frames() < RIM_SAMPLES
             {
-                let res = rim_residuals(img, &fit, &self.opts.search, self.surface.as_ref());
+                // The frame's own edge points when it was measured around the prediction; a frame found by
+                // detection is searched once more.
+                let res = if self.rim_rays.is_empty() {
+                    rim_residuals(img, &fit, &self.opts.search, self.surface.as_ref())
+                } else {
+                    residuals_about(&fit, &self.rim_rays)
+                };
                 self.rim.add(self.opts.search.rays.max(8), &res);
                 if self.rim.frames() >= RIM_MIN_SAMPLES {
                     self.opts.search.rim_shape = self.rim.shape();

@@ -127,3 +127,39 @@ fn no_ball_and_flat_frames_give_nothing_not_a_panic() {
     let white = vec![255u8; 128 * 128];
     assert!(detect_circles(&Plane::new(&white, 128, 128), &CircleDetection::default()).is_empty());
 }
+
+/// Over the full acquisition range (8 px to half the frame), a lone ball of any size is the best candidate:
+/// the octave bands each search their own radii, and the many small circles of the band's noise do not
+/// push the ball out.
+#[test]
+fn the_full_radius_range_finds_balls_of_every_size() {
+    for r in [9.0, 21.0, 47.0, 90.0, 180.0] {
+        let s = Scene {
+            size: (512, 512),
+            ball: (251.3, 262.6, r),
+            noise: 4.0,
+            distractors: vec![(40.0, 40.0, 6.0, 30.0)],
+            ..Scene::default()
+        };
+        let px = render(&s);
+        let det = CircleDetection {
+            min_radius: 8.0,
+            max_radius: 256.0,
+            max_candidates: 24,
+            ..Default::default()
+        };
+        let found = detect_circles(&plane(&px, &s), &det);
+        let best = found.first().unwrap_or_else(|| panic!("r {r}: no circle"));
+        let tol = 1.5 + 0.03 * r;
+        assert!(
+            (best.x - s.ball.0).abs() < tol && (best.y - s.ball.1).abs() < tol && (best.r - r).abs() < tol,
+            "r {r}: {best:?}"
+        );
+        // A circle seen in two overlapping bands is reported once.
+        let copies = found
+            .iter()
+            .filter(|c| (c.x - s.ball.0).hypot(c.y - s.ball.1) < 0.1 * r && (c.r - r).abs() < 0.1 * r)
+            .count();
+        assert_eq!(copies, 1, "r {r}: {found:?}");
+    }
+}
