@@ -102,8 +102,8 @@ impl Estimate {
     pub fn contact_at_level(&self, level_m: f64, radius_m: f64) -> (f64, f64) {
         let y = radius_m + level_m;
         (
-            crossing(&self.flight_in, y, self.t_touch.value, 0.0).value,
-            crossing(&self.flight_out, y, self.t_sep.value, 0.0).value,
+            crossing(&self.flight_in, y, self.t_touch.value).t.value,
+            crossing(&self.flight_out, y, self.t_sep.value).t.value,
         )
     }
 }
@@ -218,27 +218,50 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
     let radius = c.ball_diameter_m / 2.0;
     // Uncertainty of "one radius above the surface line" in the local frame, m.
     let sigma_level = ((line.sigma_y0 * s).powi(2) + (radius * scale.sigma_m_per_px / s).powi(2)).sqrt();
-    let t_touch = crossing(&fin, radius, points[first].t, sigma_level);
-    let t_sep = crossing(&fout, radius, points[last].t, sigma_level);
+    // The level's error is common to both crossings, so it is carried as a derivative and propagated
+    // coherently into the contact time, COR and μ, not added to each crossing separately.
+    let touch = crossing(&fin, radius, points[first].t);
+    let sep = crossing(&fout, radius, points[last].t);
+    let with_level = |c: &Crossing| Measured::new(c.t.value, c.t.se.hypot(c.dt_dlevel * sigma_level));
+    let (t_touch, t_sep) = (with_level(&touch), with_level(&sep));
     let rel_scale = scale.sigma_m_per_px / s;
-    // Velocities at the crossings: statistical error (for ratios, where the scale cancels) and total.
-    let velocity = |f: &BallisticFit, t: &Measured| {
-        let v = f.velocity(t.value);
+    // Per velocity component at a crossing: the value, the fit's error (for ratios, where the scale and the
+    // level's common part are propagated separately), its derivative with the level, and the total error.
+    let velocity = |f: &BallisticFit, c: &Crossing| {
+        let v = f.velocity(c.t.value);
         [0, 1].map(|k| {
-            let (_, sv, _) = f.errors_at(k, t.value);
-            let stat = (sv * sv + (f.a[k] * t.se).powi(2)).sqrt();
-            (v[k], stat, (stat * stat + (v[k] * rel_scale).powi(2)).sqrt())
+            let (_, sv, _) = f.errors_at(k, c.t.value);
+            let stat = (sv * sv + (f.a[k] * c.t.se).powi(2)).sqrt();
+            let dv_dlevel = f.a[k] * c.dt_dlevel;
+            let total = (stat * stat + (dv_dlevel * sigma_level).powi(2) + (v[k] * rel_scale).powi(2)).sqrt();
+            VelocityPart {
+                value: v[k],
+                stat,
+                dv_dlevel,
+                total,
+            }
         })
     };
-    let vin = velocity(&fin, &t_touch);
-    let vout = velocity(&fout, &t_sep);
-    let cor = (vout[1].0 / vin[1].0).abs();
-    let cor_se = cor * ((vin[1].1 / vin[1].0).powi(2) + (vout[1].1 / vout[1].0).powi(2)).sqrt();
-    let (dvt, dvn) = (vout[0].0 - vin[0].0, vout[1].0 - vin[1].0);
+    let vin = velocity(&fin, &touch);
+    let vout = velocity(&fout, &sep);
+    let cor = (vout[1].value / vin[1].value).abs();
+    let cor_level = cor * (vout[1].dv_dlevel / vout[1].value - vin[1].dv_dlevel / vin[1].value) * sigma_level;
+    let cor_se = (cor * cor * ((vin[1].stat / vin[1].value).powi(2) + (vout[1].stat / vout[1].value).powi(2))
+        + cor_level * cor_level)
+        .sqrt();
+    let (dvt, dvn) = (vout[0].value - vin[0].value, vout[1].value - vin[1].value);
     let mu = -dvt / dvn;
-    let mu_se = ((vin[0].1.powi(2) + vout[0].1.powi(2)) / (dvn * dvn)
-        + (dvt / (dvn * dvn)).powi(2) * (vin[1].1.powi(2) + vout[1].1.powi(2)))
-    .sqrt();
+    let (ddvt, ddvn) = (
+        vout[0].dv_dlevel - vin[0].dv_dlevel,
+        vout[1].dv_dlevel - vin[1].dv_dlevel,
+    );
+    let mu_level = (-ddvt / dvn + dvt * ddvn / (dvn * dvn)) * sigma_level;
+    let mu_se = ((vin[0].stat.powi(2) + vout[0].stat.powi(2)) / (dvn * dvn)
+        + (dvt / (dvn * dvn)).powi(2) * (vin[1].stat.powi(2) + vout[1].stat.powi(2))
+        + mu_level * mu_level)
+        .sqrt();
+    let contact_se =
+        (touch.t.se.powi(2) + sep.t.se.powi(2) + ((sep.dt_dlevel - touch.dt_dlevel) * sigma_level).powi(2)).sqrt();
     let contact = &points[first..=last];
     let (t_max, delta_max) = deepest(contact, radius, sigma_level, rel_scale);
     let mut notes = Vec::new();
@@ -252,11 +275,11 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
         }
     }
     Ok(Estimate {
-        v_in: [Measured::new(vin[0].0, vin[0].2), Measured::new(vin[1].0, vin[1].2)],
-        v_out: [Measured::new(vout[0].0, vout[0].2), Measured::new(vout[1].0, vout[1].2)],
+        v_in: vin.map(|v| Measured::new(v.value, v.total)),
+        v_out: vout.map(|v| Measured::new(v.value, v.total)),
         cor: Measured::new(cor, cor_se),
         mu: Measured::new(mu, mu_se),
-        contact_ms: Measured::new((t_sep.value - t_touch.value) * 1e3, (t_sep.se.hypot(t_touch.se)) * 1e3),
+        contact_ms: Measured::new((t_sep.value - t_touch.value) * 1e3, contact_se * 1e3),
         t_touch,
         t_max,
         t_sep,
@@ -277,8 +300,28 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
     })
 }
 
-/// When the arc's height is `level` (the root nearest `near`), with its standard error.
-fn crossing(f: &BallisticFit, level: f64, near: f64, sigma_level: f64) -> Measured {
+/// When a flight arc crosses the contact level.
+struct Crossing {
+    /// The time, s, with the fit's standard error (the level taken as exact).
+    t: Measured,
+    /// How the time moves with the level, s/m (1 / the normal velocity there).
+    dt_dlevel: f64,
+}
+
+/// One velocity component at a crossing, m/s.
+#[derive(Clone, Copy)]
+struct VelocityPart {
+    value: f64,
+    /// The flight fit's standard error (its timing included, the level's and scale's errors not).
+    stat: f64,
+    /// How the value moves with the contact level (the arc's acceleration × dt/dlevel), 1/s.
+    dv_dlevel: f64,
+    /// All errors: the fit's, the level's and the scale's.
+    total: f64,
+}
+
+/// When the arc's height is `level` (the root nearest `near`), with the fit's standard error.
+fn crossing(f: &BallisticFit, level: f64, near: f64) -> Crossing {
     // ½a·d² + v0·d + (p0 − level) = 0 in d = t − t_ref.
     let (a, b, c) = (0.5 * f.a[1], f.v0[1], f.p0[1] - level);
     let d_near = near - f.t_ref;
@@ -295,8 +338,12 @@ fn crossing(f: &BallisticFit, level: f64, near: f64, sigma_level: f64) -> Measur
     };
     let t = f.t_ref + d;
     let vy = f.velocity(t)[1];
+    let vy = if vy.abs() < 1e-9 { 1e-9_f64.copysign(vy) } else { vy };
     let (sp, _, _) = f.errors_at(1, t);
-    Measured::new(t, (sp * sp + sigma_level * sigma_level).sqrt() / vy.abs().max(1e-9))
+    Crossing {
+        t: Measured::new(t, sp / vy.abs()),
+        dt_dlevel: 1.0 / vy,
+    }
 }
 
 /// Time and depth of the lowest centre: a parabola through the frames around the lowest one.

@@ -188,3 +188,26 @@ fn a_clip_ending_close_to_the_impact_is_refused_with_a_reason() {
     );
     assert!(err.to_string().contains("ends too close to the impact"), "{err}");
 }
+
+/// A surface line found off by its stated σ moves both crossings the same way (the contact level is common
+/// to them), so the contact time's error is the sum of the two crossings' shifts, and its SE says so.
+#[test]
+fn a_surface_line_off_by_its_sigma_is_one_standard_error_of_the_contact_time() {
+    let model = Model::paper(25_650.0, 14.0, 0.5);
+    for (angle, drop) in [(0.0, 0.2), (22.5, 0.9)] {
+        let (mut track, truth) = shot(&model, angle, drop, 0.02, 11);
+        let line = track.surface.as_mut().unwrap();
+        // Found 0.5 px above the true surface, and said to be uncertain by 0.5 px.
+        line.y0 -= 0.5;
+        line.sigma_y0 = 0.5;
+        let e = estimate(&track, &conditions(angle)).unwrap();
+        let z = (e.contact_ms.value - truth.contact_time() * 1e3) / e.contact_ms.se;
+        assert!((0.8..=1.25).contains(&z), "{angle}°: contact time error/SE = {z}");
+        // COR barely moves: both speeds change the same way.
+        assert!(
+            (e.cor.value - truth.restitution).abs() < 2.0 * e.cor.se,
+            "{angle}°: {:?}",
+            e.cor
+        );
+    }
+}

@@ -16,6 +16,8 @@ struct Truth {
     x: f64,
     y: f64,
     r: f64,
+    /// Centre height above the surface, m.
+    y_m: f64,
     contact: bool,
     visible: bool,
 }
@@ -28,11 +30,12 @@ fn read_truth(path: &Path) -> HashMap<usize, Truth> {
             .position(|c| c == name)
             .unwrap_or_else(|| panic!("{name} column"))
     };
-    let (f, x, y, r, ph, vis) = (
+    let (f, x, y, r, ym, ph, vis) = (
         col("frame"),
         col("x_px"),
         col("y_px"),
         col("r_px"),
+        col("y_m"),
         col("phase"),
         col("visible"),
     );
@@ -46,6 +49,7 @@ fn read_truth(path: &Path) -> HashMap<usize, Truth> {
                     x: n(x),
                     y: n(y),
                     r: n(r),
+                    y_m: n(ym),
                     contact: &rec[ph] != "flight",
                     visible: &rec[vis] == "full",
                 },
@@ -91,11 +95,11 @@ fn main() {
     };
     let shots = read_shots(&truth_dir.join("shots.csv"));
     println!(
-        "| clip | frames ok | flight RMS px | contact RMS px | contact shift px | jitter px | radius bias px | RMS err/σ | scale err % | tilt err ° |"
+        "| clip | frames ok | flight RMS px | contact RMS px | contact shift px | jitter px | radius bias px | RMS err/σ | scale err % | tilt err ° | line height px |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
     let (mut all_f, mut all_c, mut all_j, mut all_rb, mut all_z) = (vec![], vec![], vec![], vec![], vec![]);
-    let mut all_shift = vec![];
+    let (mut all_shift, mut all_line) = (vec![], vec![]);
     for (clip_name, (scale_truth, tilt_truth)) in &shots {
         let clip = Clip::open(session.join(clip_name)).unwrap();
         let truth = read_truth(&truth_dir.join(format!("{clip_name}.csv")));
@@ -135,6 +139,16 @@ fn main() {
             .map(|s| (s.m_per_px / scale_truth - 1.0) * 100.0)
             .unwrap_or(f64::NAN);
         let tilt_err = track.surface.map(|l| l.tilt_deg() - tilt_truth).unwrap_or(f64::NAN);
+        // How far above the renderer's contact plane the surface line was found, px, below the first frame's
+        // centre (distances taken perpendicular to the line).
+        let line_height = match (track.surface, truth.get(&0)) {
+            (Some(l), Some(t)) => {
+                let found = (l.y_at(t.x) - t.y) * l.slope.atan().cos();
+                t.y_m / scale_truth - found
+            }
+            _ => f64::NAN,
+        };
+        all_line.push(line_height);
         let mean_rb = rb.iter().sum::<f64>() / rb.len().max(1) as f64;
         // ef and ec hold (dx, dy) pairs.
         let mean_xy = |v: &[f64], k: usize| {
@@ -146,7 +160,7 @@ fn main() {
             all_shift.push(shift);
         }
         println!(
-            "| {clip_name} | {ok}/{} | {:.3} | {:.3} | {:.3} | {:.4} | {:+.3} | {:.2} | {:+.3} | {:+.3} |",
+            "| {clip_name} | {ok}/{} | {:.3} | {:.3} | {:.3} | {:.4} | {:+.3} | {:.2} | {:+.3} | {:+.3} | {:+.3} |",
             track.fixes.len(),
             rms(&ef),
             rms(&ec),
@@ -155,7 +169,8 @@ fn main() {
             mean_rb,
             rms(&z),
             scale_err,
-            tilt_err
+            tilt_err,
+            line_height
         );
         all_f.extend(ef);
         all_c.extend(ec);
@@ -165,13 +180,14 @@ fn main() {
     }
     let mean_rb = all_rb.iter().sum::<f64>() / all_rb.len().max(1) as f64;
     println!(
-        "| **all** | | **{:.3}** | **{:.3}** | **{:.3}** (RMS) | **{:.4}** | **{:+.3}** | **{:.2}** | | |",
+        "| **all** | | **{:.3}** | **{:.3}** | **{:.3}** (RMS) | **{:.4}** | **{:+.3}** | **{:.2}** | | | **{:+.3}** (mean) |",
         rms(&all_f),
         rms(&all_c),
         rms(&all_shift),
         rms(&all_j),
         mean_rb,
-        rms(&all_z)
+        rms(&all_z),
+        all_line.iter().sum::<f64>() / all_line.len().max(1) as f64
     );
 }
 

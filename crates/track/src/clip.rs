@@ -358,6 +358,7 @@ pub fn track_clip(
         tracker.surface(),
         opts.ball_diameter_m,
         tracker.edge_definition_px(),
+        tracker.rim_shape().map_or(0.0, |s| s.rms_px()),
     );
     Ok(Track {
         fixes,
@@ -443,14 +444,21 @@ fn observe<P: Pixel>(tracker: &mut Tracker, frame: usize, t_s: f64, p: &Plane<P>
 
 /// m/px from the mean radius of frames where the whole ball is clear of the surface and the border.
 ///
-/// Its standard error holds the radius's scatter over those frames and, as a Type-B term, the rim's
-/// definition: `edge_definition_px / √3`, the median distance between the gradient-maximum edge and the
-/// half-contrast crossing taken as the half-width of a uniform uncertainty.
+/// Its standard error holds the radius's scatter over those frames and two Type-B terms for where "the rim"
+/// is, both measured on the clip:
+/// - the edge's definition, `edge_definition_px / √3`: the median distance between the gradient-maximum
+///   edge and the half-contrast crossing, taken as the half-width of a uniform uncertainty;
+/// - the rim's shape, `rim_shape_rms_px`: lighting and the limb's shading move the apparent edge by
+///   different amounts at different angles (the learned [`RimShape`](crate::RimShape)). Their mean over the
+///   rim, which is what biases the radius, cannot be seen (a circle absorbs it), so it is taken to be as
+///   uncertain as the part that can: the shape's RMS, as a standard uncertainty. The same reasoning keeps
+///   the uncorrected spread in each frame's centre σ.
 pub(crate) fn scale_from(
     fixes: &[BallFix],
     surface: Option<&SurfaceLine>,
     diameter: f64,
     edge_definition_px: f64,
+    rim_shape_rms_px: f64,
 ) -> Option<Scale> {
     let radii: Vec<f64> = fixes
         .iter()
@@ -467,7 +475,8 @@ pub(crate) fn scale_from(
     let m_per_px = diameter / (2.0 * mean);
     Some(Scale {
         m_per_px,
-        sigma_m_per_px: m_per_px * ((sd * sd / n) + edge_definition_px.powi(2) / 3.0).sqrt() / mean,
+        sigma_m_per_px: m_per_px * ((sd * sd / n) + edge_definition_px.powi(2) / 3.0 + rim_shape_rms_px.powi(2)).sqrt()
+            / mean,
         radius_px: mean,
         frames: radii.len(),
     })
@@ -491,6 +500,32 @@ mod tests {
             seed: k as u64,
             ..Scene::default()
         })
+    }
+
+    /// The rim shape's RMS enters the scale's error as a standard uncertainty of the radius.
+    #[test]
+    fn the_scale_error_holds_the_rim_shape() {
+        let fixes: Vec<BallFix> = (0..20)
+            .map(|k| BallFix {
+                frame: k,
+                t_s: k as f64 * 1e-4,
+                x_px: 100.0,
+                y_px: 100.0 + k as f64,
+                r_px: if k % 2 == 0 { 79.99 } else { 80.01 },
+                sigma_px: 0.02,
+                sigma_r_px: 0.02,
+                quality: 1.0,
+                status: Status::Ok,
+            })
+            .collect();
+        let plain = scale_from(&fixes, None, 0.067, 0.0, 0.0).unwrap();
+        let shaped = scale_from(&fixes, None, 0.067, 0.0, 0.08).unwrap();
+        assert_eq!(plain.m_per_px, shaped.m_per_px);
+        // The radii's scatter alone: 0.01 px / √20 of 80 px.
+        let scatter = plain.sigma_m_per_px / plain.m_per_px;
+        assert!(scatter < 5e-5, "{plain:?}");
+        let rel = shaped.sigma_m_per_px / shaped.m_per_px;
+        assert!((rel - scatter.hypot(0.08 / 80.0)).abs() < 1e-9, "{rel}");
     }
 
     #[test]

@@ -62,6 +62,14 @@ pub struct RimShape {
     pub offsets_px: std::sync::Arc<[f64]>,
 }
 
+impl RimShape {
+    /// The RMS of the offsets over the rim, px: how far the apparent rim strays from a circle.
+    pub fn rms_px(&self) -> f64 {
+        let n = self.offsets_px.len().max(1) as f64;
+        (self.offsets_px.iter().map(|o| o * o).sum::<f64>() / n).sqrt()
+    }
+}
+
 /// Highest harmonic of the rim's shape kept (see [`RimShapeLearner::shape`]).
 const RIM_HARMONICS: usize = 8;
 

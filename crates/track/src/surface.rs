@@ -74,16 +74,7 @@ pub fn find_surface_line<P: Pixel>(img: &Plane<P>) -> Option<SurfaceLine> {
             .collect();
         peaks.sort_by(|a, b| b.1.total_cmp(&a.1));
         for &(y, s) in peaks.iter().take(6) {
-            let (a0, a1, a2) = (d[y - 1].abs() as f64, d[y].abs() as f64, d[y + 1].abs() as f64);
-            let den = a0 - 2.0 * a1 + a2;
-            let off = if den < 0.0 {
-                (0.5 * (a0 - a2) / den).clamp(-0.5, 0.5)
-            } else {
-                0.0
-            };
-            // The derivative at y spans rows y−2..y+2, centred between y and y+1... centred on y + 0.0
-            // (symmetric stencil around y), so the edge sits at y + off.
-            cands.push((x as f64, y as f64 + off, s as f64));
+            cands.push((x as f64, sub_pixel_edge(&prof, y), s as f64));
         }
     }
     if cands.len() < 8 {
@@ -133,6 +124,29 @@ pub fn find_surface_line<P: Pixel>(img: &Plane<P>) -> Option<SurfaceLine> {
         .min_by(|a, b| (a.1 + a.2 * xc).total_cmp(&(b.1 + b.2 * xc)))
         .copied()?;
     refine_line(&cands, c, slope, tol, xc)
+}
+
+/// The edge at row `y` of a column profile (the smoothed derivative's peak), to a fraction of a row: a
+/// parabola through the narrowest central differences |p[k+1] − p[k−1]| at rows y−1, y, y+1.
+///
+/// The smoothed derivative finds the edge among the texture, but it mixes in the brightness slopes on either
+/// side: a band whose top edge catches the light (brighter just below the edge, fading over a few rows)
+/// pulls its peak up by about a third of a row, the narrowest difference by half as much. The row stays
+/// the smoothed derivative's, since the narrow difference's own peak wanders on a weak edge in texture.
+fn sub_pixel_edge(prof: &[f32], y: usize) -> f64 {
+    let n = |k: usize| (prof[k + 1] - prof[k - 1]).abs() as f64;
+    let h = prof.len();
+    let lo = y.saturating_sub(1).max(2);
+    let hi = (y + 1).min(h - 3);
+    let k = y.clamp(lo, hi);
+    let (a0, a1, a2) = (n(k - 1), n(k), n(k + 1));
+    let den = a0 - 2.0 * a1 + a2;
+    let off = if den < 0.0 {
+        (0.5 * (a0 - a2) / den).clamp(-0.5, 0.5)
+    } else {
+        0.0
+    };
+    k as f64 + off
 }
 
 /// Number of distinct columns with a candidate within `tol` of the line, and their mean edge strength.
@@ -191,4 +205,50 @@ fn refine_line(cands: &[(f64, f64, f64)], mut c: f64, mut slope: f64, tol: f64, 
         });
     }
     result
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A column crossing a band's top edge at row `e`: backdrop 70 above; below, a band of 90 whose top
+    /// `lip` rows catch the light (up to +12, fading linearly); the edge's coverage ramps over one row.
+    fn column(e: f64, lip: f64) -> Vec<f32> {
+        (0..40)
+            .map(|y| {
+                let y = y as f64;
+                let cover = (y - e + 0.5).clamp(0.0, 1.0);
+                let depth = (y - e).max(0.0);
+                let band = 90.0
+                    + if lip > 0.0 {
+                        12.0 * (1.0 - depth / lip).max(0.0)
+                    } else {
+                        0.0
+                    };
+                (70.0 * (1.0 - cover) + band * cover) as f32
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_plain_step_is_found_to_a_small_fraction_of_a_row() {
+        for e in [20.0, 20.25, 20.5, 20.8] {
+            let p = column(e, 0.0);
+            let y = sub_pixel_edge(&p, e.round() as usize);
+            assert!((y - e).abs() < 0.1, "{y} vs {e}");
+        }
+    }
+
+    #[test]
+    fn a_lit_lip_pulls_the_edge_less_than_a_smoothed_derivative_does() {
+        let e = 20.0;
+        let p = column(e, 2.5);
+        let y = sub_pixel_edge(&p, 20);
+        // The four-row smoothed derivative's parabola puts this edge 0.28 rows high.
+        let d = |k: usize| ((p[k + 1] + p[k + 2]) - (p[k - 1] + p[k - 2])).abs() as f64;
+        let (a0, a1, a2) = (d(19), d(20), d(21));
+        let smoothed = 20.0 + 0.5 * (a0 - a2) / (a0 - 2.0 * a1 + a2);
+        assert!((smoothed - e).abs() > 0.25, "{smoothed}");
+        assert!((y - e).abs() < 0.2, "{y}");
+    }
 }

@@ -198,6 +198,11 @@ impl Tracker {
         *e.select_nth_unstable_by(mid, f64::total_cmp).1
     }
 
+    /// The rim's shape learned so far (see [`RimShape`](crate::RimShape)), if enough full-rim frames were seen.
+    pub fn rim_shape(&self) -> Option<&crate::RimShape> {
+        self.opts.search.rim_shape.as_ref()
+    }
+
     /// The radius expected from free flight so far, px.
     pub fn flight_radius(&self) -> Option<f64> {
         if self.flight_radii.is_empty() {
