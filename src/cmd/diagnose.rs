@@ -56,6 +56,12 @@ pub fn run(mut a: Args) -> anyhow::Result<()> {
         ),
         _ => {}
     }
+    if let Some(p) = &d.proposal {
+        println!(
+            "\na formula term to try (add to {model}, then analyse again):\n{}",
+            p.model_toml.trim_end()
+        );
+    }
     println!("wrote {}", diagnosis.display());
     fail_on_failed_shots(&analysis)
 }

@@ -247,6 +247,10 @@ pub struct Diagnosis {
     pub folds: usize,
     /// The thresholds.
     pub thresholds: Thresholds,
+    /// A formula term proposed when no library effect explains the misfit (`none_explains` only, and only
+    /// when one removes a material part of it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub proposal: Option<crate::TermProposal>,
     /// Wall time of the search, s.
     pub seconds: f64,
 }

@@ -14,6 +14,9 @@
 //! (default 6 folds, each fit warm-started at the full fit), which costs a fixed number of refits however
 //! many shots a session has: leave-one-shot-out would cost one refit per shot per candidate.
 //!
+//! When none explains it, a formula term is looked for in a small library of normal forces in δ and δ̇
+//! (forward selection, each term fitted through the simulator: [`TermProposal`]).
+//!
 //! [`find_missing_effect`] returns a [`Diagnosis`] (`diagnosis.json`); [`add_effect_to_model_toml`] adds the
 //! named effect to the user's `model.toml`, comments kept. See `docs/diagnosis.md`.
 
@@ -23,6 +26,7 @@ mod error;
 mod evaluate;
 mod model_file;
 mod options;
+mod proposal;
 mod search;
 mod stats;
 mod verdict;
@@ -36,4 +40,5 @@ pub use error::DiagnoseError;
 pub use evaluate::{FitSummary, FittedValue};
 pub use model_file::add_effect_to_model_toml;
 pub use options::{Progress, SearchOptions};
+pub use proposal::{ProposedTerm, TermProposal};
 pub use search::{find_missing_effect, find_missing_effect_with};

@@ -72,6 +72,11 @@ pub struct SearchOptions {
     pub fold_max_iterations: usize,
     /// Integration settings of every simulation.
     pub sim: SimOptions,
+    /// When no library effect explains a misfit, look for a formula term that does (default true): forward
+    /// selection over a small library of normal-force terms in δ and δ̇ ([`TermProposal`](crate::TermProposal)),
+    /// each fitted and judged by held-out error like a candidate. Costs one candidate's fit per term tried
+    /// (10 for the first term, 9 for a second).
+    pub propose_terms: bool,
 }
 
 impl Default for SearchOptions {
@@ -98,6 +103,7 @@ impl Default for SearchOptions {
             },
             fold_max_iterations: 15,
             sim: SimOptions::default(),
+            propose_terms: true,
         }
     }
 }

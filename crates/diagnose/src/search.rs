@@ -1,12 +1,14 @@
 //! The search: the current model and every candidate fitted to all shots and cross-validated across
 //! shots, then compared.
 
+use crate::VerdictKind;
 use crate::candidates::{CandidateSetup, candidate_names, library_effect, set_values, with_candidate};
 use crate::diagnosis::{
     Baseline, Candidate, Checks, Diagnosis, Evidence, Noise, NoiseSource, PhaseResidual, Signature, Thresholds,
 };
 use crate::evaluate::{Evaluator, ShotSums, summarize};
 use crate::options::{Progress, SearchOptions};
+use crate::proposal::{self, ProposedTerm, TermProposal};
 use crate::verdict::decide;
 use crate::{DiagnoseError, FitSummary, stats};
 use bouncelab_compare::{Component, DiagnoseOptions, ShotExtras, compare, diagnose};
@@ -356,7 +358,26 @@ pub fn find_missing_effect_with(
             })
             .collect(),
     };
-    let (verdict, baseline, signature) = decide(&mut candidates, verdict_inputs);
+    let (mut verdict, baseline, signature) = decide(&mut candidates, verdict_inputs);
+    let proposal = if options.propose_terms && verdict.kind == VerdictKind::NoneExplains {
+        let levels = base.levels.as_deref();
+        let search = TermSearch {
+            shots,
+            fold_of: &fold_of,
+            k,
+            options,
+            levels,
+            noise_m,
+            progress,
+            total,
+        };
+        search.propose(&warm, heldout_error_m)
+    } else {
+        None
+    };
+    if let Some(p) = &proposal {
+        verdict.sentence = format!("{} {}", verdict.sentence, proposal::sentence(p));
+    }
     progress(Progress {
         done: total,
         total,
@@ -378,8 +399,123 @@ pub fn find_missing_effect_with(
             phase_tolerance_m: options.phase_tolerance_m,
             explained_fraction: options.explained_fraction,
         },
+        proposal,
         seconds: clock.elapsed().as_secs_f64(),
     })
+}
+
+/// What the term search needs of the missing-effect search.
+struct TermSearch<'a> {
+    shots: &'a [MeasuredShot],
+    fold_of: &'a [usize],
+    k: usize,
+    options: &'a SearchOptions,
+    levels: Option<&'a [f64]>,
+    noise_m: f64,
+    progress: &'a dyn Fn(Progress),
+    total: usize,
+}
+
+impl TermSearch<'_> {
+    /// Forward selection over the term library (see [`proposal`]): from `current` (the current model at its
+    /// fitted values, held-out error `heldout_m`), each round fits every unused term as one more custom
+    /// effect and keeps the one with the lowest held-out error, if its coefficient is at least
+    /// `min_param_z` standard errors from zero and it removes at least [`proposal::MIN_TERM_FRACTION`] of
+    /// the systematic held-out mean square left; it stops when a round keeps nothing, at
+    /// [`proposal::MAX_TERMS`], or when what is left is within the tolerance. `None` when no term is kept.
+    fn propose(&self, current: &ModelSpec, heldout_m: f64) -> Option<TermProposal> {
+        let systematic = |e: f64| excess(e * e, self.noise_m);
+        let mut current = current.clone();
+        let mut err = heldout_m;
+        let mut chosen: Vec<usize> = Vec::new();
+        let mut terms: Vec<ProposedTerm> = Vec::new();
+        for round in 0..proposal::MAX_TERMS {
+            let name = format!("term_{}", round + 1);
+            let tries: Vec<usize> = (0..proposal::library_size()).filter(|i| !chosen.contains(i)).collect();
+            let mut best: Option<(usize, ModelRun, f64, ModelSpec)> = None;
+            for (j, &i) in tries.iter().enumerate() {
+                let (phase, target, formula, start) = proposal::term(i);
+                (self.progress)(Progress {
+                    done: self.total.saturating_sub(1),
+                    total: self.total,
+                    what: format!("term {}/{}: {target} {formula} in {phase}", j + 1, tries.len()),
+                });
+                let Some(spec) = with_term(&current, &name, i, start) else {
+                    continue;
+                };
+                let Ok(run) = run_model(&spec, self.shots, self.fold_of, self.k, self.options, self.levels) else {
+                    continue;
+                };
+                let e = rms_of(run.heldout.iter().flatten());
+                if e.is_finite() && best.as_ref().is_none_or(|b| e < b.2) {
+                    best = Some((i, run, e, spec));
+                }
+            }
+            let Some((i, run, e, mut spec)) = best else {
+                break;
+            };
+            let Some(c) = run
+                .summary
+                .parameters
+                .iter()
+                .find(|p| p.effect == name && p.param == "c")
+            else {
+                break;
+            };
+            let z = c.std_error.map_or(0.0, |s| c.value.abs() / s);
+            let (before, after) = (systematic(err).powi(2), systematic(e).powi(2));
+            if z < self.options.min_param_z || before - after < proposal::MIN_TERM_FRACTION * before {
+                break;
+            }
+            let (phase, target, formula, _) = proposal::term(i);
+            terms.push(ProposedTerm {
+                name: name.clone(),
+                phase: phase.into(),
+                target: target.into(),
+                formula: formula.into(),
+                c: c.value,
+                c_std_error: c.std_error,
+                heldout_error_m: e,
+            });
+            set_values(&mut spec, &run.summary.parameters);
+            chosen.push(i);
+            current = spec;
+            err = e;
+            if systematic(e) <= self.options.tolerance_m {
+                break;
+            }
+        }
+        if terms.is_empty() {
+            return None;
+        }
+        let model_toml = terms
+            .iter()
+            .zip(&chosen)
+            .map(|(t, &i)| proposal::term_toml(&t.name, i, t.c))
+            .collect::<Vec<_>>()
+            .join("\n");
+        Some(TermProposal {
+            terms,
+            library_size: proposal::library_size(),
+            heldout_before_m: heldout_m,
+            heldout_after_m: err,
+            systematic_before_m: systematic(heldout_m),
+            systematic_after_m: systematic(err),
+            model_toml,
+        })
+    }
+}
+
+/// `spec` with library term `i` added as the custom effect `name`, its coefficient free from `start`.
+fn with_term(spec: &ModelSpec, name: &str, i: usize, start: f64) -> Option<ModelSpec> {
+    // The model crate reads the term as it would from a user's file, so what is proposed is what a file
+    // with it would give.
+    let text = format!("[effects.spring]\nk = 1\n{}", proposal::term_toml(name, i, start));
+    let parsed = ModelSpec::parse(&text, "term library").ok()?;
+    let effect = parsed.effects.into_iter().find(|e| e.name == name)?;
+    let mut out = spec.clone();
+    out.effects.push(effect);
+    Some(out)
 }
 
 /// The candidate setups of a search, in library order.

@@ -172,13 +172,55 @@ fn invented(name: &str, body: &str, tracking: Tracking) -> Diagnosis {
 /// held-out ones better.
 #[test]
 fn invented_adhesion_is_not_given_a_library_name() {
-    invented("pull_off", ADHESION_STRONG, Tracking::default());
+    let d = invented("pull_off", ADHESION_STRONG, Tracking::default());
+    // No library term has the pull-off's exponential shape, but the term library comes close: a constant
+    // pull in restitution first.
+    let p = d.proposal.as_ref().expect("a term proposed");
+    assert_eq!(
+        (p.terms[0].phase.as_str(), p.terms[0].formula.as_str()),
+        ("restitution", "c"),
+        "{p:?}"
+    );
+    assert!(p.terms[0].c < 0.0, "a pull: {p:?}");
+    assert!(p.heldout_after_m < 0.5 * p.heldout_before_m, "{p:?}");
+    assert!(p.model_toml.contains("kind = \"custom\""), "{}", p.model_toml);
+}
+
+/// A constant pull of 1.5 N while the ball leaves the surface is a term of the library: the search finds
+/// it again, with its coefficient.
+#[test]
+fn a_hidden_library_term_is_proposed_back() {
+    let d = invented(
+        "pull",
+        "phase = \"restitution\"\nnormal = \"-1.5\"",
+        Tracking::default(),
+    );
+    let p = d.proposal.as_ref().expect("a term proposed");
+    let t = &p.terms[0];
+    assert_eq!(
+        (t.phase.as_str(), t.target.as_str(), t.formula.as_str()),
+        ("restitution", "normal", "c"),
+        "{p:?}"
+    );
+    let se = t.c_std_error.expect("determined");
+    assert!((t.c + 1.5).abs() < 4.0 * se.max(0.01), "c = {} ± {se}", t.c);
+    assert!(p.systematic_after_m < 8e-6, "{p:?}");
 }
 
 /// Friction growing with the slip speed (a viscous tangential force on top of Coulomb's).
 #[test]
 fn invented_velocity_dependent_friction_is_not_given_a_library_name() {
-    invented("viscous_slip", VISCOUS_SLIP_STRONG, Tracking::default());
+    let d = invented("viscous_slip", VISCOUS_SLIP_STRONG, Tracking::default());
+    // It is a term of the library: −η·slip with η = 20 N·s/m.
+    let p = d.proposal.as_ref().expect("a term proposed");
+    let t = &p.terms[0];
+    assert_eq!(
+        (t.target.as_str(), t.formula.as_str()),
+        ("tangential", "c * slip"),
+        "{p:?}"
+    );
+    let se = t.c_std_error.expect("determined");
+    assert!((t.c + 20.0).abs() < 4.0 * se.max(0.1), "c = {} ± {se}", t.c);
 }
 
 /// σ stated 1.4× too large or too small, and the flattened ball's centre found 20 µm off in contact:
