@@ -195,4 +195,9 @@ fn an_effect_outside_the_library_is_not_named() {
     eprintln!("pull-off: {}", d.verdict.sentence);
     assert_eq!(d.verdict.kind, VerdictKind::NoneExplains, "{}", d.verdict.sentence);
     assert!(d.verdict.effect.is_none());
+    // The term search proposes a pull where the pull-off acts, and it removes most of the misfit.
+    let p = d.proposal.as_ref().expect("a formula term proposed");
+    let t = &p.terms[0];
+    assert!(t.target == "normal" && t.phase == "restitution" && t.c < 0.0, "{p:?}");
+    assert!(p.systematic_after_m < 0.5 * p.systematic_before_m, "{p:?}");
 }
