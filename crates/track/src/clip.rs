@@ -260,13 +260,17 @@ fn acquire(clip: &Clip, opts: &ClipTracking, warnings: &mut Vec<String>) -> Resu
                     seed: Some(seed),
                 }));
             }
-            if fallback.is_none() {
-                fallback = a.iter().find(|c| c.support > FALLBACK_QUALITY).map(|c| c.r);
+            // The clearest circle seen in any band, should none move.
+            if let Some(c) = a.iter().max_by(|p, q| p.support.total_cmp(&q.support))
+                && c.support > FALLBACK_QUALITY
+                && fallback.is_none_or(|f: crate::Circle| c.support > f.support)
+            {
+                fallback = Some(*c);
             }
         }
         k += gap;
     }
-    if let Some(r) = fallback {
+    if let Some(r) = fallback.map(|c| c.r) {
         warnings.push(format!(
             "could not tell the ball by its motion; tracking the clearest circle (radius {r:.1} px) — give the scale to be sure"
         ));

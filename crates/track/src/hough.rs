@@ -3,8 +3,9 @@
 //! radius of the range; the ball's centre collects the votes of its whole rim.
 //!
 //! Cost: O(pixels) for the gradient plus O(edges × radius range) votes, on an image downsampled so that
-//! the smallest radius is still ≥ 12 px (one octave of radii at a time when the range is wider); ≈ 1–3 ms
-//! for a 512×512 frame and a known radius, ≈ 5 ms for radii 8–256 px. Used once per clip and after a loss.
+//! the smallest radius is still ≥ 12 px (one octave of radii at a time when the range is wider); ≈ 0.3–3 ms
+//! for a 512×512 frame and a known radius, ≈ 22 ms for radii 8–256 px (50 ms as one band), most of it in the
+//! octaves below 24 px, which cannot be downsampled. Used once per clip and after a loss.
 
 use crate::plane::{Pixel, Plane};
 
@@ -100,8 +101,8 @@ fn sobel(p: &[f32], w: usize, h: usize) -> Gradients {
 ///
 /// A radius range wider than an octave is searched an octave at a time (bands overlapping by 10 %), each
 /// band on the image downsampled as far as its smallest radius allows: a vote costs the same at every
-/// sampling, and a band of radii [r, 2r] at factor f casts edges/f² × r/f of them, so the whole range
-/// 8–256 px costs about what its first octave does at full resolution. Each band keeps its own
+/// sampling, and a band of radii [r, 2r] at factor f casts edges/f² × r/f of them, so the bands above 24 px
+/// together cost less than the full-resolution ones below it. Each band keeps its own
 /// `max_candidates`, so a ball is never crowded out by the many small circles texture makes. Circles found
 /// in two overlapping bands are returned once.
 pub fn detect_circles<P: Pixel>(img: &Plane<P>, opts: &CircleDetection) -> Vec<Circle> {

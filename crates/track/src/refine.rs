@@ -278,7 +278,7 @@ pub(crate) fn refine_circle_with_rays<P: Pixel>(
         let (x, y, r) = (fit.fit.x, fit.fit.y, fit.fit.r);
         match once(x, y, r, search.half_width) {
             Some(f) => fit = f,
-            None => return Some(fit),
+            None => break,
         }
     }
     let narrow = (search.half_width * 0.5).max(2.0);

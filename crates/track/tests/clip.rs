@@ -79,3 +79,36 @@ fn a_clip_without_a_ball_is_an_error_naming_it() {
     assert!(matches!(err, TrackError::NoBall { .. }), "{err}");
     assert!(err.to_string().contains(&dir.path().display().to_string()));
 }
+
+/// A ball at rest cannot be told by its motion: the clearest circle over all radii is tracked (the ball,
+/// not the small screw head), and a warning says so.
+#[test]
+fn a_ball_at_rest_is_tracked_as_the_clearest_circle_with_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    write_clip(dir.path(), 24, |i| Scene {
+        ball: (120.3, 90.7, 40.0),
+        surface: Some((200.0, 0.0)),
+        band: (150.0, 20.0),
+        distractors: vec![(30.0, 215.0, 6.0, 40.0)],
+        seed: i as u64,
+        ..Scene::default()
+    });
+    let clip = Clip::open(dir.path()).unwrap();
+    let track = track_clip(&clip, &ClipTracking::default(), |_, _| {}).unwrap();
+    assert!(
+        track
+            .warnings
+            .iter()
+            .any(|w| w.contains("could not tell the ball by its motion")),
+        "{:?}",
+        track.warnings
+    );
+    let measured: Vec<_> = track.fixes.iter().filter(|f| f.status.measured()).collect();
+    assert!(!measured.is_empty());
+    for f in measured {
+        assert!(
+            (f.x_px - 120.3).abs() < 0.2 && (f.y_px - 90.7).abs() < 0.2 && (f.r_px - 40.0).abs() < 0.5,
+            "{f:?}"
+        );
+    }
+}
