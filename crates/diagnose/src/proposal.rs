@@ -142,6 +142,9 @@ pub struct TermProposal {
     pub systematic_after_m: f64,
     /// The terms as `model.toml` sections, coefficients free, to add and fit with `analyze`.
     pub model_toml: String,
+    /// Terms whose fit failed, each with why (such a term is not a candidate).
+    #[serde(default)]
+    pub failed: Vec<String>,
 }
 
 /// The library term `i` as the custom effect `name` of a model file, its coefficient free from `c`.

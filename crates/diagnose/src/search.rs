@@ -429,6 +429,7 @@ impl TermSearch<'_> {
         let mut err = heldout_m;
         let mut chosen: Vec<usize> = Vec::new();
         let mut terms: Vec<ProposedTerm> = Vec::new();
+        let mut failed: Vec<String> = Vec::new();
         for round in 0..proposal::MAX_TERMS {
             let name = format!("term_{}", round + 1);
             let tries: Vec<usize> = (0..proposal::library_size()).filter(|i| !chosen.contains(i)).collect();
@@ -440,11 +441,17 @@ impl TermSearch<'_> {
                     total: self.total,
                     what: format!("term {}/{}: {target} {formula} in {phase}", j + 1, tries.len()),
                 });
-                let Some(spec) = with_term(&current, &name, i, start) else {
-                    continue;
-                };
-                let Ok(run) = run_model(&spec, self.shots, self.fold_of, self.k, self.options, self.levels) else {
-                    continue;
+                let run = with_term(&current, &name, i, start).and_then(|spec| {
+                    run_model(&spec, self.shots, self.fold_of, self.k, self.options, self.levels)
+                        .map(|run| (spec, run))
+                        .map_err(|e| e.to_string())
+                });
+                let (spec, run) = match run {
+                    Ok(r) => r,
+                    Err(why) => {
+                        failed.push(format!("{target} `{formula}` in {phase}: {why}"));
+                        continue;
+                    }
                 };
                 let e = rms_of(run.heldout.iter().flatten());
                 if e.is_finite() && best.as_ref().is_none_or(|b| e < b.2) {
@@ -502,20 +509,24 @@ impl TermSearch<'_> {
             systematic_before_m: systematic(heldout_m),
             systematic_after_m: systematic(err),
             model_toml,
+            failed,
         })
     }
 }
 
 /// `spec` with library term `i` added as the custom effect `name`, its coefficient free from `start`.
-fn with_term(spec: &ModelSpec, name: &str, i: usize, start: f64) -> Option<ModelSpec> {
+fn with_term(spec: &ModelSpec, name: &str, i: usize, start: f64) -> Result<ModelSpec, String> {
     // The model crate reads the term as it would from a user's file, so what is proposed is what a file
     // with it would give.
-    let text = format!("[effects.spring]\nk = 1\n{}", proposal::term_toml(name, i, start));
-    let parsed = ModelSpec::parse(&text, "term library").ok()?;
-    let effect = parsed.effects.into_iter().find(|e| e.name == name)?;
+    let parsed = ModelSpec::parse(&proposal::term_toml(name, i, start), "term library").map_err(|e| e.to_string())?;
+    let effect = parsed
+        .effects
+        .into_iter()
+        .find(|e| e.name == name)
+        .ok_or_else(|| format!("the term library's text has no effect {name}"))?;
     let mut out = spec.clone();
     out.effects.push(effect);
-    Some(out)
+    Ok(out)
 }
 
 /// The candidate setups of a search, in library order.
