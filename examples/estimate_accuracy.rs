@@ -43,7 +43,7 @@ fn main() {
     println!("|---|---|---|---|---|---|---|---|---|");
     let (mut e_cor, mut e_mu, mut e_vin, mut e_vout, mut e_tc, mut e_d) =
         (vec![], vec![], vec![], vec![], vec![], vec![]);
-    let (mut z_cor, mut z_vin, mut z_vout) = (vec![], vec![], vec![]);
+    let (mut z_cor, mut z_vin, mut z_vout, mut z_tc) = (vec![], vec![], vec![], vec![]);
     let mut e_spin: Vec<(f64, f64)> = vec![]; // (error, allowed max(2 rad/s, 3 %))
     let mut groups: BTreeMap<(String, String), (Vec<f64>, Vec<f64>)> = BTreeMap::new();
     let mut failures = Vec::new();
@@ -94,6 +94,7 @@ fn main() {
         z_cor.push((est.cor.value - cor_t) / est.cor.se);
         z_vin.push((est.v_in[1].value - vin_n) / est.v_in[1].se);
         z_vout.push((est.v_out[1].value - vout_n) / est.v_out[1].se);
+        z_tc.push((est.contact_ms.value - num("contact_ms")) / est.contact_ms.se);
         let g = groups
             .entry((r[col("surface")].to_string(), r[col("angle_deg")].to_string()))
             .or_default();
@@ -135,6 +136,7 @@ fn main() {
         rms(&z_vin),
         rms(&z_vout)
     );
+    println!("| RMS(error/SE): contact time | {:.2} | not a target |", rms(&z_tc));
     println!();
     println!("| surface | angle ° | mean COR est | mean COR truth | difference |");
     println!("|---|---|---|---|---|");

@@ -87,8 +87,10 @@ pub struct Estimate {
     /// Reduced χ² of the flight fits (in x, in y, out x, out y): ≫ 1 means the tracker's σ is too small or the
     /// flight is not ballistic (drag, a bad frame).
     pub chi2_red: [f64; 4],
-    /// Standard error of the contact plane's height in the local frame, m: the surface line's (with the
-    /// correlation of its columns) and the scale's at one radius. 0 in estimates stored before it existed.
+    /// Shot-to-shot standard error of the contact plane's height in the local frame, m: the surface line's
+    /// (with the correlation of its columns) and the scale's at one radius, without the rim shape's Type-B
+    /// term, which lighting makes common to a session's clips (a fit's surface level takes that part; this
+    /// is the prior of each shot's deviation from it). 0 in estimates stored before it existed.
     #[serde(default)]
     pub surface_sigma_m: f64,
     /// Things a person should know.
@@ -216,8 +218,17 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
     let fin = fit(&incoming, "incoming")?;
     let fout = fit(&outgoing, "outgoing")?;
     let radius = c.ball_diameter_m / 2.0;
-    // Uncertainty of "one radius above the surface line" in the local frame, m.
-    let sigma_level = ((line.sigma_y0 * s).powi(2) + (radius * scale.sigma_m_per_px / s).powi(2)).sqrt();
+    // Uncertainty of "one radius above the surface line" in the local frame, m: all of it for this shot's
+    // errors (the line's scatter and its edge's definition as a uniform Type-B term, the scale's at one
+    // radius), and for a fit's per-shot level only the shot-to-shot part, without the Type-B terms that a
+    // surface's clips share (see `Estimate::surface_sigma_m`).
+    let sigma_level = ((line.sigma_y0.powi(2) + line.edge_definition_px.powi(2) / 3.0) * s * s
+        + (radius * scale.sigma_m_per_px / s).powi(2))
+    .sqrt();
+    let scatter_scale = (scale.sigma_m_per_px.powi(2) - scale.sigma_shape_m_per_px.powi(2))
+        .max(0.0)
+        .sqrt();
+    let sigma_level_scatter = ((line.sigma_y0 * s).powi(2) + (radius * scatter_scale / s).powi(2)).sqrt();
     // The level's error is common to both crossings, so it is carried as a derivative and propagated
     // coherently into the contact time, COR and μ, not added to each crossing separately.
     let touch = crossing(&fin, radius, points[first].t);
@@ -295,7 +306,7 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
         chi2_red: [fin.chi2_red[0], fin.chi2_red[1], fout.chi2_red[0], fout.chi2_red[1]],
         flight_in: fin,
         flight_out: fout,
-        surface_sigma_m: sigma_level,
+        surface_sigma_m: sigma_level_scatter,
         notes,
     })
 }

@@ -69,10 +69,12 @@ fn shot(model: &Model, incline_deg: f64, drop_m: f64, after: f64, seed: u64) -> 
             sigma_y0: 0.005,
             sigma_tilt_deg: 0.001,
             columns: 120,
+            edge_definition_px: 0.0,
         }),
         scale: Some(Scale {
             m_per_px: SCALE,
             sigma_m_per_px: SCALE * 2e-4,
+            sigma_shape_m_per_px: 0.0,
             radius_px: r / SCALE,
             frames: 150,
         }),

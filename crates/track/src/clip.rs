@@ -65,6 +65,10 @@ pub struct Scale {
     pub m_per_px: f64,
     /// Its standard error, m/px.
     pub sigma_m_per_px: f64,
+    /// The part of `sigma_m_per_px` that is the rim shape's Type-B term, m/px (see `scale_from`): lighting
+    /// that is the same for every clip of a session gives every clip about the same radius bias, so it is
+    /// not a shot-to-shot scatter.
+    pub sigma_shape_m_per_px: f64,
     /// Mean free-flight radius, px.
     pub radius_px: f64,
     /// Frames it was measured on.
@@ -481,6 +485,7 @@ pub(crate) fn scale_from(
         m_per_px,
         sigma_m_per_px: m_per_px * ((sd * sd / n) + edge_definition_px.powi(2) / 3.0 + rim_shape_rms_px.powi(2)).sqrt()
             / mean,
+        sigma_shape_m_per_px: m_per_px * rim_shape_rms_px / mean,
         radius_px: mean,
         frames: radii.len(),
     })
@@ -530,6 +535,9 @@ mod tests {
         assert!(scatter < 5e-5, "{plain:?}");
         let rel = shaped.sigma_m_per_px / shaped.m_per_px;
         assert!((rel - scatter.hypot(0.08 / 80.0)).abs() < 1e-9, "{rel}");
+        // That part is named, for what is common to a session's clips.
+        assert!((shaped.sigma_shape_m_per_px / shaped.m_per_px - 0.08 / 80.0).abs() < 1e-12);
+        assert_eq!(plain.sigma_shape_m_per_px, 0.0);
     }
 
     #[test]

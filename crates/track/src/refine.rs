@@ -643,6 +643,7 @@ mod tests {
             sigma_y0: 0.0,
             sigma_tilt_deg: 0.0,
             columns: SIZE,
+            edge_definition_px: 0.0,
         }
     }
 
