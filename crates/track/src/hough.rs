@@ -7,7 +7,7 @@
 //! for a 512×512 frame and a known radius, ≈ 22 ms for radii 8–256 px (50 ms as one band), most of it in the
 //! octaves below 24 px, which cannot be downsampled. Used once per clip and after a loss.
 
-use crate::plane::{Pixel, Plane};
+use crate::plane::{Pixel, Plane, parabola_offset};
 
 /// Options of [`detect_circles`].
 #[derive(Debug, Clone, PartialEq)]
@@ -298,17 +298,9 @@ fn local_maxima(acc: &[f32], w: usize, h: usize, sep: usize, n: usize) -> Vec<(f
     out.into_iter()
         .map(|(x, y)| {
             let v = |dx: isize, dy: isize| acc[(y as isize + dy) as usize * w + (x as isize + dx) as usize] as f64;
-            let sub = |m: f64, c: f64, p: f64| {
-                let d = m - 2.0 * c + p;
-                if d < 0.0 {
-                    (0.5 * (m - p) / d).clamp(-0.5, 0.5)
-                } else {
-                    0.0
-                }
-            };
             (
-                x as f64 + sub(v(-1, 0), v(0, 0), v(1, 0)),
-                y as f64 + sub(v(0, -1), v(0, 0), v(0, 1)),
+                x as f64 + parabola_offset(v(-1, 0), v(0, 0), v(1, 0)),
+                y as f64 + parabola_offset(v(0, -1), v(0, 0), v(0, 1)),
             )
         })
         .collect()

@@ -80,3 +80,15 @@ impl<'a, P: Pixel> Plane<'a, P> {
         top + fy * (bottom - top)
     }
 }
+
+/// Where a sampled peak lies between its samples: the vertex of the parabola through the values `a0`,
+/// `a1`, `a2` at offsets −1, 0, +1, as an offset from the middle one (clamped to ±0.5; 0 when the three do
+/// not bend down). The sub-sample step of every edge and vote peak in this crate.
+pub(crate) fn parabola_offset(a0: f64, a1: f64, a2: f64) -> f64 {
+    let den = a0 - 2.0 * a1 + a2;
+    if den < 0.0 {
+        (0.5 * (a0 - a2) / den).clamp(-0.5, 0.5)
+    } else {
+        0.0
+    }
+}

@@ -7,7 +7,7 @@
 //! robust circle fit. Cost: rays × samples bilinear reads (128 × 17 ≈ 2,200, ≈ 10 µs) plus the fit.
 
 use crate::fit::{CircleFit, fit_circle};
-use crate::plane::{Pixel, Plane};
+use crate::plane::{Pixel, Plane, parabola_offset};
 use crate::surface::SurfaceLine;
 
 /// Options of [`refine_circle`].
@@ -374,13 +374,7 @@ fn refine_once<P: Pixel>(
             continue;
         }
         let m = |j: usize| (profile[j + 1] - profile[j - 1]).abs() as f64;
-        let (a0, a1, a2) = (m(best_j - 1), m(best_j), m(best_j + 1));
-        let den = a0 - 2.0 * a1 + a2;
-        let off = if den < 0.0 {
-            (0.5 * (a0 - a2) / den).clamp(-0.5, 0.5)
-        } else {
-            0.0
-        };
+        let off = parabola_offset(m(best_j - 1), m(best_j), m(best_j + 1));
         let d = start + (best_j as f64 + off) * search.step;
         if let Some(raw) = raw_points.as_deref_mut() {
             raw.push((ray, [x + d * c, y + d * s]));

@@ -6,7 +6,7 @@
 //! band's own texture (woven tape, grains) lies below its top edge, and the ball only covers some columns.
 //! Cost: O(width/stride × height) reads, ≈ 0.2 ms for 512×512.
 
-use crate::plane::{Pixel, Plane};
+use crate::plane::{Pixel, Plane, parabola_offset};
 
 /// A straight line across the image, `y = y0 + slope·(x − x0)` in px.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -139,14 +139,8 @@ pub fn find_surface_line<P: Pixel>(img: &Plane<P>) -> Option<SurfaceLine> {
 /// The edge at the smoothed derivative `d`'s peak row `y`, to a fraction of a row: a parabola through
 /// |d| at rows y−1, y, y+1.
 fn smoothed_edge(d: &[f32], y: usize) -> f64 {
-    let (a0, a1, a2) = (d[y - 1].abs() as f64, d[y].abs() as f64, d[y + 1].abs() as f64);
-    let den = a0 - 2.0 * a1 + a2;
-    let off = if den < 0.0 {
-        (0.5 * (a0 - a2) / den).clamp(-0.5, 0.5)
-    } else {
-        0.0
-    };
-    y as f64 + off
+    let a = |k: usize| d[k].abs() as f64;
+    y as f64 + parabola_offset(a(y - 1), a(y), a(y + 1))
 }
 
 /// The edge at row `y` of a column profile (the smoothed derivative's peak), to a fraction of a row: a
@@ -158,18 +152,9 @@ fn smoothed_edge(d: &[f32], y: usize) -> f64 {
 /// the smoothed derivative's, since the narrow difference's own peak wanders on a weak edge in texture.
 fn sub_pixel_edge(prof: &[f32], y: usize) -> f64 {
     let n = |k: usize| (prof[k + 1] - prof[k - 1]).abs() as f64;
-    let h = prof.len();
-    let lo = y.saturating_sub(1).max(2);
-    let hi = (y + 1).min(h - 3);
-    let k = y.clamp(lo, hi);
-    let (a0, a1, a2) = (n(k - 1), n(k), n(k + 1));
-    let den = a0 - 2.0 * a1 + a2;
-    let off = if den < 0.0 {
-        (0.5 * (a0 - a2) / den).clamp(-0.5, 0.5)
-    } else {
-        0.0
-    };
-    k as f64 + off
+    // n(k ± 1) reads rows k − 2 … k + 2.
+    let k = y.clamp(2, prof.len() - 3);
+    k as f64 + parabola_offset(n(k - 1), n(k), n(k + 1))
 }
 
 /// Number of distinct columns with a candidate within `tol` of the line, and their mean edge strength.
