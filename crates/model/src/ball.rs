@@ -63,11 +63,12 @@ impl State {
         }
     }
 
-    pub(crate) fn to_array(self) -> [f64; 6] {
-        [self.x, self.y, self.theta, self.vx, self.vy, self.omega]
+    /// The integrated vector with this state and no contact history.
+    pub(crate) fn to_array(self) -> crate::integrator::Y {
+        [self.x, self.y, self.theta, self.vx, self.vy, self.omega, 0.0, 0.0]
     }
 
-    pub(crate) fn from_array(a: [f64; 6]) -> State {
+    pub(crate) fn from_array(a: crate::integrator::Y) -> State {
         State {
             x: a[0],
             y: a[1],

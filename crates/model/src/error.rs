@@ -61,6 +61,15 @@ pub enum ModelError {
     /// The state became NaN or infinite (a custom term returned NaN, or parameters blew the model up).
     #[error("the simulation became non-finite at t = {t_s} s in {phase} (check custom terms and parameters)")]
     NonFinite { t_s: f64, phase: &'static str },
+    /// Friction switched between sticking and sliding again and again at one instant.
+    #[error(
+        "friction switched between sticking and sliding {switches} times at t = {t_s} s in {phase} without the time advancing (the force grazes its Coulomb limit there); change the tangential parameters slightly"
+    )]
+    Chatter {
+        t_s: f64,
+        phase: &'static str,
+        switches: usize,
+    },
     /// The integrator needed more steps than allowed (the step size collapsed).
     #[error(
         "the integrator needed more than {max_steps} steps (at t = {t_s} s in {phase}); the model is too stiff for the tolerance"

@@ -1,10 +1,13 @@
-//! Dormand–Prince 5(4) steps with Hairer's continuous extension, for a 6-component state.
+//! Dormand–Prince 5(4) steps with Hairer's continuous extension, for the simulator's state vector.
 //!
 //! Hand-written because the simulator needs to stop exactly at events found on the dense output and to
 //! restart with a different right-hand side, and because one impact must cost tens of microseconds.
 
-/// The integrated vector: x, y, θ, vx, vy, ω.
-pub(crate) type Y = [f64; 6];
+/// Components of the integrated vector.
+pub(crate) const N: usize = 8;
+
+/// The integrated vector: x, y, θ, vx, vy, ω, then the contact's history u_t = ∫ slip dt and ∫ δ dt.
+pub(crate) type Y = [f64; N];
 
 const C2: f64 = 1.0 / 5.0;
 const C3: f64 = 3.0 / 10.0;
@@ -47,7 +50,7 @@ const D7: f64 = 69997945.0 / 29380423.0;
 fn comb(y: &Y, h: f64, terms: &[(f64, &Y)]) -> Y {
     let mut out = *y;
     for (c, k) in terms {
-        for i in 0..6 {
+        for i in 0..N {
             out[i] += h * c * k[i];
         }
     }
@@ -69,8 +72,19 @@ pub(crate) struct Step {
 }
 
 impl Step {
-    /// Tries a step. `f0` is the derivative at (`t0`, `y0`).
-    pub fn attempt(f: &mut impl FnMut(f64, &Y) -> Y, t0: f64, y0: &Y, f0: &Y, h: f64, rtol: f64, atol: f64) -> Step {
+    /// Tries a step. `f0` is the derivative at (`t0`, `y0`); the error norm is over the first `n_err`
+    /// components (the others are integrated alongside without steering the step).
+    #[allow(clippy::too_many_arguments)]
+    pub fn attempt(
+        f: &mut impl FnMut(f64, &Y) -> Y,
+        t0: f64,
+        y0: &Y,
+        f0: &Y,
+        h: f64,
+        rtol: f64,
+        atol: f64,
+        n_err: usize,
+    ) -> Step {
         let k1 = *f0;
         let k2 = f(t0 + C2 * h, &comb(y0, h, &[(A21, &k1)]));
         let k3 = f(t0 + C3 * h, &comb(y0, h, &[(A31, &k1), (A32, &k2)]));
@@ -86,11 +100,13 @@ impl Step {
         let y1 = comb(y0, h, &[(A71, &k1), (A73, &k3), (A74, &k4), (A75, &k5), (A76, &k6)]);
         let k7 = f(t0 + h, &y1);
         let mut sum = 0.0;
-        let mut cont = [[0.0; 6]; 4];
-        for i in 0..6 {
-            let e = h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i]);
-            let sc = atol + rtol * y0[i].abs().max(y1[i].abs());
-            sum += (e / sc) * (e / sc);
+        let mut cont = [[0.0; N]; 4];
+        for i in 0..N {
+            if i < n_err {
+                let e = h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i]);
+                let sc = atol + rtol * y0[i].abs().max(y1[i].abs());
+                sum += (e / sc) * (e / sc);
+            }
             let ydiff = y1[i] - y0[i];
             let bspl = h * k1[i] - ydiff;
             cont[0][i] = ydiff;
@@ -98,7 +114,7 @@ impl Step {
             cont[2][i] = ydiff - h * k7[i] - bspl;
             cont[3][i] = h * (D1 * k1[i] + D3 * k3[i] + D4 * k4[i] + D5 * k5[i] + D6 * k6[i] + D7 * k7[i]);
         }
-        let err = (sum / 6.0).sqrt();
+        let err = (sum / n_err as f64).sqrt();
         Step {
             t0,
             h,
@@ -114,7 +130,7 @@ impl Step {
     pub fn at(&self, t: f64) -> Y {
         let th = ((t - self.t0) / self.h).clamp(0.0, 1.0);
         let th1 = 1.0 - th;
-        let mut out = [0.0; 6];
+        let mut out = [0.0; N];
         for (i, o) in out.iter_mut().enumerate() {
             let c = &self.cont;
             *o = self.y0[i] + th * (c[0][i] + th1 * (c[1][i] + th * (c[2][i] + th1 * c[3][i])));
@@ -183,15 +199,15 @@ mod tests {
 
     /// Harmonic oscillator x'' = −x along components 1 and 4 (y, vy).
     fn osc(_t: f64, y: &Y) -> Y {
-        [0.0, y[4], 0.0, 0.0, -y[1], 0.0]
+        [0.0, y[4], 0.0, 0.0, -y[1], 0.0, 0.0, 0.0]
     }
 
     /// Largest dense-output error over a step of size `h`.
     fn dense_error(h: f64) -> f64 {
         let mut f = osc;
-        let y0 = [0.0, 1.0, 0.0, 0.0, 0.0, 0.0];
+        let y0 = [0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
         let f0 = f(0.0, &y0);
-        let s = Step::attempt(&mut f, 0.0, &y0, &f0, h, 1e-10, 1e-12);
+        let s = Step::attempt(&mut f, 0.0, &y0, &f0, h, 1e-10, 1e-12, 6);
         (0..=20)
             .map(|i| {
                 let t = h * i as f64 / 20.0;
@@ -204,9 +220,9 @@ mod tests {
     #[test]
     fn step_and_dense_output_match_the_exact_solution() {
         let mut f = osc;
-        let y0 = [0.0, 1.0, 0.0, 0.0, 0.0, 0.0];
+        let y0 = [0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
         let f0 = f(0.0, &y0);
-        let s = Step::attempt(&mut f, 0.0, &y0, &f0, 0.1, 1e-10, 1e-12);
+        let s = Step::attempt(&mut f, 0.0, &y0, &f0, 0.1, 1e-10, 1e-12, 6);
         assert!((s.y1[1] - 0.1f64.cos()).abs() < 1e-9);
         // The continuous extension is of order 4: its error over a step falls as h⁵.
         let (e1, e2) = (dense_error(0.2), dense_error(0.1));

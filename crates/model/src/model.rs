@@ -93,6 +93,22 @@ impl Model {
         self.effects.iter().map(|e| e.friction_coefficient()).sum()
     }
 
+    /// Total tangential compliance of the contact patch, m/N (0: rigid, the Coulomb contact).
+    pub fn tangential_compliance(&self) -> f64 {
+        self.effects.iter().map(|e| e.tangential_compliance()).sum()
+    }
+
+    /// Total damping of the contact patch's tangential spring, N·s/m.
+    pub fn tangential_damping(&self) -> f64 {
+        self.effects.iter().map(|e| e.tangential_damping()).sum()
+    }
+
+    /// True if an effect reads the contact's history (`u_t`, `∫δ dt`) or the patch is compliant: the
+    /// simulator then controls the history's integration error.
+    pub fn uses_contact_history(&self) -> bool {
+        self.effects.iter().any(|e| e.uses_contact_history())
+    }
+
     /// Moment of inertia about the centre, kg·m², including effects that change it.
     pub fn inertia(&self) -> f64 {
         self.ball.inertia(self.effects.iter().map(|e| e.inertia_shift()).sum())

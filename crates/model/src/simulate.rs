@@ -1,7 +1,7 @@
 //! Flight → contact → flight, integrated with events at every phase and stick/slip switch.
 
 use crate::effects::{Context, Loads, Observation, Phase};
-use crate::integrator::{Step, Y, find_root};
+use crate::integrator::{N, Step, Y, find_root};
 use crate::{Model, ModelError, State};
 use serde::{Deserialize, Serialize};
 use std::cell::Cell;
@@ -47,8 +47,16 @@ pub struct Sample {
     pub observed: Observation,
     /// Phase at this instant.
     pub phase: Phase,
-    /// True if the contact point is sticking (the ball rolls).
+    /// True if the contact point is sticking (the ball rolls); with a compliant patch
+    /// (`tangential_spring`), true while the patch holds (the ball's contact point may still move).
     pub sticking: bool,
+    /// Tangential displacement of the contact patch `u_t = ∫ slip dt` since touch, m.
+    #[serde(default)]
+    pub u_t: f64,
+    /// Displacement stored in the patch's tangential spring, m (0 without a tangential compliance): the
+    /// tangential contact force is `−u/λ − c_t·slip` at every instant of the contact.
+    #[serde(default)]
+    pub patch_displacement: f64,
 }
 
 /// What happened at a stick/slip switch.
@@ -126,6 +134,9 @@ pub struct Simulation {
     pub impact: Impact,
 }
 
+/// Stick/slip switches allowed at one instant before the contact is reported as undecidable there.
+const MAX_SWITCHES_AT_ONE_INSTANT: usize = 16;
+
 /// Slip speed below which a slip against the sliding direction is taken as rounding, m/s.
 const SLIP_EPS: f64 = 1e-12;
 
@@ -145,6 +156,11 @@ struct Mode {
     friction: Friction,
     delta_max: f64,
     force_max: f64,
+    /// True when the contact patch is compliant: `Stick` then means "the patch holds" (force from its
+    /// spring) and `Slip` "the patch slides at the Coulomb limit".
+    patch: bool,
+    /// u_t at which the patch's spring is relaxed while it holds: its displacement is `u_t − offset`.
+    patch_offset: f64,
 }
 
 /// Quantities the events are made of.
@@ -152,8 +168,16 @@ struct Mode {
 struct Aux {
     normal: f64,
     slip: f64,
+    /// Rigid contact: the friction force that keeps the slip at zero. Compliant patch: the force of its
+    /// spring (what the patch transmits while it holds), N.
     required_friction: f64,
     friction_limit: f64,
+    /// Compliant patch sliding in direction σ: `σ·(k_t·slip + c_t·d(slip)/dt) − μ·dP/dt`, how much faster
+    /// the spring's force would grow than the limit if the patch held (N/s); it falls through zero when
+    /// the patch stops sliding.
+    patch_slide_rate: f64,
+    /// Displacement stored in the patch's spring, m.
+    patch_u: f64,
 }
 
 struct Dynamics<'a> {
@@ -165,21 +189,55 @@ struct Dynamics<'a> {
     inertia: f64,
     /// 1/m + R²/I: how fast a tangential contact force changes the slip.
     slip_mobility: f64,
+    /// Tangential stiffness k_t = 1/λ of a compliant contact patch, N/m (unused when rigid).
+    patch_stiffness: f64,
+    /// Damping of the patch's tangential spring, N·s/m.
+    patch_damping: f64,
+    /// True if the patch is compliant (λ ≠ 0) and friction can load it (μ ≠ 0).
+    patch: bool,
+    /// Components of the state in the integrator's error norm: the contact's history only when used.
+    n_err: usize,
 }
+
+/// Time step of the central difference that gives dP/dt for the compliant patch's slide → hold switch, s
+/// (relative error ≈ (ε/T)² + 1e-16·T/ε for a contact of duration T: below 1e-9 for T between 10 µs and
+/// 10 ms).
+const RATE_EPS_S: f64 = 1e-9;
 
 impl<'a> Dynamics<'a> {
     fn new(model: &'a Model, incline: f64) -> Self {
         let inertia = model.inertia();
         let (m, r) = (model.ball.mass_kg, model.ball.radius_m);
+        let mu = model.friction_coefficient();
+        let compliance = model.tangential_compliance();
         Dynamics {
             model,
             incline,
             sin_b: incline.sin(),
             cos_b: incline.cos(),
-            mu: model.friction_coefficient(),
+            mu,
             inertia,
             slip_mobility: 1.0 / m + r * r / inertia,
+            patch_stiffness: 1.0 / compliance,
+            patch_damping: model.tangential_damping(),
+            patch: compliance != 0.0 && mu != 0.0,
+            n_err: if model.uses_contact_history() { N } else { 6 },
         }
+    }
+
+    /// The total normal force at (`t`, `y`), N (not clipped at zero: its rate is wanted while it is still
+    /// positive, including in the last instants before it vanishes).
+    fn normal_load(&self, t: f64, y: &Y, mode: &Mode) -> f64 {
+        let ball = &self.model.ball;
+        let state = State::from_array(*y);
+        let ctx = Context {
+            delta_max: mode.delta_max,
+            force_max: mode.force_max,
+            u_t: y[6],
+            delta_int: y[7],
+            ..Context::of(t, &state, mode.phase, ball, self.model.gravity, self.incline)
+        };
+        self.model.effects().iter().map(|e| e.normal_force(&ctx)).sum()
     }
 
     fn eval(&self, t: f64, y: &Y, mode: &Mode) -> (Y, Aux) {
@@ -189,6 +247,8 @@ impl<'a> Dynamics<'a> {
         let mut ctx = Context {
             delta_max: mode.delta_max,
             force_max: mode.force_max,
+            u_t: y[6],
+            delta_int: y[7],
             ..Context::of(t, &state, mode.phase, ball, self.model.gravity, self.incline)
         };
         let slip = ctx.slip;
@@ -212,13 +272,31 @@ impl<'a> Dynamics<'a> {
             slip,
             ..Aux::default()
         };
-        let friction = if mode.phase.in_contact() {
-            aux.required_friction = -(ax_other + r * alpha_other) / self.slip_mobility;
+        let in_contact = mode.phase.in_contact();
+        let friction = if in_contact {
             aux.friction_limit = self.mu * normal.max(0.0);
-            match mode.friction {
-                Friction::None => 0.0,
-                Friction::Slip(sigma) => -sigma * aux.friction_limit,
-                Friction::Stick => aux.required_friction,
+            if mode.patch {
+                let (k, c) = (self.patch_stiffness, self.patch_damping);
+                match mode.friction {
+                    Friction::None => 0.0,
+                    Friction::Slip(sigma) => {
+                        // The spring's displacement limited so that it transmits exactly the limit.
+                        aux.patch_u = (sigma * aux.friction_limit - c * slip) / k;
+                        -sigma * aux.friction_limit
+                    }
+                    Friction::Stick => {
+                        aux.patch_u = y[6] - mode.patch_offset;
+                        aux.required_friction = -(k * aux.patch_u + c * slip);
+                        aux.required_friction
+                    }
+                }
+            } else {
+                aux.required_friction = -(ax_other + r * alpha_other) / self.slip_mobility;
+                match mode.friction {
+                    Friction::None => 0.0,
+                    Friction::Slip(sigma) => -sigma * aux.friction_limit,
+                    Friction::Stick => aux.required_friction,
+                }
             }
         } else {
             0.0
@@ -230,7 +308,29 @@ impl<'a> Dynamics<'a> {
             ax_other + friction / m,
             ay,
             alpha_other + r * friction / self.inertia,
+            if in_contact { slip } else { 0.0 },
+            if in_contact { ctx.delta } else { 0.0 },
         ];
+        if let (true, Friction::Slip(sigma)) = (mode.patch && in_contact, mode.friction) {
+            let slip_rate = dy[3] + r * dy[5];
+            let shifted = |e: f64| std::array::from_fn::<f64, N, _>(|i| y[i] + e * dy[i]);
+            // Contact laws bend at δ = 0: the difference stays on the side δ > 0 (central while δ lasts
+            // longer than ±ε, forward at the touch itself).
+            let (delta, rate) = (ctx.delta, ctx.delta_dot.abs());
+            let load_rate = if delta > 0.0 {
+                let eps = if rate > 0.0 {
+                    RATE_EPS_S.min(0.25 * delta / rate)
+                } else {
+                    RATE_EPS_S
+                };
+                (self.normal_load(t + eps, &shifted(eps), mode) - self.normal_load(t - eps, &shifted(-eps), mode))
+                    / (2.0 * eps)
+            } else {
+                (self.normal_load(t + RATE_EPS_S, &shifted(RATE_EPS_S), mode) - normal) / RATE_EPS_S
+            };
+            aux.patch_slide_rate =
+                sigma * (self.patch_stiffness * slip + self.patch_damping * slip_rate) - self.mu * load_rate;
+        }
         (dy, aux)
     }
 }
@@ -257,6 +357,7 @@ impl Event {
             Event::ForceVanishes => aux.normal,
             Event::PenetrationVanishes => r - y[1],
             Event::SlipStops => match mode.friction {
+                Friction::Slip(_) if mode.patch => aux.patch_slide_rate,
                 Friction::Slip(sigma) => sigma * aux.slip,
                 _ => 1.0,
             },
@@ -362,7 +463,7 @@ struct Recorder<'a> {
 }
 
 impl Recorder<'_> {
-    fn record(&mut self, t: f64, y: &Y, mode: &Mode) {
+    fn record(&mut self, t: f64, y: &Y, patch_u: f64, mode: &Mode) {
         let state = State::from_array(*y);
         let mut observed = Observation::from(state);
         for e in self.model.effects() {
@@ -374,17 +475,35 @@ impl Recorder<'_> {
             observed,
             phase: mode.phase,
             sticking: mode.friction == Friction::Stick,
+            u_t: y[6],
+            patch_displacement: patch_u,
         });
     }
 
-    /// Records every requested time not yet recorded up to `t_hi`, with states from `at`.
-    fn record_until(&mut self, t_hi: f64, mode: &Mode, at: impl Fn(f64) -> Y) {
+    /// Records every requested time not yet recorded up to `t_hi`, with states from `at` and the patch's
+    /// displacement from `patch`.
+    fn record_until(&mut self, t_hi: f64, mode: &Mode, at: impl Fn(f64) -> Y, patch: impl Fn(f64, &Y) -> f64) {
         while let Some(&t) = self.times.get(self.samples.len()) {
             if t > t_hi {
                 break;
             }
             let y = at(t);
-            self.record(t, &y, mode);
+            let u = patch(t, &y);
+            self.record(t, &y, u, mode);
+        }
+    }
+}
+
+impl Dynamics<'_> {
+    /// The displacement stored in the patch's spring at (`t`, `y`), m (0 unless the patch is compliant
+    /// and in contact).
+    fn patch_displacement(&self, t: f64, y: &Y, mode: &Mode) -> f64 {
+        if !(mode.patch && mode.phase.in_contact()) {
+            return 0.0;
+        }
+        match mode.friction {
+            Friction::Stick => y[6] - mode.patch_offset,
+            _ => self.eval(t, y, mode).1.patch_u,
         }
     }
 }
@@ -411,8 +530,10 @@ impl<'a> Run<'a> {
             friction: Friction::None,
             delta_max: 0.0,
             force_max: 0.0,
+            patch: self.dynamics.patch,
+            patch_offset: 0.0,
         };
-        self.recorder.record_until(t0, &mode, |_| y0);
+        self.recorder.record_until(t0, &mode, |_| y0, |_, _| 0.0);
         let (mut t, mut y) = (t0, y0);
         // Touching already, moving in: the contact starts now.
         let start_in_contact = y0[1] <= r && y0[4] < 0.0;
@@ -432,7 +553,9 @@ impl<'a> Run<'a> {
         } else {
             mode.phase = Phase::Compression;
         }
-        // Touch.
+        // Touch: the contact's history starts.
+        y[6] = 0.0;
+        y[7] = 0.0;
         let (t_touch, state_in) = (t, State::from_array(y));
         mode.friction = self.initial_friction(t, &y, &mode);
         let mut slip_events = Vec::new();
@@ -478,6 +601,22 @@ impl<'a> Run<'a> {
         if self.dynamics.mu == 0.0 {
             return Friction::None;
         }
+        if mode.patch {
+            // The patch holds unless its damper alone already asks for more than the limit. A tie (no load
+            // and no damping yet) holds too: the hold's event then switches at once if the spring's force
+            // outgrows the limit.
+            let hold = Mode {
+                friction: Friction::Stick,
+                patch_offset: y[6],
+                ..*mode
+            };
+            let aux = self.dynamics.eval(t, y, &hold).1;
+            return if aux.required_friction.abs() <= aux.friction_limit {
+                Friction::Stick
+            } else {
+                Friction::Slip(-aux.required_friction.signum())
+            };
+        }
         let probe = Mode {
             friction: Friction::Slip(0.0),
             ..*mode
@@ -502,10 +641,11 @@ impl<'a> Run<'a> {
         slip_events: &mut Vec<SlipEvent>,
     ) -> Result<(f64, Y), ModelError> {
         mode.phase = phase;
+        let mut same_instant = 0;
         loop {
             // A slip that already points against the sliding direction (its zero fell on the same instant
             // as a phase switch) is handled as a slip event right away.
-            if let Friction::Slip(sigma) = mode.friction {
+            if let (false, Friction::Slip(sigma)) = (mode.patch, mode.friction) {
                 let slip = self.dynamics.eval(t, &y, mode).1.slip;
                 if sigma * slip < -SLIP_EPS {
                     slip_events.push(SlipEvent {
@@ -521,6 +661,14 @@ impl<'a> Run<'a> {
             }
             // A stick/slip event ended the segment.
             let kind = match mode.friction {
+                Friction::Slip(_) if mode.patch => {
+                    // The patch stops sliding: it holds from the displacement it had, so the force is
+                    // continuous.
+                    let aux = self.dynamics.eval(t, &y, mode).1;
+                    mode.patch_offset = y[6] - aux.patch_u;
+                    mode.friction = Friction::Stick;
+                    SlipEventKind::StartsSticking
+                }
                 Friction::Slip(_) => self.slip_stops(t, &mut y, mode),
                 Friction::Stick => {
                     let aux = self.dynamics.eval(t, &y, mode).1;
@@ -529,6 +677,19 @@ impl<'a> Run<'a> {
                 }
                 Friction::None => unreachable!("no stick/slip events without friction"),
             };
+            // Switches piling up on one instant mean the law cannot decide there (a tangency of the force
+            // with its limit, within rounding): say so rather than spin through the step budget.
+            match slip_events.last() {
+                Some(last) if t - last.t <= 1e-12 * t.abs().max(1e-3) => same_instant += 1,
+                _ => same_instant = 0,
+            }
+            if same_instant >= MAX_SWITCHES_AT_ONE_INSTANT {
+                return Err(ModelError::Chatter {
+                    t_s: t,
+                    phase: phase.name(),
+                    switches: same_instant + 1,
+                });
+            }
             slip_events.push(SlipEvent { t, kind });
         }
     }
@@ -560,6 +721,7 @@ impl<'a> Run<'a> {
         let r = dynamics.model.ball.radius_m;
         let events = Event::active(mode);
         let m = *mode;
+        let n_err = dynamics.n_err;
         // The last stage of a step is evaluated at its end: keep its event quantities instead of recomputing.
         let last_aux = Cell::new(Aux::default());
         let mut rhs = |tt: f64, yy: &Y| {
@@ -576,6 +738,16 @@ impl<'a> Run<'a> {
             g
         };
         let mut g = values(&y, &aux);
+        if m.patch {
+            // A compliant patch's switch leaves the new mode's event function at zero (the force is
+            // continuous): count it as just positive so that the next crossing is seen, and one at once
+            // (the other mode was due right away) is found at the start.
+            for (gk, e) in g.iter_mut().zip(events) {
+                if matches!(e, Event::SlipStops | Event::GripLost) && *gk <= 0.0 {
+                    *gk = f64::MIN_POSITIVE;
+                }
+            }
+        }
         let scale = dynamics.model.ball.radius_m.max(1e-3) / y[3].hypot(y[4]).max(0.1);
         let mut h = (1e-3 * scale).min(self.opts.max_step_s);
         loop {
@@ -593,7 +765,7 @@ impl<'a> Run<'a> {
                     phase: m.phase.name(),
                 });
             }
-            let step = Step::attempt(&mut rhs, t, &y, &f, h, self.opts.rtol, self.opts.atol);
+            let step = Step::attempt(&mut rhs, t, &y, &f, h, self.opts.rtol, self.opts.atol, n_err);
             if step.err > 1.0 {
                 h = step.next_h();
                 if h < 1e-15 * t.abs().max(1e-3) || !h.is_finite() {
@@ -632,13 +804,14 @@ impl<'a> Run<'a> {
                 // Re-step exactly to the event so its state has the integrator's full accuracy.
                 let he = te - t;
                 let (ye, at) = if he > 0.0 {
-                    let s = Step::attempt(&mut rhs, t, &y, &f, he, self.opts.rtol, self.opts.atol);
+                    let s = Step::attempt(&mut rhs, t, &y, &f, he, self.opts.rtol, self.opts.atol, n_err);
                     (s.y1, Some(s))
                 } else {
                     (y, None)
                 };
                 if let Some(s) = &at {
-                    self.recorder.record_until(te, &m, |tt| s.at(tt));
+                    self.recorder
+                        .record_until(te, &m, |tt| s.at(tt), |tt, yy| dynamics.patch_displacement(tt, yy, &m));
                 }
                 match ev {
                     Event::Touch => mode.phase = Phase::Compression,
@@ -648,7 +821,12 @@ impl<'a> Run<'a> {
                 }
                 return Ok((te, ye));
             }
-            self.recorder.record_until(t + h, &m, |tt| step.at(tt));
+            self.recorder.record_until(
+                t + h,
+                &m,
+                |tt| step.at(tt),
+                |tt, yy| dynamics.patch_displacement(tt, yy, &m),
+            );
             t += h;
             y = step.y1;
             f = step.f1;

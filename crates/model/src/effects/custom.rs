@@ -1,13 +1,14 @@
 //! A user's force law, written as formulas in `model.toml` and evaluated, never executed as code.
 //!
-//! Formulas are parsed once by `exmex` into a flat expression; each evaluation fills the variables the
-//! formula uses from the context (a few array writes) and evaluates the expression. Names are checked when
-//! the model is read, so a typo is reported with its position instead of failing mid-simulation.
+//! Formulas are parsed and compiled once (`formula.rs`) into a postfix program whose loads read the
+//! context or the term's parameters directly, so an evaluation allocates nothing whatever the number of
+//! names. Names are checked when the model is read, so a typo is reported with its position instead of
+//! failing mid-simulation.
 
+use super::formula::{self, Program};
 use super::{Context, Effect, Loads, Phase};
 use crate::ModelError;
 use crate::error::FormulaError;
-use exmex::prelude::*;
 use std::sync::Arc;
 
 /// When a custom term acts.
@@ -76,7 +77,7 @@ impl Target {
 }
 
 /// State variables a formula may use, with their meaning (listed by `bouncelab effects`).
-pub const FORMULA_VARIABLES: [(&str, &str); 15] = [
+pub const FORMULA_VARIABLES: [(&str, &str); 17] = [
     ("delta", "penetration δ = R − y, m (alias δ)"),
     ("delta_dot", "penetration rate dδ/dt, m/s"),
     (
@@ -87,6 +88,14 @@ pub const FORMULA_VARIABLES: [(&str, &str); 15] = [
     ("v_n", "normal velocity of the centre, m/s"),
     ("omega", "spin, rad/s, counter-clockwise (alias ω)"),
     ("slip", "slip of the contact point v_t + ω·R, m/s"),
+    (
+        "u_t",
+        "tangential displacement of the contact patch ∫ slip dt since touch, m (a spring's stretch)",
+    ),
+    (
+        "delta_int",
+        "∫ δ dt since touch, m·s (memory of the load: stress relaxation)",
+    ),
     ("x", "position along the surface, m"),
     ("y", "height of the centre, m"),
     ("theta", "orientation, rad"),
@@ -97,9 +106,85 @@ pub const FORMULA_VARIABLES: [(&str, &str); 15] = [
     ("g", "gravitational acceleration, m/s²"),
 ];
 
-#[derive(Debug, Clone, Copy)]
+/// A state variable of [`FORMULA_VARIABLES`], by meaning.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Var {
+    Delta,
+    DeltaDot,
+    DeltaMax,
+    Vt,
+    Vn,
+    Omega,
+    Slip,
+    Ut,
+    DeltaInt,
+    X,
+    Y,
+    Theta,
+    T,
+    P,
+    M,
+    R,
+    G,
+}
+
+impl Var {
+    fn from_name(name: &str) -> Option<Var> {
+        Some(match name {
+            "delta" => Var::Delta,
+            "delta_dot" => Var::DeltaDot,
+            "delta_max" => Var::DeltaMax,
+            "v_t" => Var::Vt,
+            "v_n" => Var::Vn,
+            "omega" => Var::Omega,
+            "slip" => Var::Slip,
+            "u_t" => Var::Ut,
+            "delta_int" => Var::DeltaInt,
+            "x" => Var::X,
+            "y" => Var::Y,
+            "theta" => Var::Theta,
+            "t" => Var::T,
+            "P" => Var::P,
+            "m" => Var::M,
+            "R" => Var::R,
+            "g" => Var::G,
+            _ => return None,
+        })
+    }
+
+    #[inline]
+    fn value(self, ctx: &Context) -> f64 {
+        let s = ctx.state;
+        match self {
+            Var::Delta => ctx.delta,
+            Var::DeltaDot => ctx.delta_dot,
+            Var::DeltaMax => ctx.delta_max,
+            Var::Vt => s.vx,
+            Var::Vn => s.vy,
+            Var::Omega => s.omega,
+            Var::Slip => ctx.slip,
+            Var::Ut => ctx.u_t,
+            Var::DeltaInt => ctx.delta_int,
+            Var::X => s.x,
+            Var::Y => s.y,
+            Var::Theta => s.theta,
+            Var::T => ctx.t,
+            Var::P => ctx.normal_force,
+            Var::M => ctx.ball.mass_kg,
+            Var::R => ctx.ball.radius_m,
+            Var::G => ctx.gravity,
+        }
+    }
+
+    /// True for the variables the simulator integrates only for the terms that use them.
+    fn is_history(self) -> bool {
+        matches!(self, Var::Ut | Var::DeltaInt)
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
 enum Slot {
-    Var(usize),
+    Var(Var),
     Param(usize),
 }
 
@@ -107,8 +192,7 @@ enum Slot {
 #[derive(Debug, Clone)]
 struct Compiled {
     target: Target,
-    expr: FlatEx<f64>,
-    slots: Vec<Slot>,
+    program: Program<Slot>,
 }
 
 /// A custom term as declared in the model file.
@@ -132,6 +216,7 @@ pub struct CustomTerm {
     spec: Arc<CustomTermSpec>,
     compiled: Vec<Compiled>,
     params: Vec<f64>,
+    uses_history: bool,
 }
 
 fn alias(name: &str) -> &str {
@@ -142,14 +227,11 @@ fn alias(name: &str) -> &str {
     }
 }
 
-fn known_function(name: &str) -> bool {
-    FlatEx::<f64>::parse(&format!("{name}(1)")).is_ok()
-}
-
 impl CustomTerm {
     /// Parses and checks every formula of `spec`; `origin` names the model file in errors.
     pub fn compile(spec: CustomTermSpec, values: Vec<f64>, origin: &str) -> Result<CustomTerm, ModelError> {
         let mut compiled = Vec::new();
+        let mut uses_history = false;
         for (target, text) in &spec.formulas {
             let field = Target::KEYS
                 .iter()
@@ -166,28 +248,35 @@ impl CustomTerm {
                     message,
                 }))
             };
-            precheck(text).map_err(|(pos, msg)| bad(Some(pos), msg))?;
-            let expr = FlatEx::<f64>::parse(text).map_err(|e| {
-                let msg = e.to_string();
-                // exmex appends debug dumps of its operators; keep the sentence.
-                let msg = msg.split(", Operator").next().unwrap_or(&msg).to_string();
-                bad(None, format!("cannot parse the formula: {msg}"))
-            })?;
-            let mut slots = Vec::new();
-            for var in expr.var_names() {
-                let name = alias(var);
-                let pos = text.find(var.as_str()).map(|b| text[..b].chars().count());
-                if let Some(i) = FORMULA_VARIABLES.iter().position(|(v, _)| *v == name) {
-                    if name == "P" && *target == Target::Normal {
-                        return Err(bad(
-                            pos,
-                            "a `normal` formula cannot use P, the total normal force it is part of".into(),
-                        ));
+            if *target == Target::Normal && spec.phase == CustomPhase::Flight {
+                return Err(bad(
+                    None,
+                    "a `normal` contact force cannot act in phase = \"flight\"".into(),
+                ));
+            }
+            let ast = formula::parse(text).map_err(|e| bad(Some(e.pos), e.message))?;
+            let mut refused_p = false;
+            let bound = Program::compile(&ast, &mut |name: &str| {
+                let name = alias(name);
+                if let Some(v) = Var::from_name(name) {
+                    if v == Var::P && *target == Target::Normal {
+                        refused_p = true;
+                        return None;
                     }
-                    slots.push(Slot::Var(i));
-                } else if let Some(i) = spec.param_names.iter().position(|p| p == name) {
-                    slots.push(Slot::Param(i));
-                } else {
+                    uses_history |= v.is_history();
+                    return Some(Slot::Var(v));
+                }
+                spec.param_names.iter().position(|p| p == name).map(Slot::Param)
+            });
+            let program = match bound {
+                Ok(p) => p,
+                Err((_, pos)) if refused_p => {
+                    return Err(bad(
+                        Some(pos),
+                        "a `normal` formula cannot use P, the total normal force it is part of".into(),
+                    ));
+                }
+                Err((name, pos)) => {
                     let vars: Vec<&str> = FORMULA_VARIABLES.iter().map(|(v, _)| *v).collect();
                     let params = if spec.param_names.is_empty() {
                         "none".to_string()
@@ -195,31 +284,25 @@ impl CustomTerm {
                         spec.param_names.join(", ")
                     };
                     return Err(bad(
-                        pos,
+                        Some(pos),
                         format!(
-                            "`{var}` is neither a state variable ({}) nor a parameter of this effect ({params}); declare it as `{var} = <value>`",
-                            vars.join(", ")
+                            "`{name}` is neither a state variable ({}), a parameter of this effect ({params}) nor a constant ({}); declare it as `{name} = <value>`",
+                            vars.join(", "),
+                            formula::constant_names()
                         ),
                     ));
                 }
-            }
-            if *target != Target::Normal || spec.phase != CustomPhase::Flight {
-                compiled.push(Compiled {
-                    target: *target,
-                    expr,
-                    slots,
-                });
-            } else {
-                return Err(bad(
-                    None,
-                    "a `normal` contact force cannot act in phase = \"flight\"".into(),
-                ));
-            }
+            };
+            compiled.push(Compiled {
+                target: *target,
+                program,
+            });
         }
         Ok(CustomTerm {
             spec: Arc::new(spec),
             compiled,
             params: values,
+            uses_history,
         })
     }
 
@@ -230,78 +313,12 @@ impl CustomTerm {
 
     #[inline]
     fn eval(&self, c: &Compiled, ctx: &Context) -> f64 {
-        let s = ctx.state;
-        let mut vals = [0.0f64; 32];
-        for (slot, v) in c.slots.iter().zip(vals.iter_mut()) {
-            *v = match *slot {
-                Slot::Param(i) => self.params[i],
-                Slot::Var(i) => match i {
-                    0 => ctx.delta,
-                    1 => ctx.delta_dot,
-                    2 => ctx.delta_max,
-                    3 => s.vx,
-                    4 => s.vy,
-                    5 => s.omega,
-                    6 => ctx.slip,
-                    7 => s.x,
-                    8 => s.y,
-                    9 => s.theta,
-                    10 => ctx.t,
-                    11 => ctx.normal_force,
-                    12 => ctx.ball.mass_kg,
-                    13 => ctx.ball.radius_m,
-                    _ => ctx.gravity,
-                },
-            };
-        }
         // A formula that cannot be evaluated yields NaN, which the simulator reports with the time and phase.
-        c.expr.eval(&vals[..c.slots.len()]).unwrap_or(f64::NAN)
+        c.program.eval(|slot| match slot {
+            Slot::Param(i) => self.params[i],
+            Slot::Var(v) => v.value(ctx),
+        })
     }
-}
-
-/// Checks parentheses and function names, returning the character position of the first problem.
-fn precheck(text: &str) -> Result<(), (usize, String)> {
-    if text.len() > 2000 {
-        return Err((0, "formula longer than 2000 characters".into()));
-    }
-    let chars: Vec<char> = text.chars().collect();
-    let mut open = Vec::new();
-    for (i, c) in chars.iter().enumerate() {
-        match c {
-            '(' => open.push(i),
-            ')' if open.pop().is_none() => return Err((i, "this `)` closes nothing".into())),
-            _ => {}
-        }
-    }
-    if let Some(i) = open.pop() {
-        return Err((i, "this `(` is never closed".into()));
-    }
-    let ident = |c: char| c.is_alphanumeric() || c == '_';
-    let mut i = 0;
-    while i < chars.len() {
-        if ident(chars[i]) && !chars[i].is_ascii_digit() && (i == 0 || !ident(chars[i - 1])) {
-            let start = i;
-            while i < chars.len() && ident(chars[i]) {
-                i += 1;
-            }
-            let name: String = chars[start..i].iter().collect();
-            let mut j = i;
-            while j < chars.len() && chars[j] == ' ' {
-                j += 1;
-            }
-            if j < chars.len() && chars[j] == '(' && !known_function(&name) {
-                return Err((
-                    start,
-                    format!(
-                        "unknown function `{name}` (use sin, cos, tan, exp, ln, log10, sqrt, abs, signum, tanh, …)"
-                    ),
-                ));
-            }
-        } else {
-            i += 1;
-        }
-    }
-    Ok(())
 }
 
 impl Effect for CustomTerm {
@@ -341,6 +358,9 @@ impl Effect for CustomTerm {
             }
         }
         out
+    }
+    fn uses_contact_history(&self) -> bool {
+        self.uses_history
     }
     fn clone_box(&self) -> Box<dyn Effect> {
         Box::new(self.clone())

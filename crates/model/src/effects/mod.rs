@@ -7,6 +7,7 @@
 mod contact;
 pub(crate) mod custom;
 mod flight;
+pub(crate) mod formula;
 mod measurement;
 mod tangential;
 
@@ -14,7 +15,7 @@ pub use contact::{Hertz, HuntCrossley, LinearDamping, LinearSpring, PlasticDent,
 pub use custom::{CustomPhase, CustomTerm, CustomTermSpec, FORMULA_VARIABLES, Target};
 pub use flight::QuadraticDrag;
 pub use measurement::{CameraRoll, SurfaceLevel};
-pub use tangential::{Coulomb, InertiaFactor, RollingResistance};
+pub use tangential::{Coulomb, InertiaFactor, RollingResistance, TangentialSpring};
 
 use crate::{Ball, State};
 use std::fmt::Debug;
@@ -77,6 +78,13 @@ pub struct Context<'a> {
     /// Total normal contact force `P`, N: the sum of every effect's [`Effect::normal_force`]. Known in
     /// [`Effect::loads`] only (it is 0 while the normal forces themselves are being summed).
     pub normal_force: f64,
+    /// Tangential displacement of the contact patch, m: `u_t = ∫ slip dt` from touch (0 before it; frozen
+    /// at its separation value after). Error-controlled only for effects whose
+    /// [`Effect::uses_contact_history`] is true.
+    pub u_t: f64,
+    /// Load history of the contact, m·s: `∫ δ dt` from touch (0 before it; frozen after separation).
+    /// Error-controlled only for effects whose [`Effect::uses_contact_history`] is true.
+    pub delta_int: f64,
 }
 
 impl<'a> Context<'a> {
@@ -97,6 +105,8 @@ impl<'a> Context<'a> {
             delta_max: 0.0,
             force_max: 0.0,
             normal_force: 0.0,
+            u_t: 0.0,
+            delta_int: 0.0,
         }
     }
 }
@@ -200,6 +210,23 @@ pub trait Effect: Debug + Send + Sync {
     fn inertia_shift(&self) -> f64 {
         0.0
     }
+    /// Tangential compliance of the contact patch this effect adds, m/N (compliances in series add). With
+    /// a total compliance above zero the simulator replaces the rigid stick of Coulomb friction by an
+    /// elastic patch (see [`TangentialSpring`] and `docs/model.md`).
+    fn tangential_compliance(&self) -> f64 {
+        0.0
+    }
+    /// Viscous damping of the contact patch's tangential spring this effect adds, N·s/m (acts only with a
+    /// tangential compliance).
+    fn tangential_damping(&self) -> f64 {
+        0.0
+    }
+    /// True if the effect reads [`Context::u_t`] or [`Context::delta_int`]: the simulator then controls
+    /// their integration error like the state's (otherwise they are integrated but left out of the error
+    /// norm, so models that do not use them step exactly as before).
+    fn uses_contact_history(&self) -> bool {
+        false
+    }
     /// How the effect changes what the camera measures (a measurement effect); the default changes nothing.
     fn observe(&self, _obs: &mut Observation) {}
     /// A boxed copy.
@@ -263,6 +290,7 @@ pub fn builtin_effects() -> &'static [EffectInfo] {
             PlasticDent::info(),
             RollingResistance::info(),
             InertiaFactor::info(),
+            TangentialSpring::info(),
             QuadraticDrag::info(),
             CameraRoll::info(),
             SurfaceLevel::info(),

@@ -122,3 +122,71 @@ impl Effect for InertiaFactor {
         self.dc
     }
 }
+
+/// Tangential compliance of the contact patch (Maw–Barber–Fawcett; the Cundall–Strack tangential spring):
+/// the patch stores the tangential displacement `u` of the ball's contact point and gives it back.
+///
+/// While the patch holds, the tangential force at the contact point is `F = −u/λ − c_t·u̇` with `u̇` the
+/// slip `v_t + ω·R` (λ = 1/k_t the compliance); when `|F|` would exceed the Coulomb limit `μ·P` the patch
+/// slides at `F = ∓μ·P` and the stored displacement is limited to `u = λ·(±μ·P − c_t·slip)`, so the force
+/// is continuous at every switch. The rigid Coulomb contact is the limit λ → 0, and λ = 0 is that contact
+/// exactly. The law and the switches belong to the simulator's stick/slip state machine (`simulate.rs`);
+/// this effect only supplies λ and c_t.
+#[derive(Debug, Clone)]
+pub struct TangentialSpring {
+    /// Tangential compliance λ = 1/k_t of the contact patch, m/N (0: a rigid patch, today's Coulomb).
+    pub compliance: f64,
+    /// Viscous damping of the patch's tangential spring, N·s/m.
+    pub c_t: f64,
+}
+
+impl TangentialSpring {
+    /// Catalogue entry.
+    pub fn info() -> EffectInfo {
+        EffectInfo {
+            name: "tangential_spring",
+            doc: "Elastic contact patch: while friction holds it, the patch stores the contact point's tangential displacement u and pushes back with F = −u/λ − c_t·u̇ (|F| ≤ μ·P, sliding beyond), so the slip reverses and the ball leaves with more spin than rolling (λ = 1/k_t; λ = 0 is the rigid Coulomb contact).",
+            group: "tangential",
+            base: false,
+            params: &[
+                ParamSpec {
+                    name: "compliance",
+                    unit: "m/N",
+                    doc: "tangential compliance λ = 1/k_t of the contact patch",
+                    default: Some(0.0),
+                    neutral: 0.0,
+                    min: 0.0,
+                    max: 1e-3,
+                },
+                ParamSpec {
+                    name: "c_t",
+                    unit: "N·s/m",
+                    doc: "damping of the patch's tangential spring",
+                    default: Some(0.0),
+                    neutral: 0.0,
+                    min: 0.0,
+                    max: 1e3,
+                },
+            ],
+            build: |v| {
+                Box::new(TangentialSpring {
+                    compliance: v[0],
+                    c_t: v[1],
+                })
+            },
+        }
+    }
+}
+
+impl Effect for TangentialSpring {
+    effect_params!("tangential_spring", compliance, c_t);
+    fn tangential_compliance(&self) -> f64 {
+        self.compliance
+    }
+    fn tangential_damping(&self) -> f64 {
+        self.c_t
+    }
+    fn uses_contact_history(&self) -> bool {
+        self.compliance != 0.0
+    }
+}
