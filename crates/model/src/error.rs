@@ -34,13 +34,35 @@ pub enum ModelError {
         doc: String,
     },
     /// A parameter value outside its physical range, or bounds that do not hold it.
-    #[error("{origin}: {effect}.{param} = {value}: {reason}")]
+    #[error("{origin}: {effect}.{param} = {}: {reason}", num(*.value))]
     InvalidValue {
         origin: String,
         effect: String,
         param: String,
         value: f64,
         reason: String,
+    },
+    /// A number of the model file outside its physical range (gravity, the ball's values).
+    #[error("{origin}: {key} = {} {reason}", num(*.value))]
+    OutOfRange {
+        origin: String,
+        key: String,
+        value: f64,
+        /// Why, with the range and its unit.
+        reason: String,
+    },
+    /// The model has nothing that pushes the ball back out of the surface.
+    #[error(
+        "{origin}{surface}: the model has no elastic normal force: at {probe_mm} mm of penetration it pushes the ball out with P = {force_n} N ({detail}); add `[effects.spring]` with k > 0 (N/m), `[effects.hertz]` with k_h > 0, or a custom term with a `normal` formula"
+    )]
+    NoNormalForce {
+        origin: String,
+        /// ` (surface NAME)` or empty.
+        surface: String,
+        probe_mm: f64,
+        force_n: f64,
+        /// What the file sets, e.g. `spring.k = 0` or `no effects at all`.
+        detail: String,
     },
     /// A custom formula that does not parse or names something unknown.
     #[error("{0}")]
@@ -70,6 +92,11 @@ pub enum ModelError {
         phase: &'static str,
         switches: usize,
     },
+    /// The ball's centre went below the surface: nothing in the model stops it.
+    #[error(
+        "the ball sank through the surface (penetration {depth_m} m, more than its radius, at t = {t_s} s): the model's normal force cannot stop it; give it a spring (k > 0) or another elastic normal force"
+    )]
+    SankThrough { t_s: f64, depth_m: f64 },
     /// The integrator needed more steps than allowed (the step size collapsed).
     #[error(
         "the integrator needed more than {max_steps} steps (at t = {t_s} s in {phase}); the model is too stiff for the tolerance"
@@ -79,6 +106,16 @@ pub enum ModelError {
         t_s: f64,
         phase: &'static str,
     },
+}
+
+/// A number as a person writes it: plain when short, with an exponent when very large or small.
+pub(crate) fn num(v: f64) -> String {
+    let a = v.abs();
+    if a != 0.0 && a.is_finite() && !(1e-4..1e6).contains(&a) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
 }
 
 /// Where and why a custom formula was refused.

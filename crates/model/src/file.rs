@@ -31,6 +31,7 @@
 
 use crate::effects::custom::{CustomPhase, FORMULA_VARIABLES, Target};
 use crate::effects::{CustomTerm, CustomTermSpec, EffectInfo, builtin, builtin_effects};
+use crate::error::num;
 use crate::{Ball, Model, ModelError};
 use std::path::Path;
 use toml::{Table, Value};
@@ -162,9 +163,7 @@ impl ModelSpec {
                 }
             }
         }
-        if !(gravity.is_finite() && gravity >= 0.0) {
-            return Err(syntax(format!("gravity_m_s2 = {gravity} must be ≥ 0")));
-        }
+        check_range(origin, "gravity_m_s2", gravity, GRAVITY_RANGE, "m/s²")?;
         let mut spec = ModelSpec {
             origin: origin.to_string(),
             ball,
@@ -224,13 +223,12 @@ impl ModelSpec {
                         });
                     };
                     let inherited = setting.params[i].1;
-                    let (lo, hi) = setting.valid_range(param);
                     let s = parse_param(
                         v,
                         inherited,
                         &format!("surfaces.{surface}.{effect}"),
                         param,
-                        (lo, hi),
+                        setting.valid_range(param),
                         origin,
                     )?;
                     values.push((
@@ -309,6 +307,38 @@ impl ModelSpec {
                 }
             }
         }
+        let force = probe_normal_force(&model);
+        if force <= 0.0 {
+            let detail = if self.effects.is_empty() {
+                "the file has no effects at all".to_string()
+            } else {
+                let normal: Vec<String> = settings
+                    .iter()
+                    .filter(|(r, _)| {
+                        self.effects.iter().any(|e| {
+                            e.name == r.effect
+                                && match &e.kind {
+                                    EffectKind::Builtin(info) => info.group == "normal",
+                                    EffectKind::Custom(spec) => spec.formulas.iter().any(|(t, _)| *t == Target::Normal),
+                                }
+                        })
+                    })
+                    .map(|(r, s)| format!("{r} = {}", s.value))
+                    .collect();
+                if normal.is_empty() {
+                    "no normal-force effect".to_string()
+                } else {
+                    normal.join(", ")
+                }
+            };
+            return Err(ModelError::NoNormalForce {
+                origin: self.origin.clone(),
+                surface: surface.map(|s| format!(" (surface `{s}`)")).unwrap_or_default(),
+                probe_mm: PROBE_DEPTH_M * 1e3,
+                force_n: force,
+                detail,
+            });
+        }
         Ok(model)
     }
 
@@ -319,15 +349,15 @@ impl ModelSpec {
 }
 
 impl EffectSetting {
-    fn valid_range(&self, param: &str) -> (f64, f64) {
+    fn valid_range(&self, param: &str) -> (f64, f64, &'static str) {
         match &self.kind {
             EffectKind::Builtin(info) => info
                 .params
                 .iter()
                 .find(|p| p.name == param)
-                .map(|p| (p.min, p.max))
-                .unwrap_or((f64::NEG_INFINITY, f64::INFINITY)),
-            EffectKind::Custom(_) => (f64::NEG_INFINITY, f64::INFINITY),
+                .map(|p| (p.min, p.max, p.unit))
+                .unwrap_or((f64::NEG_INFINITY, f64::INFINITY, "")),
+            EffectKind::Custom(_) => (f64::NEG_INFINITY, f64::INFINITY, ""),
         }
     }
 
@@ -342,6 +372,54 @@ impl EffectSetting {
             EffectKind::Custom(_) => ("custom".into(), "parameter of a custom term".into()),
         }
     }
+}
+
+/// Physical range of gravity, m/s² (0 for a test without weight; the largest planet's is 25).
+const GRAVITY_RANGE: (f64, f64) = (0.0, 100.0);
+/// Physical range of the ball's mass, kg (a table-tennis ball is 2.7 g, a shot put 7 kg).
+const MASS_RANGE: (f64, f64) = (1e-4, 20.0);
+/// Physical range of the ball's radius, m.
+const RADIUS_RANGE: (f64, f64) = (1e-3, 0.5);
+/// Physical range of the inertia factor c = I/(m·R²): a sphere's lies between a point mass at the centre
+/// and a thin shell (2/3), with room for a rounded 0.667.
+const INERTIA_FACTOR_RANGE: (f64, f64) = (0.05, 0.67);
+/// Penetration at which the model's normal force is probed for an elastic term, m.
+const PROBE_DEPTH_M: f64 = 1e-3;
+
+fn check_range(
+    origin: &str,
+    key: &str,
+    value: f64,
+    (min, max): (f64, f64),
+    unit: &'static str,
+) -> Result<f64, ModelError> {
+    if value.is_finite() && value >= min && value <= max {
+        Ok(value)
+    } else {
+        let range = format!("[{}, {}]{}", num(min), num(max), unit_suffix(unit));
+        let reason = if value <= 0.0 && min > 0.0 {
+            format!("must be > 0 (its physical range is {range})")
+        } else {
+            format!("is outside its physical range {range}")
+        };
+        Err(ModelError::OutOfRange {
+            origin: origin.to_string(),
+            key: key.to_string(),
+            value,
+            reason,
+        })
+    }
+}
+
+/// The normal force `model` pushes with at [`PROBE_DEPTH_M`] of penetration, at rest, in compression, N.
+fn probe_normal_force(model: &Model) -> f64 {
+    use crate::effects::{Context, Phase};
+    let state = crate::State {
+        y: model.ball.radius_m - PROBE_DEPTH_M,
+        ..crate::State::default()
+    };
+    let ctx = Context::of(0.0, &state, Phase::Compression, &model.ball, model.gravity, 0.0);
+    model.effects().iter().map(|e| e.normal_force(&ctx)).sum()
 }
 
 fn number(v: &Value) -> Option<f64> {
@@ -361,18 +439,15 @@ fn parse_ball(v: &Value, origin: &str) -> Result<Ball, ModelError> {
     let mut ball = Ball::TENNIS;
     for (k, v) in t {
         let x = number(v).ok_or_else(|| syntax(format!("ball.{k} must be a number")))?;
-        let positive = |name: &str, x: f64| {
-            if x.is_finite() && x > 0.0 {
-                Ok(x)
-            } else {
-                Err(syntax(format!("ball.{name} = {x} must be > 0")))
-            }
-        };
+        let key = format!("ball.{k}");
         match k.as_str() {
-            "mass_kg" => ball.mass_kg = positive(k, x)?,
-            "radius_m" => ball.radius_m = positive(k, x)?,
-            "diameter_m" => ball.radius_m = positive(k, x)? / 2.0,
-            "inertia_factor" => ball.inertia_factor = positive(k, x)?,
+            "mass_kg" => ball.mass_kg = check_range(origin, &key, x, MASS_RANGE, "kg")?,
+            "radius_m" => ball.radius_m = check_range(origin, &key, x, RADIUS_RANGE, "m")?,
+            "diameter_m" => {
+                let (lo, hi) = RADIUS_RANGE;
+                ball.radius_m = check_range(origin, &key, x, (2.0 * lo, 2.0 * hi), "m")? / 2.0
+            }
+            "inertia_factor" => ball.inertia_factor = check_range(origin, &key, x, INERTIA_FACTOR_RANGE, "")?,
             "gravity_m_s2" => {
                 return Err(syntax(
                     "gravity_m_s2 ended up inside [ball]: TOML files a key under the table above it, so put it before the first [table]".into(),
@@ -388,12 +463,20 @@ fn parse_ball(v: &Value, origin: &str) -> Result<Ball, ModelError> {
     Ok(ball)
 }
 
+fn unit_suffix(unit: &str) -> String {
+    if unit.is_empty() || unit == "1" {
+        String::new()
+    } else {
+        format!(" {unit}")
+    }
+}
+
 fn parse_param(
     v: &Value,
     inherited: Option<ParamSetting>,
     effect: &str,
     param: &str,
-    (lo, hi): (f64, f64),
+    (lo, hi, unit): (f64, f64, &str),
     origin: &str,
 ) -> Result<ParamSetting, ModelError> {
     let invalid = |value: f64, reason: String| ModelError::InvalidValue {
@@ -457,11 +540,19 @@ fn parse_param(
         return Err(invalid(s.value, "must be finite".into()));
     }
     if s.value < lo || s.value > hi {
-        let what = match param {
-            "k" | "k_h" => "a negative stiffness would pull the ball into the surface".to_string(),
-            _ => format!("the physical range is [{lo}, {hi}]"),
+        let why = match param {
+            "k" | "k_h" if s.value < 0.0 => "; a negative stiffness would pull the ball into the surface",
+            _ => "",
         };
-        return Err(invalid(s.value, what));
+        return Err(invalid(
+            s.value,
+            format!(
+                "outside its physical range [{}, {}]{}{why}",
+                num(lo),
+                num(hi),
+                unit_suffix(unit)
+            ),
+        ));
     }
     s.min = s.min.max(lo);
     s.max = s.max.min(hi);
@@ -514,7 +605,7 @@ fn parse_effect(name: &str, body: &Value, origin: &str) -> Result<EffectSetting,
                 None,
                 &format!("effects.{name}"),
                 p.name,
-                (p.min, p.max),
+                (p.min, p.max, p.unit),
                 origin,
             )?),
             None => p.default.map(|d| ParamSetting {
@@ -587,7 +678,7 @@ fn parse_custom(name: &str, t: &Table, origin: &str) -> Result<EffectSetting, Mo
                     None,
                     &format!("effects.{name}"),
                     p,
-                    (f64::NEG_INFINITY, f64::INFINITY),
+                    (f64::NEG_INFINITY, f64::INFINITY, ""),
                     origin,
                 )?;
                 params.push((p.to_string(), Some(s)));

@@ -782,6 +782,12 @@ impl<'a> Run<'a> {
                     phase: m.phase.name(),
                 });
             }
+            if m.phase.in_contact() && step.y1[1] < 0.0 {
+                return Err(ModelError::SankThrough {
+                    t_s: t + h,
+                    depth_m: r - step.y1[1],
+                });
+            }
             let g1 = values(&step.y1, &last_aux.get());
             // The earliest event whose function falls through zero in this step.
             let mut hit: Option<(f64, Event)> = None;

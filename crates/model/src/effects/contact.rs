@@ -2,8 +2,6 @@
 
 use super::{Context, Effect, EffectInfo, ParamSpec, Phase, effect_params};
 
-const INF: f64 = f64::INFINITY;
-
 /// Linear spring `P = k·δ` in compression and restitution (the paper's elastic term).
 #[derive(Debug, Clone)]
 pub struct LinearSpring {
@@ -26,7 +24,7 @@ impl LinearSpring {
                 default: None,
                 neutral: 0.0,
                 min: 0.0,
-                max: INF,
+                max: 1e9,
             }],
             build: |v| Box::new(LinearSpring { k: v[0] }),
         }
@@ -62,7 +60,7 @@ impl LinearDamping {
                 default: None,
                 neutral: 0.0,
                 min: 0.0,
-                max: INF,
+                max: 1e6,
             }],
             build: |v| Box::new(LinearDamping { b: v[0] }),
         }
@@ -101,7 +99,7 @@ impl Hertz {
                 default: Some(0.0),
                 neutral: 0.0,
                 min: 0.0,
-                max: INF,
+                max: 1e12,
             }],
             build: |v| Box::new(Hertz { k_h: v[0] }),
         }
@@ -141,7 +139,7 @@ impl HuntCrossley {
                     default: Some(0.0),
                     neutral: 0.0,
                     min: 0.0,
-                    max: INF,
+                    max: 1e12,
                 },
                 ParamSpec {
                     name: "n",
@@ -191,7 +189,7 @@ impl RestitutionDamping {
                 default: Some(0.0),
                 neutral: 0.0,
                 min: 0.0,
-                max: INF,
+                max: 1e6,
             }],
             build: |v| Box::new(RestitutionDamping { b_r: v[0] }),
         }
