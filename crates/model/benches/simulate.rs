@@ -4,7 +4,7 @@
 //! An impact runs from 15 ms before touch to separation (2 m/s, 15° from the normal, paper's clay values);
 //! "sampled" also returns the trajectory at 10,000 fps over a 40 ms clip, as a fit does.
 
-use bouncelab_model::effects::{Hertz, HuntCrossley};
+use bouncelab_model::effects::{Hertz, HuntCrossley, TangentialSpring};
 use bouncelab_model::{Ball, Model, SimOptions, State, simulate};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
@@ -42,6 +42,28 @@ fn bench(c: &mut Criterion) {
     .unwrap();
     g.bench_function("base_custom_formula", |b| {
         b.iter(|| simulate(black_box(&custom), 0.0, 0.0, start(), &[], &o).unwrap())
+    });
+    let names: Vec<String> = (0..33).map(|i| format!("p{i}")).collect();
+    let decl: String = names.iter().map(|n| format!("{n} = 0.01\n")).collect();
+    let wide = bouncelab_model::ModelSpec::parse(
+        &format!(
+            "[effects.spring]\nk = 25650\n[effects.damping]\nb = 14\n[effects.coulomb]\nmu = 0.5\n[effects.wide]\nkind = \"custom\"\nnormal = \"({}) * delta\"\n{decl}",
+            names.join(" + ")
+        ),
+        "bench",
+    )
+    .unwrap()
+    .build(None)
+    .unwrap();
+    g.bench_function("base_custom_formula_33_names", |b| {
+        b.iter(|| simulate(black_box(&wide), 0.0, 0.0, start(), &[], &o).unwrap())
+    });
+    let spring = base.clone().with(TangentialSpring {
+        compliance: 1e-5,
+        c_t: 0.0,
+    });
+    g.bench_function("base_tangential_spring", |b| {
+        b.iter(|| simulate(black_box(&spring), 0.0, 0.0, start(), &[], &o).unwrap())
     });
     g.finish();
 }

@@ -64,11 +64,13 @@ impl State {
     }
 
     /// The integrated vector with this state and no contact history.
-    pub(crate) fn to_array(self) -> crate::integrator::Y {
-        [self.x, self.y, self.theta, self.vx, self.vy, self.omega, 0.0, 0.0]
+    pub(crate) fn to_array<const N: usize>(self) -> [f64; N] {
+        let mut a = [0.0; N];
+        a[..6].copy_from_slice(&[self.x, self.y, self.theta, self.vx, self.vy, self.omega]);
+        a
     }
 
-    pub(crate) fn from_array(a: crate::integrator::Y) -> State {
+    pub(crate) fn from_array<const N: usize>(a: [f64; N]) -> State {
         State {
             x: a[0],
             y: a[1],

@@ -3,11 +3,14 @@
 //! Hand-written because the simulator needs to stop exactly at events found on the dense output and to
 //! restart with a different right-hand side, and because one impact must cost tens of microseconds.
 
-/// Components of the integrated vector.
-pub(crate) const N: usize = 8;
+/// Components of the ball's state: x, y, θ, vx, vy, ω.
+pub(crate) const N_STATE: usize = 6;
+/// Components with the contact's history u_t = ∫ slip dt and ∫ δ dt after the state (integrated only for
+/// models that use it, so the others pay nothing for it).
+pub(crate) const N_HISTORY: usize = 8;
 
-/// The integrated vector: x, y, θ, vx, vy, ω, then the contact's history u_t = ∫ slip dt and ∫ δ dt.
-pub(crate) type Y = [f64; N];
+/// The integrated vector: the state, then (when `N = N_HISTORY`) the contact's history.
+pub(crate) type Y<const N: usize> = [f64; N];
 
 const C2: f64 = 1.0 / 5.0;
 const C3: f64 = 3.0 / 10.0;
@@ -47,7 +50,7 @@ const D6: f64 = -1453857185.0 / 822651844.0;
 const D7: f64 = 69997945.0 / 29380423.0;
 
 #[inline]
-fn comb(y: &Y, h: f64, terms: &[(f64, &Y)]) -> Y {
+fn comb<const N: usize>(y: &Y<N>, h: f64, terms: &[(f64, &Y<N>)]) -> Y<N> {
     let mut out = *y;
     for (c, k) in terms {
         for i in 0..N {
@@ -59,32 +62,29 @@ fn comb(y: &Y, h: f64, terms: &[(f64, &Y)]) -> Y {
 
 /// One attempted step from (`t0`, `y0`) of size `h`, with its error estimate and dense output.
 #[derive(Debug, Clone)]
-pub(crate) struct Step {
+pub(crate) struct Step<const N: usize> {
     pub t0: f64,
     pub h: f64,
-    pub y0: Y,
-    pub y1: Y,
+    pub y0: Y<N>,
+    pub y1: Y<N>,
     /// Derivative at the end of the step (first stage of the next one).
-    pub f1: Y,
+    pub f1: Y<N>,
     /// Scaled error norm; the step is acceptable when ≤ 1.
     pub err: f64,
-    cont: [Y; 4],
+    cont: [Y<N>; 4],
 }
 
-impl Step {
-    /// Tries a step. `f0` is the derivative at (`t0`, `y0`); the error norm is over the first `n_err`
-    /// components (the others are integrated alongside without steering the step).
-    #[allow(clippy::too_many_arguments)]
+impl<const N: usize> Step<N> {
+    /// Tries a step. `f0` is the derivative at (`t0`, `y0`).
     pub fn attempt(
-        f: &mut impl FnMut(f64, &Y) -> Y,
+        f: &mut impl FnMut(f64, &Y<N>) -> Y<N>,
         t0: f64,
-        y0: &Y,
-        f0: &Y,
+        y0: &Y<N>,
+        f0: &Y<N>,
         h: f64,
         rtol: f64,
         atol: f64,
-        n_err: usize,
-    ) -> Step {
+    ) -> Step<N> {
         let k1 = *f0;
         let k2 = f(t0 + C2 * h, &comb(y0, h, &[(A21, &k1)]));
         let k3 = f(t0 + C3 * h, &comb(y0, h, &[(A31, &k1), (A32, &k2)]));
@@ -102,11 +102,9 @@ impl Step {
         let mut sum = 0.0;
         let mut cont = [[0.0; N]; 4];
         for i in 0..N {
-            if i < n_err {
-                let e = h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i]);
-                let sc = atol + rtol * y0[i].abs().max(y1[i].abs());
-                sum += (e / sc) * (e / sc);
-            }
+            let e = h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i]);
+            let sc = atol + rtol * y0[i].abs().max(y1[i].abs());
+            sum += (e / sc) * (e / sc);
             let ydiff = y1[i] - y0[i];
             let bspl = h * k1[i] - ydiff;
             cont[0][i] = ydiff;
@@ -114,7 +112,7 @@ impl Step {
             cont[2][i] = ydiff - h * k7[i] - bspl;
             cont[3][i] = h * (D1 * k1[i] + D3 * k3[i] + D4 * k4[i] + D5 * k5[i] + D6 * k6[i] + D7 * k7[i]);
         }
-        let err = (sum / n_err as f64).sqrt();
+        let err = (sum / N as f64).sqrt();
         Step {
             t0,
             h,
@@ -127,7 +125,7 @@ impl Step {
     }
 
     /// The state at time `t` inside the step, from the 4th-order continuous extension.
-    pub fn at(&self, t: f64) -> Y {
+    pub fn at(&self, t: f64) -> Y<N> {
         let th = ((t - self.t0) / self.h).clamp(0.0, 1.0);
         let th1 = 1.0 - th;
         let mut out = [0.0; N];
@@ -198,16 +196,16 @@ mod tests {
     use super::*;
 
     /// Harmonic oscillator x'' = −x along components 1 and 4 (y, vy).
-    fn osc(_t: f64, y: &Y) -> Y {
-        [0.0, y[4], 0.0, 0.0, -y[1], 0.0, 0.0, 0.0]
+    fn osc(_t: f64, y: &Y<6>) -> Y<6> {
+        [0.0, y[4], 0.0, 0.0, -y[1], 0.0]
     }
 
     /// Largest dense-output error over a step of size `h`.
     fn dense_error(h: f64) -> f64 {
         let mut f = osc;
-        let y0 = [0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+        let y0 = [0.0, 1.0, 0.0, 0.0, 0.0, 0.0];
         let f0 = f(0.0, &y0);
-        let s = Step::attempt(&mut f, 0.0, &y0, &f0, h, 1e-10, 1e-12, 6);
+        let s = Step::attempt(&mut f, 0.0, &y0, &f0, h, 1e-10, 1e-12);
         (0..=20)
             .map(|i| {
                 let t = h * i as f64 / 20.0;
@@ -220,9 +218,9 @@ mod tests {
     #[test]
     fn step_and_dense_output_match_the_exact_solution() {
         let mut f = osc;
-        let y0 = [0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+        let y0 = [0.0, 1.0, 0.0, 0.0, 0.0, 0.0];
         let f0 = f(0.0, &y0);
-        let s = Step::attempt(&mut f, 0.0, &y0, &f0, 0.1, 1e-10, 1e-12, 6);
+        let s = Step::attempt(&mut f, 0.0, &y0, &f0, 0.1, 1e-10, 1e-12);
         assert!((s.y1[1] - 0.1f64.cos()).abs() < 1e-9);
         // The continuous extension is of order 4: its error over a step falls as h⁵.
         let (e1, e2) = (dense_error(0.2), dense_error(0.1));

@@ -104,7 +104,7 @@ impl Model {
     }
 
     /// True if an effect reads the contact's history (`u_t`, `∫δ dt`) or the patch is compliant: the
-    /// simulator then controls the history's integration error.
+    /// simulator then integrates the history with the state.
     pub fn uses_contact_history(&self) -> bool {
         self.effects.iter().any(|e| e.uses_contact_history())
     }

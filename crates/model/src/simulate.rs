@@ -1,7 +1,7 @@
 //! Flight → contact → flight, integrated with events at every phase and stick/slip switch.
 
 use crate::effects::{Context, Loads, Observation, Phase};
-use crate::integrator::{N, Step, Y, find_root};
+use crate::integrator::{N_HISTORY, N_STATE, Step, Y, find_root};
 use crate::{Model, ModelError, State};
 use serde::{Deserialize, Serialize};
 use std::cell::Cell;
@@ -134,6 +134,12 @@ pub struct Simulation {
     pub impact: Impact,
 }
 
+/// Component `i` of the contact's history in `y` (0 when the model does not integrate it).
+#[inline]
+fn history<const N: usize>(y: &Y<N>, i: usize) -> f64 {
+    y.get(N_STATE + i).copied().unwrap_or(0.0)
+}
+
 /// Stick/slip switches allowed at one instant before the contact is reported as undecidable there.
 const MAX_SWITCHES_AT_ONE_INSTANT: usize = 16;
 
@@ -195,8 +201,6 @@ struct Dynamics<'a> {
     patch_damping: f64,
     /// True if the patch is compliant (λ ≠ 0) and friction can load it (μ ≠ 0).
     patch: bool,
-    /// Components of the state in the integrator's error norm: the contact's history only when used.
-    n_err: usize,
 }
 
 /// Time step of the central difference that gives dP/dt for the compliant patch's slide → hold switch, s
@@ -221,34 +225,33 @@ impl<'a> Dynamics<'a> {
             patch_stiffness: 1.0 / compliance,
             patch_damping: model.tangential_damping(),
             patch: compliance != 0.0 && mu != 0.0,
-            n_err: if model.uses_contact_history() { N } else { 6 },
         }
     }
 
     /// The total normal force at (`t`, `y`), N (not clipped at zero: its rate is wanted while it is still
     /// positive, including in the last instants before it vanishes).
-    fn normal_load(&self, t: f64, y: &Y, mode: &Mode) -> f64 {
+    fn normal_load<const N: usize>(&self, t: f64, y: &Y<N>, mode: &Mode) -> f64 {
         let ball = &self.model.ball;
         let state = State::from_array(*y);
         let ctx = Context {
             delta_max: mode.delta_max,
             force_max: mode.force_max,
-            u_t: y[6],
-            delta_int: y[7],
+            u_t: history(y, 0),
+            delta_int: history(y, 1),
             ..Context::of(t, &state, mode.phase, ball, self.model.gravity, self.incline)
         };
         self.model.effects().iter().map(|e| e.normal_force(&ctx)).sum()
     }
 
-    fn eval(&self, t: f64, y: &Y, mode: &Mode) -> (Y, Aux) {
+    fn eval<const N: usize>(&self, t: f64, y: &Y<N>, mode: &Mode) -> (Y<N>, Aux) {
         let ball = &self.model.ball;
         let (m, r) = (ball.mass_kg, ball.radius_m);
         let state = State::from_array(*y);
         let mut ctx = Context {
             delta_max: mode.delta_max,
             force_max: mode.force_max,
-            u_t: y[6],
-            delta_int: y[7],
+            u_t: history(y, 0),
+            delta_int: history(y, 1),
             ..Context::of(t, &state, mode.phase, ball, self.model.gravity, self.incline)
         };
         let slip = ctx.slip;
@@ -285,7 +288,7 @@ impl<'a> Dynamics<'a> {
                         -sigma * aux.friction_limit
                     }
                     Friction::Stick => {
-                        aux.patch_u = y[6] - mode.patch_offset;
+                        aux.patch_u = history(y, 0) - mode.patch_offset;
                         aux.required_friction = -(k * aux.patch_u + c * slip);
                         aux.required_friction
                     }
@@ -301,19 +304,21 @@ impl<'a> Dynamics<'a> {
         } else {
             0.0
         };
-        let dy = [
+        let mut dy = [0.0; N];
+        dy[..N_STATE].copy_from_slice(&[
             state.vx,
             state.vy,
             state.omega,
             ax_other + friction / m,
             ay,
             alpha_other + r * friction / self.inertia,
-            if in_contact { slip } else { 0.0 },
-            if in_contact { ctx.delta } else { 0.0 },
-        ];
+        ]);
+        if N == N_HISTORY && in_contact {
+            dy[N_STATE..].copy_from_slice(&[slip, ctx.delta]);
+        }
         if let (true, Friction::Slip(sigma)) = (mode.patch && in_contact, mode.friction) {
             let slip_rate = dy[3] + r * dy[5];
-            let shifted = |e: f64| std::array::from_fn::<f64, N, _>(|i| y[i] + e * dy[i]);
+            let shifted = |e: f64| -> Y<N> { std::array::from_fn(|i| y[i] + e * dy[i]) };
             // Contact laws bend at δ = 0: the difference stays on the side δ > 0 (central while δ lasts
             // longer than ±ε, forward at the touch itself).
             let (delta, rate) = (ctx.delta, ctx.delta_dot.abs());
@@ -350,7 +355,7 @@ enum Event {
 }
 
 impl Event {
-    fn value(self, y: &Y, aux: &Aux, mode: &Mode, r: f64) -> f64 {
+    fn value<const N: usize>(self, y: &Y<N>, aux: &Aux, mode: &Mode, r: f64) -> f64 {
         match self {
             Event::Touch => y[1] - r,
             Event::MaxCompression => -y[4],
@@ -393,7 +398,7 @@ pub fn simulate(
     opts: &SimOptions,
 ) -> Result<Simulation, ModelError> {
     let r = model.ball.radius_m;
-    let y0 = start.to_array();
+    let y0: Y<N_STATE> = start.to_array();
     if !y0.iter().all(|v| v.is_finite()) || !t0.is_finite() || !incline_rad.is_finite() {
         return Err(ModelError::BadStart(
             "the start state, time or incline is not finite".into(),
@@ -426,7 +431,11 @@ pub fn simulate(
         ));
     }
     let mut run = Run::new(model, incline_rad, opts, times);
-    run.go(t0, y0)
+    if model.uses_contact_history() {
+        run.go::<N_HISTORY>(t0, start.to_array())
+    } else {
+        run.go::<N_STATE>(t0, start.to_array())
+    }
 }
 
 /// Simulates a ball released at rest `drop_height_m` (m, measured vertically from the ball's bottom to the
@@ -463,7 +472,7 @@ struct Recorder<'a> {
 }
 
 impl Recorder<'_> {
-    fn record(&mut self, t: f64, y: &Y, patch_u: f64, mode: &Mode) {
+    fn record<const N: usize>(&mut self, t: f64, y: &Y<N>, patch_u: f64, mode: &Mode) {
         let state = State::from_array(*y);
         let mut observed = Observation::from(state);
         for e in self.model.effects() {
@@ -475,14 +484,20 @@ impl Recorder<'_> {
             observed,
             phase: mode.phase,
             sticking: mode.friction == Friction::Stick,
-            u_t: y[6],
+            u_t: history(y, 0),
             patch_displacement: patch_u,
         });
     }
 
     /// Records every requested time not yet recorded up to `t_hi`, with states from `at` and the patch's
     /// displacement from `patch`.
-    fn record_until(&mut self, t_hi: f64, mode: &Mode, at: impl Fn(f64) -> Y, patch: impl Fn(f64, &Y) -> f64) {
+    fn record_until<const N: usize>(
+        &mut self,
+        t_hi: f64,
+        mode: &Mode,
+        at: impl Fn(f64) -> Y<N>,
+        patch: impl Fn(f64, &Y<N>) -> f64,
+    ) {
         while let Some(&t) = self.times.get(self.samples.len()) {
             if t > t_hi {
                 break;
@@ -497,12 +512,12 @@ impl Recorder<'_> {
 impl Dynamics<'_> {
     /// The displacement stored in the patch's spring at (`t`, `y`), m (0 unless the patch is compliant
     /// and in contact).
-    fn patch_displacement(&self, t: f64, y: &Y, mode: &Mode) -> f64 {
+    fn patch_displacement<const N: usize>(&self, t: f64, y: &Y<N>, mode: &Mode) -> f64 {
         if !(mode.patch && mode.phase.in_contact()) {
             return 0.0;
         }
         match mode.friction {
-            Friction::Stick => y[6] - mode.patch_offset,
+            Friction::Stick => history(y, 0) - mode.patch_offset,
             _ => self.eval(t, y, mode).1.patch_u,
         }
     }
@@ -523,7 +538,7 @@ impl<'a> Run<'a> {
         }
     }
 
-    fn go(&mut self, t0: f64, y0: Y) -> Result<Simulation, ModelError> {
+    fn go<const N: usize>(&mut self, t0: f64, y0: Y<N>) -> Result<Simulation, ModelError> {
         let r = self.dynamics.model.ball.radius_m;
         let mut mode = Mode {
             phase: Phase::Flight,
@@ -554,8 +569,7 @@ impl<'a> Run<'a> {
             mode.phase = Phase::Compression;
         }
         // Touch: the contact's history starts.
-        y[6] = 0.0;
-        y[7] = 0.0;
+        y[N_STATE..].fill(0.0);
         let (t_touch, state_in) = (t, State::from_array(y));
         mode.friction = self.initial_friction(t, &y, &mode);
         let mut slip_events = Vec::new();
@@ -597,7 +611,7 @@ impl<'a> Run<'a> {
         })
     }
 
-    fn initial_friction(&self, t: f64, y: &Y, mode: &Mode) -> Friction {
+    fn initial_friction<const N: usize>(&self, t: f64, y: &Y<N>, mode: &Mode) -> Friction {
         if self.dynamics.mu == 0.0 {
             return Friction::None;
         }
@@ -607,7 +621,7 @@ impl<'a> Run<'a> {
             // outgrows the limit.
             let hold = Mode {
                 friction: Friction::Stick,
-                patch_offset: y[6],
+                patch_offset: history(y, 0),
                 ..*mode
             };
             let aux = self.dynamics.eval(t, y, &hold).1;
@@ -632,14 +646,14 @@ impl<'a> Run<'a> {
     }
 
     /// Integrates one contact phase, handling stick/slip switches, until the phase ends.
-    fn contact(
+    fn contact<const N: usize>(
         &mut self,
         mut t: f64,
-        mut y: Y,
+        mut y: Y<N>,
         mode: &mut Mode,
         phase: Phase,
         slip_events: &mut Vec<SlipEvent>,
-    ) -> Result<(f64, Y), ModelError> {
+    ) -> Result<(f64, Y<N>), ModelError> {
         mode.phase = phase;
         let mut same_instant = 0;
         loop {
@@ -665,7 +679,7 @@ impl<'a> Run<'a> {
                     // The patch stops sliding: it holds from the displacement it had, so the force is
                     // continuous.
                     let aux = self.dynamics.eval(t, &y, mode).1;
-                    mode.patch_offset = y[6] - aux.patch_u;
+                    mode.patch_offset = history(&y, 0) - aux.patch_u;
                     mode.friction = Friction::Stick;
                     SlipEventKind::StartsSticking
                 }
@@ -695,7 +709,7 @@ impl<'a> Run<'a> {
     }
 
     /// The slip has reached zero: stick if friction can hold the contact point, else slide the other way.
-    fn slip_stops(&self, t: f64, y: &mut Y, mode: &mut Mode) -> SlipEventKind {
+    fn slip_stops<const N: usize>(&self, t: f64, y: &mut Y<N>, mode: &mut Mode) -> SlipEventKind {
         let Friction::Slip(sigma) = mode.friction else {
             unreachable!("called while sliding")
         };
@@ -716,21 +730,26 @@ impl<'a> Run<'a> {
 
     /// Integrates in the current mode until an event fires (returning its time and state; the phase is
     /// advanced for phase events) or until `until` is reached.
-    fn integrate(&mut self, mut t: f64, mut y: Y, mode: &mut Mode, until: Option<f64>) -> Result<(f64, Y), ModelError> {
+    fn integrate<const N: usize>(
+        &mut self,
+        mut t: f64,
+        mut y: Y<N>,
+        mode: &mut Mode,
+        until: Option<f64>,
+    ) -> Result<(f64, Y<N>), ModelError> {
         let dynamics = &self.dynamics;
         let r = dynamics.model.ball.radius_m;
         let events = Event::active(mode);
         let m = *mode;
-        let n_err = dynamics.n_err;
         // The last stage of a step is evaluated at its end: keep its event quantities instead of recomputing.
         let last_aux = Cell::new(Aux::default());
-        let mut rhs = |tt: f64, yy: &Y| {
+        let mut rhs = |tt: f64, yy: &Y<N>| {
             let (dy, a) = dynamics.eval(tt, yy, &m);
             last_aux.set(a);
             dy
         };
         let (mut f, aux) = dynamics.eval(t, &y, &m);
-        let values = |y: &Y, aux: &Aux| {
+        let values = |y: &Y<N>, aux: &Aux| {
             let mut g = [0.0; MAX_EVENTS];
             for (gk, e) in g.iter_mut().zip(events) {
                 *gk = e.value(y, aux, &m, r);
@@ -765,7 +784,7 @@ impl<'a> Run<'a> {
                     phase: m.phase.name(),
                 });
             }
-            let step = Step::attempt(&mut rhs, t, &y, &f, h, self.opts.rtol, self.opts.atol, n_err);
+            let step = Step::attempt(&mut rhs, t, &y, &f, h, self.opts.rtol, self.opts.atol);
             if step.err > 1.0 {
                 h = step.next_h();
                 if h < 1e-15 * t.abs().max(1e-3) || !h.is_finite() {
@@ -810,7 +829,7 @@ impl<'a> Run<'a> {
                 // Re-step exactly to the event so its state has the integrator's full accuracy.
                 let he = te - t;
                 let (ye, at) = if he > 0.0 {
-                    let s = Step::attempt(&mut rhs, t, &y, &f, he, self.opts.rtol, self.opts.atol, n_err);
+                    let s = Step::attempt(&mut rhs, t, &y, &f, he, self.opts.rtol, self.opts.atol);
                     (s.y1, Some(s))
                 } else {
                     (y, None)

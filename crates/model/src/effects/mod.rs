@@ -79,11 +79,11 @@ pub struct Context<'a> {
     /// [`Effect::loads`] only (it is 0 while the normal forces themselves are being summed).
     pub normal_force: f64,
     /// Tangential displacement of the contact patch, m: `u_t = ∫ slip dt` from touch (0 before it; frozen
-    /// at its separation value after). Error-controlled only for effects whose
-    /// [`Effect::uses_contact_history`] is true.
+    /// at its separation value after). Integrated only when an effect of the model says it reads it
+    /// ([`Effect::uses_contact_history`]); 0 otherwise.
     pub u_t: f64,
     /// Load history of the contact, m·s: `∫ δ dt` from touch (0 before it; frozen after separation).
-    /// Error-controlled only for effects whose [`Effect::uses_contact_history`] is true.
+    /// Integrated only when an effect of the model says it reads it; 0 otherwise.
     pub delta_int: f64,
 }
 
@@ -221,9 +221,9 @@ pub trait Effect: Debug + Send + Sync {
     fn tangential_damping(&self) -> f64 {
         0.0
     }
-    /// True if the effect reads [`Context::u_t`] or [`Context::delta_int`]: the simulator then controls
-    /// their integration error like the state's (otherwise they are integrated but left out of the error
-    /// norm, so models that do not use them step exactly as before).
+    /// True if the effect reads [`Context::u_t`] or [`Context::delta_int`]: the simulator then integrates
+    /// them with the state (error-controlled like it); models without such an effect integrate the state
+    /// alone, exactly as before.
     fn uses_contact_history(&self) -> bool {
         false
     }
