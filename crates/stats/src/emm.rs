@@ -260,18 +260,18 @@ mod tests {
     use crate::coef::table_of;
     use proptest::prelude::*;
 
-    /// (surface 0..3, angle 0..4, covariate, response) rows.
+    /// The paper's table from (surface 0..3, angle 0..4, v_in_n, cor) rows.
     fn dataset(rows: &[(usize, usize, f64, f64)]) -> Dataset {
-        let surf: Vec<&str> = rows.iter().map(|r| ["clay", "tape1", "tape2"][r.0]).collect();
-        let ang: Vec<&str> = rows.iter().map(|r| ["0", "7.5", "15", "22.5"][r.1]).collect();
-        Dataset::new("cor", rows.iter().map(|r| r.3).collect())
-            .unwrap()
-            .with_factor("surface", &surf)
-            .unwrap()
-            .with_factor("angle", &ang)
-            .unwrap()
-            .with_covariate("v_in_n", rows.iter().map(|r| r.2).collect())
-            .unwrap()
+        let obs: Vec<crate::CorObservation> = rows
+            .iter()
+            .map(|&(s, a, v_in_n, cor)| crate::CorObservation {
+                surface: ["clay", "tape1", "tape2"][s].into(),
+                angle: [0.0, 7.5, 15.0, 22.5][a],
+                v_in_n,
+                cor,
+            })
+            .collect();
+        Dataset::from_cor(&obs).unwrap()
     }
 
     fn close(a: f64, b: f64, tol: f64) -> bool {
