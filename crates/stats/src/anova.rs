@@ -1,8 +1,8 @@
 //! Sequential (Type I) and Type II analysis-of-variance tables of a main-effects linear model.
 
 use serde::{Deserialize, Serialize};
-use statrs::distribution::{ContinuousCDF, FisherSnedecor};
 
+use crate::dist::f_upper_p;
 use crate::linear::{qr_fit, term_columns};
 use crate::{Dataset, StatsError};
 
@@ -118,15 +118,7 @@ pub fn write_anova_csv<W: std::io::Write>(writer: W, tables: &[&AnovaTable]) -> 
 fn f_test(ss: f64, df: usize, mse: f64, df_err: usize) -> AnovaRow {
     let ms = ss / df as f64;
     let f = ms / mse;
-    let p = if f.is_nan() {
-        f64::NAN
-    } else if f == f64::INFINITY {
-        0.0
-    } else {
-        FisherSnedecor::new(df as f64, df_err as f64)
-            .map(|d| d.sf(f.max(0.0)))
-            .unwrap_or(f64::NAN)
-    };
+    let p = f_upper_p(f, df as f64, df_err as f64);
     AnovaRow {
         source: String::new(),
         ss,

@@ -39,7 +39,7 @@ pub struct Diagnostics {
     pub residual_kurtosis: f64,
 }
 
-fn central_moments(x: &[f64]) -> Result<(f64, f64, f64), StatsError> {
+pub(crate) fn central_moments(x: &[f64]) -> Result<(f64, f64, f64), StatsError> {
     if x.len() < 2 {
         return Err(StatsError::TooFewObservations {
             what: "sample moments".into(),

@@ -30,6 +30,32 @@ pub enum StatsError {
         /// The term whose column was found to be redundant.
         term: String,
     },
+    /// A name that the data set holds but the model does not use as a term of the needed kind (marginal
+    /// means need a factor term, a quadratic test a covariate term).
+    #[error("`{name}` is not a {kind} term of the model")]
+    NotATerm {
+        /// The name asked for.
+        name: String,
+        /// `factor` or `covariate`.
+        kind: &'static str,
+    },
+    /// Data the computation cannot use although every value is finite: residuals that are all equal, sums
+    /// that overflow.
+    #[error("cannot compute {what}: {why}")]
+    Degenerate {
+        /// What was being computed.
+        what: String,
+        /// Why it cannot be.
+        why: String,
+    },
+    /// A weight that is not a positive finite number.
+    #[error("weight at row {row} is {value}; weights must be positive and finite")]
+    InvalidWeight {
+        /// Zero-based row index.
+        row: usize,
+        /// The weight given.
+        value: f64,
+    },
     /// A NaN or infinite value in the input.
     #[error("non-finite value in `{field}` at row {row}")]
     NonFinite {

@@ -8,10 +8,22 @@ use crate::{Dataset, StatsError};
 /// Relative size below which a column's component orthogonal to the previous columns counts as zero.
 const RANK_TOL: f64 = 1e-10;
 
+/// What a model term is made of.
+#[derive(Debug, Clone)]
+pub(crate) enum TermKind {
+    /// A treatment-coded factor: its sorted levels, the first being the reference (no column).
+    Factor { levels: Vec<String> },
+    /// A numeric covariate and its mean over the observations.
+    Covariate { mean: f64 },
+    /// A column added for a test (RESET powers, a squared covariate); never part of a reference grid.
+    Extra,
+}
+
 /// The columns of one model term.
 #[derive(Debug, Clone)]
 pub(crate) struct TermColumns {
     pub name: String,
+    pub kind: TermKind,
     /// Column names (`surface[T.tape1]`, `v_in_n`).
     pub labels: Vec<String>,
     /// Column-major values, `labels.len()` columns of `n` rows.
@@ -40,12 +52,17 @@ pub(crate) fn term_columns(data: &Dataset, terms: &[&str]) -> Result<Vec<TermCol
             }
             out.push(TermColumns {
                 name: t.to_string(),
+                kind: TermKind::Factor {
+                    levels: f.levels.clone(),
+                },
                 labels,
                 columns,
             });
         } else if let Some(c) = data.covariate(t) {
+            let mean = c.values.iter().sum::<f64>() / c.values.len().max(1) as f64;
             out.push(TermColumns {
                 name: t.to_string(),
+                kind: TermKind::Covariate { mean },
                 labels: vec![t.to_string()],
                 columns: vec![c.values.clone()],
             });
@@ -136,38 +153,97 @@ impl LinearFit {
     }
 }
 
+/// A least-squares fit with what inference needs: the QR's R gives Var(Lᵀβ̂) = σ̂² ‖R⁻ᵀL‖² for any
+/// linear combination L without forming (XᵀX)⁻¹.
+pub(crate) struct Ols {
+    pub cols: Vec<TermColumns>,
+    pub qr: Qr,
+    pub beta: DVector<f64>,
+    pub fitted: Vec<f64>,
+    pub residuals: Vec<f64>,
+    pub rss: f64,
+    /// Residual degrees of freedom, n − p.
+    pub df: usize,
+}
+
+impl Ols {
+    /// Fits `y` on an intercept plus every column of `cols`, in order.
+    pub fn new(y: &[f64], cols: Vec<TermColumns>) -> Result<Self, StatsError> {
+        let order: Vec<usize> = (0..cols.len()).collect();
+        let qr = qr_fit(y, &cols, &order)?;
+        let beta =
+            qr.r.solve_upper_triangular(&qr.effects)
+                .ok_or_else(|| StatsError::SingularDesign {
+                    term: cols.last().map(|c| c.name.clone()).unwrap_or_default(),
+                })?;
+        let fitted: Vec<f64> = (&qr.q * &qr.effects).iter().copied().collect();
+        let residuals: Vec<f64> = y.iter().zip(&fitted).map(|(a, b)| a - b).collect();
+        let rss = residuals.iter().map(|e| e * e).sum();
+        let df = y.len() - qr.r.ncols();
+        Ok(Ols {
+            cols,
+            qr,
+            beta,
+            fitted,
+            residuals,
+            rss,
+            df,
+        })
+    }
+
+    /// Fits the response of `data` on an intercept plus `terms`.
+    pub fn of(data: &Dataset, terms: &[&str]) -> Result<Self, StatsError> {
+        Ols::new(data.response(), term_columns(data, terms)?)
+    }
+
+    /// Number of coefficients, intercept included.
+    pub fn p(&self) -> usize {
+        self.beta.len()
+    }
+
+    /// σ̂², the residual mean square.
+    pub fn sigma2(&self) -> f64 {
+        self.rss / self.df as f64
+    }
+
+    /// Coefficient names, `Intercept` first, then each term's column labels.
+    pub fn names(&self) -> Vec<String> {
+        let mut names = vec!["Intercept".to_string()];
+        for c in &self.cols {
+            names.extend(c.labels.iter().cloned());
+        }
+        names
+    }
+
+    /// Standard error of Lᵀβ̂: σ̂ ‖R⁻ᵀL‖.
+    pub fn se(&self, l: &DVector<f64>) -> f64 {
+        match self.qr.r.tr_solve_upper_triangular(l) {
+            Some(z) => (self.sigma2() * z.norm_squared()).sqrt(),
+            None => f64::NAN,
+        }
+    }
+
+    /// The index of the first coefficient of term `t` (the intercept is column 0).
+    pub fn first_column(&self, t: usize) -> usize {
+        1 + self.cols[..t].iter().map(|c| c.columns.len()).sum::<usize>()
+    }
+}
+
 /// Fits the response of `data` on an intercept plus `terms` (factor names, treatment coded with the first
 /// sorted level as reference, or covariate names), no interactions.
 pub fn fit_linear(data: &Dataset, terms: &[&str]) -> Result<LinearFit, StatsError> {
-    let cols = term_columns(data, terms)?;
-    let order: Vec<usize> = (0..cols.len()).collect();
-    let y = data.response();
-    let qr = qr_fit(y, &cols, &order)?;
-    let p = qr.r.ncols();
-    let n = y.len();
-    let coef =
-        qr.r.solve_upper_triangular(&qr.effects)
-            .ok_or_else(|| StatsError::SingularDesign {
-                term: terms.last().map(|s| s.to_string()).unwrap_or_default(),
-            })?;
-    let fitted_v = &qr.q * &qr.effects;
-    let fitted: Vec<f64> = fitted_v.iter().copied().collect();
-    let residuals: Vec<f64> = y.iter().zip(&fitted).map(|(a, b)| a - b).collect();
-    let leverage = (0..n).map(|i| qr.q.row(i).norm_squared()).collect();
-    let rss = residuals.iter().map(|e| e * e).sum();
-    let mut names = vec!["Intercept".to_string()];
-    for c in &cols {
-        names.extend(c.labels.iter().cloned());
-    }
+    let ols = Ols::of(data, terms)?;
+    let n = data.len();
+    let leverage = (0..n).map(|i| ols.qr.q.row(i).norm_squared()).collect();
     Ok(LinearFit {
         terms: terms.iter().map(|s| s.to_string()).collect(),
-        coefficient_names: names,
-        coefficients: coef.iter().copied().collect(),
-        fitted,
-        residuals,
+        coefficient_names: ols.names(),
+        coefficients: ols.beta.iter().copied().collect(),
         leverage,
-        rss,
-        df_resid: n - p,
+        rss: ols.rss,
+        df_resid: ols.df,
         n,
+        fitted: ols.fitted,
+        residuals: ols.residuals,
     })
 }

@@ -1,7 +1,11 @@
-//! Tukey–Kramer all-pairs comparison of group means (one-way), as statsmodels' `pairwise_tukeyhsd`.
+//! Tukey–Kramer all-pairs comparison of raw group means (one-way, unadjusted for any covariate), as
+//! statsmodels' `pairwise_tukeyhsd`. For surfaces compared at equal impact speed, use the ANCOVA's
+//! marginal means ([`marginal_means`](crate::marginal_means)) instead: a one-way test pools the
+//! speed-driven spread into its error and can contradict the ANCOVA.
 
 use serde::{Deserialize, Serialize};
 
+use crate::dist::check_alpha;
 use crate::{Dataset, StatsError, StudentizedRange};
 
 /// Size and mean of one group.
@@ -15,9 +19,9 @@ pub struct GroupSummary {
     pub mean: f64,
 }
 
-/// One pairwise comparison, `group2 − group1`.
+/// One pairwise comparison of raw means, `group2 − group1` (unadjusted for the covariate).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct TukeyPair {
+pub struct UnadjustedTukeyPair {
     /// First group (the earlier in sorted order).
     pub group1: String,
     /// Second group.
@@ -38,39 +42,44 @@ pub struct TukeyPair {
     pub reject: bool,
 }
 
-/// Result of [`tukey_hsd`].
+/// Result of [`tukey_hsd_unadjusted`]: one-way comparisons of raw means, unadjusted for the covariate.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct TukeyHsd {
+pub struct UnadjustedTukey {
     /// Family-wise error rate.
     pub alpha: f64,
     /// Error degrees of freedom, n − k.
     pub df: usize,
-    /// Pooled within-group variance (one-way MSE).
+    /// Pooled within-group variance (one-way MSE: it holds whatever the covariate explains, so it is
+    /// larger than the ANCOVA's residual mean square).
     pub mse: f64,
     /// Critical studentized range, the 1 − alpha quantile.
     pub q_crit: f64,
     /// The groups, sorted (numerically when all labels are numbers).
     pub groups: Vec<GroupSummary>,
     /// All pairs i < j in group order.
-    pub pairs: Vec<TukeyPair>,
+    pub pairs: Vec<UnadjustedTukeyPair>,
 }
 
-/// Tukey–Kramer comparisons of `response` grouped by `groups` (one label per observation) with a
-/// one-way pooled variance, at family-wise level `alpha`.
-pub fn tukey_hsd<S: AsRef<str>>(response: &[f64], groups: &[S], alpha: f64) -> Result<TukeyHsd, StatsError> {
+/// Old name of [`UnadjustedTukey`], kept so existing callers build; use the new name.
+pub type TukeyHsd = UnadjustedTukey;
+/// Old name of [`UnadjustedTukeyPair`], kept so existing callers build; use the new name.
+pub type TukeyPair = UnadjustedTukeyPair;
+
+/// Tukey–Kramer comparisons of the raw means of `response` grouped by `groups` (one label per observation)
+/// with a one-way pooled variance, at family-wise level `alpha`: unadjusted for the covariate (see the
+/// module documentation).
+pub fn tukey_hsd_unadjusted<S: AsRef<str>>(
+    response: &[f64],
+    groups: &[S],
+    alpha: f64,
+) -> Result<UnadjustedTukey, StatsError> {
     let data = Dataset::new("response", response.to_vec())?.with_factor("group", groups)?;
-    tukey_hsd_factor(&data, "group", alpha)
+    tukey_hsd_unadjusted_factor(&data, "group", alpha)
 }
 
-/// [`tukey_hsd`] on a factor of a data set.
-pub fn tukey_hsd_factor(data: &Dataset, factor: &str, alpha: f64) -> Result<TukeyHsd, StatsError> {
-    if !(alpha > 0.0 && alpha < 1.0) {
-        return Err(StatsError::InvalidParameter {
-            name: "alpha",
-            value: alpha,
-            expected: "0 < alpha < 1",
-        });
-    }
+/// [`tukey_hsd_unadjusted`] on a factor of a data set (ignores every other column).
+pub fn tukey_hsd_unadjusted_factor(data: &Dataset, factor: &str, alpha: f64) -> Result<UnadjustedTukey, StatsError> {
+    check_alpha(alpha)?;
     let f = data.factor(factor).ok_or_else(|| StatsError::UnknownVariable {
         name: factor.to_string(),
     })?;
@@ -109,7 +118,7 @@ pub fn tukey_hsd_factor(data: &Dataset, factor: &str, alpha: f64) -> Result<Tuke
             let std_err = (0.5 * mse * (1.0 / n[i] as f64 + 1.0 / n[j] as f64)).sqrt();
             let q = mean_diff.abs() / std_err;
             let half = q_crit * std_err;
-            pairs.push(TukeyPair {
+            pairs.push(UnadjustedTukeyPair {
                 group1: f.levels[i].clone(),
                 group2: f.levels[j].clone(),
                 mean_diff,
@@ -122,7 +131,7 @@ pub fn tukey_hsd_factor(data: &Dataset, factor: &str, alpha: f64) -> Result<Tuke
             });
         }
     }
-    Ok(TukeyHsd {
+    Ok(UnadjustedTukey {
         alpha,
         df,
         mse,
@@ -136,4 +145,14 @@ pub fn tukey_hsd_factor(data: &Dataset, factor: &str, alpha: f64) -> Result<Tuke
             .collect(),
         pairs,
     })
+}
+
+/// Old name of [`tukey_hsd_unadjusted`], kept so existing callers build; use the new name.
+pub fn tukey_hsd<S: AsRef<str>>(response: &[f64], groups: &[S], alpha: f64) -> Result<UnadjustedTukey, StatsError> {
+    tukey_hsd_unadjusted(response, groups, alpha)
+}
+
+/// Old name of [`tukey_hsd_unadjusted_factor`], kept so existing callers build; use the new name.
+pub fn tukey_hsd_factor(data: &Dataset, factor: &str, alpha: f64) -> Result<UnadjustedTukey, StatsError> {
+    tukey_hsd_unadjusted_factor(data, factor, alpha)
 }

@@ -1,9 +1,12 @@
 //! Guards every number of the crate against statsmodels 0.15 / scipy 1.17 on the committed data sets in
-//! `fixtures/stats/` (regenerate with `fixtures/stats/make_reference.py`; see its docstring).
+//! `fixtures/stats/` (regenerate with `fixtures/stats/make_reference.py`; see its docstring): ANOVA
+//! tables, fit and influence, coefficient table, one-way Tukey, estimated marginal means and their
+//! Tukey/Holm comparisons, RESET, the quadratic-term test, D'Agostino–Pearson, straight lines (OLS, WLS),
+//! Holm, the studentized range.
 //!
 //! Tolerance: 1e-8 relative everywhere, except
-//! * values that can be ~0 (residuals, studentized residuals, confidence limits, normal quantiles):
-//!   also pass within 1e-12 absolute;
+//! * values that can be ~0 (residuals, studentized residuals, confidence limits, normal quantiles,
+//!   differences of marginal means and their t): also pass within 1e-12 absolute;
 //! * statsmodels' Tukey p-values and scipy's studentized-range CDF: scipy integrates the CDF with
 //!   `nquad(epsabs=1e-11)` and returns sf = 1 − cdf, so those are compared within 1e-8 relative + 5e-11
 //!   absolute; the same p-values are compared at 1e-8 relative (no absolute slack) with the
@@ -13,7 +16,11 @@ use std::cell::RefCell;
 use std::fs::File;
 use std::path::PathBuf;
 
-use bouncelab_stats::{AnovaTable, AnovaType, Dataset, StudentizedRange, ancova, kurtosis, skewness};
+use bouncelab_stats::{
+    AncovaInference, AnovaTable, AnovaType, Dataset, FTest, PAPER_TERMS, StudentizedRange, TestOutcome, ancova,
+    ancova_inference, fit_line, holm, kurtosis, normality_test, quadratic_test, reset_test, skewness,
+    tukey_hsd_unadjusted_factor,
+};
 use serde_json::Value;
 
 fn fixtures() -> PathBuf {
@@ -80,7 +87,7 @@ fn reference() -> Value {
 
 fn load(file: &str) -> Dataset {
     let f = File::open(fixtures().join(file)).expect("fixture csv");
-    Dataset::read_csv(f, "cor", &["surface", "angle"], &["v_in_n"]).expect("fixture csv parses")
+    Dataset::read_csv(f, "cor", &["surface", "angle"], &["v_in_n", "height_m"]).expect("fixture csv parses")
 }
 
 fn f(v: &Value) -> f64 {
@@ -120,7 +127,8 @@ fn check_table(c: &Checker, label: &str, table: &AnovaTable, expected: &Value, t
     c.rel(&format!("{label} Total ss"), total_ss, table.total.ss);
 }
 
-fn check_data_set(name: &str, file: &str) {
+/// Checks every number of one data set; returns the inference for further checks.
+fn check_data_set(name: &str, file: &str) -> AncovaInference {
     let reference = reference();
     let e = &reference[name];
     let data = load(file);
@@ -179,7 +187,7 @@ fn check_data_set(name: &str, file: &str) {
     );
 
     let t = &e["tukey"];
-    let ours = bouncelab_stats::tukey_hsd_factor(&data, "surface", f(&t["alpha"])).expect("tukey");
+    let ours = tukey_hsd_unadjusted_factor(&data, "surface", f(&t["alpha"])).expect("tukey");
     c.num("tukey df", f(&t["df"]), ours.df as f64, 0.0, 0.0);
     c.rel("tukey q_crit (scipy ppf)", f(&t["q_crit"]), ours.q_crit);
     for g in &ours.groups {
@@ -212,7 +220,211 @@ fn check_data_set(name: &str, file: &str) {
             c.fail(format!("{}: expected {}, got {}", w("reject"), ep["reject"], op.reject));
         }
     }
+    let inf = check_inference(&c, e, &data);
     c.finish(name);
+    inf
+}
+
+fn check_f(c: &Checker, label: &str, e: &Value, t: &FTest) {
+    c.rel(&format!("{label} F"), f(&e["f"]), t.f);
+    c.rel(&format!("{label} p"), f(&e["p"]), t.p);
+    c.num(&format!("{label} df_num"), f(&e["df_num"]), t.df_num as f64, 0.0, 0.0);
+    c.num(&format!("{label} df_den"), f(&e["df_den"]), t.df_den as f64, 0.0, 0.0);
+}
+
+/// Coefficient table, marginal means and their comparisons, residual tests and straight lines.
+fn check_inference(c: &Checker, e: &Value, data: &Dataset) -> AncovaInference {
+    let inf = ancova_inference(data, &PAPER_TERMS, 0.05).expect("ancova_inference");
+
+    let coefs = e["coefficients"].as_object().expect("coefficients");
+    c.num(
+        "coefficient count",
+        coefs.len() as f64,
+        inf.coefficients.rows.len() as f64,
+        0.0,
+        0.0,
+    );
+    for (name, ec) in coefs {
+        let Some(r) = inf.coefficients.row(name) else {
+            c.fail(format!("no coefficient {name}"));
+            continue;
+        };
+        let w = |col: &str| format!("coef {name} {col}");
+        c.rel(&w("estimate"), f(&ec["estimate"]), r.estimate);
+        c.rel(&w("se"), f(&ec["se"]), r.se);
+        c.near0(&w("t"), f(&ec["t"]), r.t);
+        c.rel(&w("p"), f(&ec["p"]), r.p);
+        c.near0(&w("lower"), f(&ec["lower"]), r.lower);
+        c.near0(&w("upper"), f(&ec["upper"]), r.upper);
+    }
+
+    for factor in ["surface", "angle"] {
+        let em = &e["marginal_means"][factor];
+        let Some(ours) = inf.means_of(factor) else {
+            c.fail(format!("no marginal means of {factor}"));
+            continue;
+        };
+        let w = |col: &str| format!("emm {factor} {col}");
+        c.num(&w("df"), f(&em["df"]), ours.df as f64, 0.0, 0.0);
+        c.rel(&w("mse"), f(&em["mse"]), ours.mse);
+        c.rel(&w("t_crit (scipy t.ppf)"), f(&em["t_crit"]), ours.t_crit);
+        c.rel(&w("q_crit (scipy ppf)"), f(&em["q_crit"]), ours.q_crit);
+        match ours.covariates_at.as_slice() {
+            [g] if g.name == "v_in_n" => c.rel(&w("grid v_in_n"), f(&em["v_in_n_mean"]), g.value),
+            other => c.fail(format!("{}: grid {other:?}", w("covariates_at"))),
+        }
+        let means = em["means"].as_array().expect("means");
+        c.num(&w("level count"), means.len() as f64, ours.means.len() as f64, 0.0, 0.0);
+        for (m, o) in means.iter().zip(&ours.means) {
+            let w = |col: &str| format!("emm {factor} {} {col}", o.level);
+            // pandas reads angles as floats: "7.5", "15.0" as written in the CSV.
+            if m["level"].as_str() != Some(o.level.as_str()) {
+                c.fail(format!("{}: expected {}", w("level"), m["level"]));
+            }
+            c.num(&w("n"), f(&m["n"]), o.n as f64, 0.0, 0.0);
+            c.rel(&w("raw mean"), f(&m["raw_mean"]), o.raw_mean);
+            c.rel(&w("estimate"), f(&m["estimate"]), o.estimate);
+            c.rel(&w("se"), f(&m["se"]), o.se);
+            c.rel(&w("lower"), f(&m["lower"]), o.lower);
+            c.rel(&w("upper"), f(&m["upper"]), o.upper);
+        }
+        let pairs = em["pairs"].as_array().expect("pairs");
+        c.num(&w("pair count"), pairs.len() as f64, ours.pairs.len() as f64, 0.0, 0.0);
+        for (p, o) in pairs.iter().zip(&ours.pairs) {
+            let w = |col: &str| format!("emm {factor} {} − {} {col}", o.level2, o.level1);
+            if p["level1"].as_str() != Some(o.level1.as_str()) || p["level2"].as_str() != Some(o.level2.as_str()) {
+                c.fail(format!("{}: expected {} {}", w("order"), p["level1"], p["level2"]));
+            }
+            c.near0(&w("estimate"), f(&p["estimate"]), o.estimate);
+            c.rel(&w("se"), f(&p["se"]), o.se);
+            c.near0(&w("t"), f(&p["t"]), o.t);
+            c.rel(&w("p (t_test)"), f(&p["p"]), o.p);
+            c.num(&w("p tukey vs scipy"), f(&p["p_tukey"]), o.p_tukey, 1e-8, 5e-11);
+            c.rel(&w("p tukey vs quadpack"), f(&p["p_tukey_quadpack"]), o.p_tukey);
+            c.rel(&w("p holm (multipletests)"), f(&p["p_holm"]), o.p_holm);
+            c.near0(&w("lower"), f(&p["lower"]), o.lower);
+            c.near0(&w("upper"), f(&p["upper"]), o.upper);
+            for (key, ours) in [("reject_tukey", o.reject_tukey), ("reject_holm", o.reject_holm)] {
+                if p[key].as_bool() != Some(ours) {
+                    c.fail(format!("{}: expected {}, got {ours}", w(key), p[key]));
+                }
+            }
+        }
+    }
+
+    let rt = &e["residual_tests"];
+    check_f(
+        c,
+        "RESET power 2",
+        &rt["reset_power2"],
+        &reset_test(data, &PAPER_TERMS, 2).expect("reset 2"),
+    );
+    check_f(
+        c,
+        "RESET power 3",
+        &rt["reset_power3"],
+        &reset_test(data, &PAPER_TERMS, 3).expect("reset 3"),
+    );
+    check_f(
+        c,
+        "quadratic v_in_n",
+        &rt["quadratic_v_in_n"],
+        &quadratic_test(data, &PAPER_TERMS, "v_in_n").expect("quadratic"),
+    );
+    let tests = &inf.residual_tests;
+    match (&tests.reset, tests.quadratic.as_slice()) {
+        (TestOutcome::Ran(r), [q]) if q.covariate == "v_in_n" => {
+            check_f(c, "inference RESET", &rt["reset_power2"], r);
+            match &q.test {
+                TestOutcome::Ran(t) => check_f(c, "inference quadratic", &rt["quadratic_v_in_n"], t),
+                other => c.fail(format!("quadratic test not run: {other:?}")),
+            }
+        }
+        other => c.fail(format!("residual tests: {other:?}")),
+    }
+    let en = &rt["normality"];
+    let fit = &ancova(data, &PAPER_TERMS).expect("ancova").fit;
+    let n = normality_test(&fit.residuals).expect("normality");
+    c.rel("normaltest K2", f(&en["k2"]), n.k2);
+    c.rel("normaltest p", f(&en["p"]), n.p);
+    c.near0("skewtest z", f(&en["z_skewness"]), n.z_skewness);
+    c.rel("skewtest p", f(&en["p_skewness"]), n.p_skewness);
+    c.near0("kurtosistest z", f(&en["z_kurtosis"]), n.z_kurtosis);
+    c.rel("kurtosistest p", f(&en["p_kurtosis"]), n.p_kurtosis);
+    if tests.normality != TestOutcome::Ran(n) {
+        c.fail(format!("inference normality differs: {:?}", tests.normality));
+    }
+    // The caption follows the reference p-values at alpha = 0.05.
+    let caption = tests.caption();
+    let curved = f(&rt["reset_power2"]["p"]) < 0.05 || f(&rt["quadratic_v_in_n"]["p"]) < 0.05;
+    if caption.starts_with("Residuals curve with") != curved
+        || caption.starts_with("No curvature detected") == curved
+        || caption.contains("residuals are not normal") != (f(&en["p"]) < 0.05)
+    {
+        c.fail(format!("caption disagrees with the reference p-values: {caption}"));
+    }
+    println!("caption: {caption}");
+
+    for (surface, el) in e["lines"].as_object().expect("lines") {
+        let rows: Vec<usize> = (0..data.len())
+            .filter(|&i| data.factor("surface").unwrap().level_of(i) == surface)
+            .collect();
+        let v = &data.covariate("v_in_n").unwrap().values;
+        let h = &data.covariate("height_m").unwrap().values;
+        let x: Vec<f64> = rows.iter().map(|&i| v[i]).collect();
+        let y: Vec<f64> = rows.iter().map(|&i| data.response()[i]).collect();
+        // make_reference.py's line_weights: 1 / (0.005 + 0.02 height)^2.
+        let wt: Vec<f64> = rows.iter().map(|&i| (0.005 + 0.02 * h[i]).powi(-2)).collect();
+        for (kind, w) in [("unweighted", None), ("weighted", Some(wt.as_slice()))] {
+            let r = &el[kind];
+            let l = fit_line(&x, &y, w).expect("line");
+            let w = |col: &str| format!("line {surface} {kind} {col}");
+            c.rel(&w("intercept"), f(&r["intercept"]), l.intercept);
+            c.near0(&w("slope"), f(&r["slope"]), l.slope);
+            c.rel(&w("intercept_se"), f(&r["intercept_se"]), l.intercept_se);
+            c.rel(&w("slope_se"), f(&r["slope_se"]), l.slope_se);
+            c.near0(&w("cov"), f(&r["cov_intercept_slope"]), l.cov_intercept_slope);
+            c.near0(&w("t"), f(&r["t"]), l.t);
+            c.rel(&w("p"), f(&r["p"]), l.p);
+            c.rel(&w("residual variance"), f(&r["residual_variance"]), l.residual_variance);
+            c.num(&w("df"), f(&r["df"]), l.df as f64, 0.0, 0.0);
+        }
+    }
+    inf
+}
+
+#[test]
+fn holm_matches_multipletests() {
+    let reference = reference();
+    let c = Checker::new();
+    for case in reference["holm"].as_array().unwrap() {
+        let p = arr(&case["p"]);
+        for (i, (want, got)) in arr(&case["p_holm"]).iter().zip(holm(&p)).enumerate() {
+            c.rel(&format!("holm {p:?}[{i}]"), *want, got);
+        }
+    }
+    c.finish("holm");
+}
+
+/// A Hertz-like session: COR falls as |v|^(1/5). The quadratic term in the speed finds the curve the
+/// linear ANCOVA misses, and the marginal means separate the tapes where the one-way comparison cannot.
+#[test]
+fn hertz_curve_is_reported() {
+    let inf = check_data_set("hertz", "cor_hertz.csv");
+    let caption = inf.residual_tests.caption();
+    assert!(
+        caption.starts_with("Residuals curve with v_in_n (quadratic term F = "),
+        "{caption}"
+    );
+    assert!(caption.contains("the linear model misses a trend"), "{caption}");
+    // The contradiction: raw one-way means cannot tell the tapes apart (the speed spread swamps
+    // the pooled variance); the adjusted means, from the same fit as the ANCOVA, can.
+    let tapes = |l1: &str, l2: &str| l1 == "tape1" && l2 == "tape2";
+    let adjusted = inf.means_of("surface").unwrap();
+    let adjusted = adjusted.pairs.iter().find(|p| tapes(&p.level1, &p.level2)).unwrap();
+    let one_way = tukey_hsd_unadjusted_factor(&load("cor_hertz.csv"), "surface", 0.05).unwrap();
+    let one_way = one_way.pairs.iter().find(|p| tapes(&p.group1, &p.group2)).unwrap();
+    assert!(adjusted.reject_tukey && !one_way.reject, "{adjusted:?}\n{one_way:?}");
 }
 
 #[test]
