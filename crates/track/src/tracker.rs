@@ -6,7 +6,7 @@ use crate::plane::{Pixel, Plane};
 use crate::refine::{
     EdgeSearch, Refined, RimShapeLearner, refine_circle_with_rays, refined_candidates, residuals_about, rim_residuals,
 };
-use crate::surface::{SurfaceLine, find_surface_line};
+use crate::surface::{SurfaceLine, find_surface_lines};
 use serde::{Deserialize, Serialize};
 
 /// What the tracker could say about the ball in a frame.
@@ -122,6 +122,8 @@ pub struct Tracker {
     /// is being learned (its residuals teach the shape without a second search); empty otherwise.
     rim_rays: Vec<(usize, [f64; 2])>,
     surface: Option<SurfaceLine>,
+    /// The other cue's line, where the two cues disagreed (see [`crate::SurfaceLines`]).
+    surface_alternative: Option<SurfaceLine>,
     surface_tries: usize,
     warnings: Vec<String>,
     /// Distance between the last prediction and its measurement, px.
@@ -159,6 +161,7 @@ impl Tracker {
             rim_frozen: false,
             rim_rays: Vec::new(),
             surface: None,
+            surface_alternative: None,
             surface_tries: 0,
             warnings: Vec::new(),
             last_innovation: 0.0,
@@ -180,6 +183,11 @@ impl Tracker {
     /// The surface line, once found.
     pub fn surface(&self) -> Option<&SurfaceLine> {
         self.surface.as_ref()
+    }
+
+    /// The other cue's line, where the brightness and texture cues found different lines.
+    pub fn surface_alternative(&self) -> Option<&SurfaceLine> {
+        self.surface_alternative.as_ref()
     }
 
     /// Things a person should know (a second ball, a lost track), each naming its frame.
@@ -242,7 +250,10 @@ impl Tracker {
     pub fn observe<P: Pixel>(&mut self, frame: usize, t_s: f64, img: &Plane<P>) -> BallFix {
         if self.surface.is_none() && self.surface_tries < 5 {
             self.surface_tries += 1;
-            self.surface = find_surface_line(img);
+            if let Some(lines) = find_surface_lines(img) {
+                self.surface = Some(lines.line);
+                self.surface_alternative = lines.alternative;
+            }
         }
         // 1. Around the prediction.
         // A confident track needs one narrow pass; the window widens when the last prediction missed (a
