@@ -1,5 +1,6 @@
 //! Built-in scenarios: `smoke` (regression tests), `paper` (the paper's 144-shot session), `none` and one
-//! `effect-<name>` session per non-base effect of the model crate (for the missing-effect diagnosis).
+//! `effect-<name>` session per non-base effect of the model crate (for the missing-effect diagnosis),
+//! `looks` (64 shots, each with its own look and physics) and `looks-smoke` (6 small ones for tests).
 
 use bouncelab_model::{ModelSpec, builtin_effects};
 
@@ -18,7 +19,10 @@ pub const EFFECT_MAGNITUDES: &[(&str, &str)] = &[
 
 /// The names of every preset.
 pub fn preset_names() -> Vec<String> {
-    let mut v: Vec<String> = ["smoke", "paper", "none"].iter().map(|s| s.to_string()).collect();
+    let mut v: Vec<String> = ["smoke", "paper", "none", "looks", "looks-smoke"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
     for e in builtin_effects().iter().filter(|e| !e.base) {
         v.push(format!("effect-{}", e.name));
     }
@@ -75,6 +79,8 @@ pub fn preset_toml(name: &str) -> Option<String> {
             paper_model_tables()
         )),
         "none" => Some(effect_session("none", None)),
+        "looks" => Some(LOOKS.to_string()),
+        "looks-smoke" => Some(LOOKS_SMOKE.to_string()),
         _ => {
             let effect = name.strip_prefix("effect-")?;
             let info = builtin_effects().iter().find(|e| e.name == effect && !e.base)?;
@@ -116,3 +122,90 @@ fn effect_session(name: &str, effect: Option<&str>) -> String {
         "name = \"{name}\"\ndescription = \"Diagnosis session: clay, {what}\"\nseed = {seed}\npre_contact_ms = {flight_ms}\npost_separation_ms = {flight_ms}\n\n[ball]\ndiameter_m = 0.067\nmass_kg = 0.0567\ninertia_factor = 0.6666666666666666\n\n{CAMERA_512}\n[model]\ngravity_m_s2 = 9.81\n[model.effects.spring]\nk = 25650\n[model.effects.damping]\nb = 14\n[model.effects.coulomb]\nmu = 0.5\n\n[surfaces.clay]\ntexture = \"clay\"\n\n{extra}\n[grid]\nsurfaces = [\"clay\"]\ndrop_heights_m = [0.2, 0.55, 0.9]\nangles_deg = [0, 7.5, 15, 22.5]\nrepeats = 1\neffects = {list}\n"
     )
 }
+
+/// 64 shots (32 on clay, 32 on tape) whose look and physics are drawn per shot: every look family of
+/// `docs/renderer.md`, at 320–512 px.
+const LOOKS: &str = r#"name = "looks"
+description = "64 shots, each with its own look (surface, contrast, lighting, clutter, ball, sensor, geometry) and physics"
+seed = 15
+pre_contact_ms = 8
+post_separation_ms = 8
+
+[ball]
+diameter_m = 0.067
+mass_kg = 0.0567
+inertia_factor = 0.6666666666666666
+
+[camera]
+fps = 10000
+exposure_s = 5e-5
+
+[model]
+gravity_m_s2 = 9.81
+[model.effects.spring]
+k = 25650
+[model.effects.damping]
+b = 14
+[model.effects.coulomb]
+mu = 0.5
+
+[surfaces.clay]
+texture = "clay"
+[surfaces.tape]
+texture = "white_tape"
+
+[random_physics]
+drop_height_m = [0.15, 0.6]
+angle_deg = [0, 25]
+k = [20000, 36000]
+b = [8, 20]
+mu = [0.3, 0.7]
+
+[look]
+width_px = [320, 512]
+height_px = [320, 512]
+
+[grid]
+surfaces = ["clay", "tape"]
+drop_heights_m = [0.3]
+angles_deg = [0]
+repeats = 32
+"#;
+
+/// 6 small shots (3 on clay, 3 on tape) with drawn looks and physics: 256 × 256, a 4-ms flight either
+/// side; renders in about a second, for tests of other crates.
+const LOOKS_SMOKE: &str = r#"name = "looks-smoke"
+description = "6 small shots with drawn looks and physics, for tests"
+seed = 3
+pre_contact_ms = 4
+post_separation_ms = 4
+
+[ball]
+diameter_m = 0.067
+mass_kg = 0.0567
+inertia_factor = 0.6666666666666666
+
+[camera]
+fps = 10000
+exposure_s = 5e-5
+
+[surfaces.clay]
+texture = "clay"
+[surfaces.tape]
+texture = "white_tape"
+
+[random_physics]
+drop_height_m = [0.15, 0.35]
+angle_deg = [0, 20]
+
+[look]
+width_px = 256
+height_px = 256
+ball_radius_px = [20, 40]
+
+[grid]
+surfaces = ["clay", "tape"]
+drop_heights_m = [0.3]
+angles_deg = [0]
+repeats = 3
+"#;
