@@ -1,10 +1,12 @@
 //! cargo run --release -p bouncelab-render --example looks_sheet [-- OUT_DIR [PRESET|SCENARIO.toml] [SHOTS]]
 //!
-//! Contact sheets of the looks of a preset (default `looks`, 12 shots spread over it): `render-looks.png`, each
+//! Contact sheets of the looks of a preset (default `looks`; 12 shots chosen one by one, surfaces in turn,
+//! each adding the most family tags and clutter kinds not yet shown): `render-looks.png`, each
 //! shot's frame 3 ms before the touch scaled to a 300 × 300 tile, and `render-looks-edges.png`, 1:1 crops
 //! of the band's edge under the ball at the touch. Prints each tile's families.
 
 use bouncelab_render::{Frame, Pixels, Scenario, ShotPlan, encode};
+use std::collections::BTreeSet;
 
 /// The frame as 8-bit gray (16-bit and 12-in-16 data scaled down).
 fn gray8(f: &Frame, bit_depth: u8) -> Vec<u8> {
@@ -34,8 +36,30 @@ fn main() {
     let mut sheet = vec![24u8; cols * tile * rows * tile];
     let mut edges = vec![24u8; cols * cw * rows * ch];
     let n = n.min(s.shots.len());
+    let plans: Vec<ShotPlan> = (0..s.shots.len())
+        .map(|i| ShotPlan::new(&s, i).expect("plan"))
+        .collect();
+    let tags = |p: &ShotPlan| -> BTreeSet<String> {
+        let l = p.look.as_ref().expect("a preset with [look]");
+        let mut t: BTreeSet<String> = l.families().iter().map(|f| f.to_string()).collect();
+        t.extend(l.items.iter().map(|i| i.kind.name().to_string()));
+        t
+    };
+    let (mut chosen, mut shown) = (Vec::new(), BTreeSet::new());
+    let surfaces: Vec<&str> = s.surfaces.iter().map(|x| x.name.as_str()).collect();
     for k in 0..n {
-        let plan = ShotPlan::new(&s, k * s.shots.len() / n).expect("plan");
+        // Surfaces in turn, so the sheet shows clay and tapes alike.
+        let surface = surfaces[k % surfaces.len()];
+        let best = (0..plans.len())
+            .filter(|i| !chosen.contains(i) && plans[*i].truth.surface == surface)
+            .max_by_key(|&i| (tags(&plans[i]).difference(&shown).count(), std::cmp::Reverse(i)))
+            .expect("enough shots");
+        shown.extend(tags(&plans[best]));
+        chosen.push(best);
+    }
+    chosen.sort();
+    for (k, &index) in chosen.iter().enumerate() {
+        let plan = &plans[index];
         let look = plan.look.as_ref().expect("a preset with [look]");
         let r = plan.renderer();
         let fps = plan.camera().fps;
@@ -103,4 +127,11 @@ fn main() {
     };
     save("render-looks.png", cols * tile, rows * tile, sheet);
     save("render-looks-edges.png", cols * cw, rows * ch, edges);
+    let all: BTreeSet<String> = plans.iter().flat_map(tags).collect();
+    println!(
+        "the sheet shows {} of the {} tags and item kinds drawn in {preset}; not shown: {:?}",
+        shown.len(),
+        all.len(),
+        all.difference(&shown).collect::<Vec<_>>()
+    );
 }

@@ -533,8 +533,7 @@ pub(crate) fn build(plan: &ShotPlan, look: &Look) -> LookScene {
     });
     let tape = look.weave_period_px.map(|period| Tape {
         seed: rng.next_u64(),
-        herringbone: look.surface == SurfaceLook::HerringboneTape
-            || (look.surface == SurfaceLook::TapeOnClay && rng.uniform() < 0.5),
+        herringbone: look.weave == Some("herringbone"),
         period,
         fore: d.foreshortening,
         zig: d.zig_periods,

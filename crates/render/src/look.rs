@@ -408,6 +408,8 @@ pub struct Look {
     pub tape_edge_roughness_px: Option<f64>,
     /// Tape: weave period, pixels.
     pub weave_period_px: Option<f64>,
+    /// Tape: its weave, `"plain"` (woven) or `"herringbone"`.
+    pub weave: Option<&'static str>,
     /// Tape on clay: height of the tape above the clay's mean edge, pixels.
     pub tape_thickness_px: Option<f64>,
     /// Tape on clay: image x of the strip's two ends on the surface line, pixels (left, right).
@@ -644,6 +646,7 @@ impl LookSpec {
         let grain = self.grain_px.draw(rng);
         let tape_edge = self.tape_edge_roughness_px.draw(rng);
         let weave = self.weave_period_px.draw(rng);
+        let herringbone_on_clay = rng.uniform() < 0.5;
         let thickness = self.tape_thickness_px.draw(rng);
         let gradient = self.gradient.draw(rng);
         let gradient_dir_deg = rng.range(0.0, 360.0);
@@ -714,6 +717,12 @@ impl LookSpec {
             grain_px: clay.then_some(grain),
             tape_edge_roughness_px: tape.then_some(tape_edge),
             weave_period_px: tape.then_some(weave),
+            weave: match surface {
+                SurfaceLook::ClaySpeckle => None,
+                SurfaceLook::WovenTape => Some("plain"),
+                SurfaceLook::HerringboneTape => Some("herringbone"),
+                SurfaceLook::TapeOnClay => Some(if herringbone_on_clay { "herringbone" } else { "plain" }),
+            },
             tape_thickness_px: (surface == SurfaceLook::TapeOnClay).then_some(thickness),
             tape_span_px: None,
             gradient,
@@ -1065,6 +1074,7 @@ pub const LOOK_COLUMNS: &[&str] = &[
     "grain_px",
     "tape_edge_roughness_px",
     "weave_period_px",
+    "weave",
     "tape_thickness_px",
     "tape_x0_px",
     "tape_x1_px",
@@ -1209,6 +1219,7 @@ impl Look {
             opt(self.grain_px),
             opt(self.tape_edge_roughness_px),
             opt(self.weave_period_px),
+            self.weave.unwrap_or_default().to_string(),
             opt(self.tape_thickness_px),
             opt(self.tape_span_px.map(|s| s.0)),
             opt(self.tape_span_px.map(|s| s.1)),

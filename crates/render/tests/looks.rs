@@ -19,7 +19,8 @@ fn render_to(s: &Scenario, dir: &std::path::Path, parallel: bool) -> Rendered {
 
 #[test]
 fn looks_are_byte_identical_for_a_seed_and_parallel_equals_sequential() {
-    let s = Scenario::parse(&tiny_look(11, ""), "tiny-look").unwrap();
+    let text = tiny_look(11, "");
+    let s = Scenario::parse(&text, "tiny-look").unwrap();
     let (a, b, c) = (
         tempfile::tempdir().unwrap(),
         tempfile::tempdir().unwrap(),
@@ -31,7 +32,7 @@ fn looks_are_byte_identical_for_a_seed_and_parallel_equals_sequential() {
     let fa = files(a.path());
     assert_eq!(fa, files(b.path()));
     assert_eq!(fa, files(c.path()));
-    assert!(fa.len() > 100, "{} files", fa.len());
+    assert!(fa.len() > 60, "{} files", fa.len());
     for f in &fa {
         let x = std::fs::read(a.path().join(f)).unwrap();
         assert_eq!(
@@ -54,11 +55,14 @@ fn looks_are_byte_identical_for_a_seed_and_parallel_equals_sequential() {
     assert_ne!(l1.unwrap().band_dn, l2.unwrap().band_dn);
 }
 
-/// Every look of the `looks` preset, without images.
-fn looks_preset() -> (Scenario, Vec<ShotPlan>) {
-    let s = Scenario::preset("looks").unwrap();
-    let plans = (0..s.shots.len()).map(|i| ShotPlan::new(&s, i).unwrap()).collect();
-    (s, plans)
+/// Every shot of the `looks` preset planned (look drawn and placed, no images), once per test process.
+fn looks_preset() -> &'static (Scenario, Vec<ShotPlan>) {
+    static PLANS: std::sync::OnceLock<(Scenario, Vec<ShotPlan>)> = std::sync::OnceLock::new();
+    PLANS.get_or_init(|| {
+        let s = Scenario::preset("looks").unwrap();
+        let plans = (0..s.shots.len()).map(|i| ShotPlan::new(&s, i).unwrap()).collect();
+        (s, plans)
+    })
 }
 
 #[test]
@@ -67,7 +71,7 @@ fn every_family_is_reachable_in_the_looks_preset() {
     let mut seen = BTreeSet::new();
     let (mut kinds, mut names, mut formats, mut surfaces) =
         (BTreeSet::new(), BTreeSet::new(), BTreeSet::new(), BTreeSet::new());
-    for p in &plans {
+    for p in plans {
         let l = p.look.as_ref().unwrap();
         seen.extend(l.families());
         kinds.extend(l.items.iter().map(|i| i.kind.name()));
@@ -88,11 +92,14 @@ fn every_family_is_reachable_in_the_looks_preset() {
 
 #[test]
 fn the_looks_presets_keep_the_ball_in_view_within_their_ranges() {
-    for name in ["looks", "looks-smoke"] {
-        let s = Scenario::preset(name).unwrap();
+    let smoke = Scenario::preset("looks-smoke").unwrap();
+    let smoke_plans: Vec<ShotPlan> = (0..smoke.shots.len())
+        .map(|i| ShotPlan::new(&smoke, i).unwrap())
+        .collect();
+    let (looks, looks_plans) = looks_preset();
+    for (name, s, plans) in [("looks", looks, looks_plans), ("looks-smoke", &smoke, &smoke_plans)] {
         let spec = s.look.clone().unwrap();
-        for i in 0..s.shots.len() {
-            let p = ShotPlan::new(&s, i).unwrap();
+        for p in plans {
             let l = p.look.as_ref().unwrap();
             assert!(
                 p.frames.iter().all(|f| f.visible == Visibility::Full),
@@ -233,7 +240,7 @@ tape_looks = ["tape_on_clay", "woven_tape"]
 fn the_looks_preset_respects_its_default_ranges() {
     let (s, plans) = looks_preset();
     let spec = s.look.clone().unwrap();
-    for p in &plans {
+    for p in plans {
         let l = p.look.as_ref().unwrap();
         let row = l.row(&p.truth.clip);
         for (c, range) in RANGED {
@@ -288,20 +295,22 @@ fn twelve_bit_files_have_their_low_four_bits_zero() {
     }
 }
 
-/// Keys giving the ball's whole rim a clear contrast, so the brute-force fit (strongest gradient along
-/// rays) finds the rim rather than the seam: a dark backdrop and a felt ball lit from near the camera.
+/// Keys giving the ball's rim a clear contrast: a dark backdrop and a felt ball lit from near the camera.
 const CONTRAST: &str = "backdrop_dn = [40, 60]\nlight_elevation_deg = [60, 80]\nball_albedo_dn = [200, 240]\n";
 
 #[test]
 fn a_looks_ball_is_where_the_truth_says() {
-    // Mirrored, rolled, a plain or backlit ball at its own scale: the brute-force fit of the render tests.
-    for (ball, seed) in [("plain", 1), ("backlit", 2), ("felt_seam", 3)] {
+    // Mirrored, rolled, at its own scale: the brute-force fit of the render tests. An unshaded backlit
+    // silhouette pins the absolute position; on a shaded felt ball the strongest gradient along a ray sits
+    // inside a dim limb (by up to a few tenths of a pixel, the same in every frame), so there the fit must
+    // follow the truth from frame to frame about a constant offset.
+    for (ball, seed, absolute) in [("backlit", 2, 0.1), ("plain", 1, 0.4), ("felt_seam", 3, 0.4)] {
         let extra = format!(
             "ruler = 0\nfixtures = 0\nscrews = 0\nsecond_circle = 0\nhand = 0\nhot_spots = 0\nread_noise_dn = 1.5\nballs = [\"{ball}\"]\ndownslopes = [\"-x\"]\nroll_deg = [1, 2]\nball_radius_px = [30, 34]\nwidth_px = 240\nheight_px = 240\n{CONTRAST}"
         );
-        let text = tiny_look(seed, &extra).replace("pre_contact_ms = 3", "pre_contact_ms = 6");
+        let text = tiny_look(seed, &extra).replace("pre_contact_ms = 1", "pre_contact_ms = 6");
         let s = Scenario::parse(&text, "ball").unwrap();
-        let (mut worst, mut n) = (0.0f64, 0);
+        let (mut worst, mut scatter, mut n) = (0.0f64, Vec::new(), 0);
         for shot in 0..s.shots.len() {
             let plan = ShotPlan::new(&s, shot).unwrap();
             let r = plan.renderer();
@@ -309,6 +318,7 @@ fn a_looks_ball_is_where_the_truth_says() {
             assert_eq!(l.ball.name(), ball);
             // Far enough above the band that its grains stay out of the fit's annulus.
             let clear = 6.0 + l.edge_roughness_px.unwrap_or(0.0) * 3.0;
+            let mut errors = Vec::new();
             for ft in plan.frames.iter().step_by(3) {
                 if ft.phase != Phase::Flight || ft.y_px + ft.r_px > plan.truth.surface_y_px - clear {
                     continue;
@@ -322,12 +332,20 @@ fn a_looks_ball_is_where_the_truth_says() {
                     ft.r_px
                 );
                 worst = worst.max((x - ft.x_px).hypot(y - ft.y_px));
-                n += 1;
+                errors.push((x - ft.x_px, y - ft.y_px));
             }
+            let m = errors.len().max(1) as f64;
+            let (mx, my) = errors.iter().fold((0.0, 0.0), |a, e| (a.0 + e.0 / m, a.1 + e.1 / m));
+            scatter.extend(errors.iter().map(|e| (e.0 - mx).hypot(e.1 - my)));
+            n += errors.len();
         }
-        eprintln!("{ball}: worst centre error {worst:.3} px over {n} flight frames");
+        let rms = (scatter.iter().map(|d| d * d).sum::<f64>() / scatter.len() as f64).sqrt();
+        eprintln!(
+            "{ball}: worst centre error {worst:.3} px, scatter about each shot's offset {rms:.3} px RMS, {n} frames"
+        );
         assert!(n >= 8, "{ball}: only {n} frames checked");
-        assert!(worst < 0.25, "{ball}: worst centre error {worst} px");
+        assert!(worst < absolute, "{ball}: worst centre error {worst} px");
+        assert!(rms < 0.1, "{ball}: the fit scatters {rms} px RMS about its offset");
     }
 }
 
@@ -413,7 +431,8 @@ ball_radius_px = 20
 
 #[test]
 fn a_look_session_gives_each_clip_its_camera_and_no_truth() {
-    let s = Scenario::preset("looks-smoke").unwrap();
+    let text = tiny_look(6, "");
+    let s = Scenario::parse(&text, "tiny-look").unwrap();
     let dir = tempfile::tempdir().unwrap();
     let out = render_to(&s, dir.path(), true);
     let session = std::fs::read_to_string(out.session_dir.join("session.toml")).unwrap();
@@ -427,7 +446,7 @@ fn a_look_session_gives_each_clip_its_camera_and_no_truth() {
         let cam = &ct["camera"];
         assert_eq!(cam["downslope"].as_str(), Some(p.downslope.as_str()));
         assert!([8, 16].contains(&cam["bit_depth"].as_integer().unwrap()));
-        assert_eq!(cam["width_px"].as_integer(), Some(256));
+        assert_eq!(cam["width_px"].as_integer(), Some(176));
     }
     for f in files(&out.session_dir) {
         let text = std::fs::read(out.session_dir.join(&f)).unwrap();
@@ -440,7 +459,7 @@ fn a_look_session_gives_each_clip_its_camera_and_no_truth() {
     }
     let (h, rows) = read_csv(&out.truth_dir.join("looks.csv"));
     assert_eq!(h, LOOK_COLUMNS);
-    assert_eq!(rows.len(), 6);
+    assert_eq!(rows.len(), 3);
 }
 
 #[test]
@@ -551,4 +570,30 @@ fn look_and_random_physics_errors_name_the_field() {
         + "[model]\n[model.effects.spring]\nk = 25650\n[model.effects.damping]\nb = 14\n";
     let e = err(&no_friction);
     assert!(e.contains("random_physics.mu") && e.contains("coulomb"), "{e}");
+}
+
+#[test]
+fn the_example_scenarios_look_and_random_physics_blocks_parse_with_the_defaults() {
+    let text = include_str!("../examples/scenario.toml");
+    // Uncomment the two blocks: every line from `#[look]` / `#[random_physics]` to the next blank line.
+    let mut out = String::new();
+    let mut inside = false;
+    for line in text.lines() {
+        if line.starts_with("#[look]") || line.starts_with("#[random_physics]") {
+            inside = true;
+        } else if line.trim().is_empty() {
+            inside = false;
+        }
+        out += if inside { &line[1..] } else { line };
+        out.push('\n');
+    }
+    let s = Scenario::parse(&out, "examples/scenario.toml (uncommented)").unwrap();
+    assert_eq!(
+        s.look.as_ref(),
+        Some(&LookSpec::default()),
+        "the example shows the defaults"
+    );
+    let rp = s.random_physics.unwrap();
+    assert_eq!(rp.k, Some(Range::new(20000.0, 36000.0)));
+    assert!(ShotPlan::new(&s, 0).unwrap().look.is_some());
 }

@@ -164,7 +164,7 @@ pub fn fit_circle(f: &Frame, cx: f64, cy: f64, r: f64) -> (f64, f64, f64) {
 }
 
 /// A small scenario with a `[look]`: 3 shots (clay, white tape, green tape) at 176 × 176 with a ball of
-/// 14–22 px, 3 ms of flight either side, every clutter item asked for; `extra` holds more `[look]` keys,
+/// 14–22 px, 1 ms of flight either side, every clutter item asked for; `extra` holds more `[look]` keys,
 /// and replaces these defaults where it sets the same key.
 pub fn tiny_look(seed: u64, extra: &str) -> String {
     let defaults = [
@@ -191,8 +191,8 @@ pub fn tiny_look(seed: u64, extra: &str) -> String {
     format!(
         r#"
 seed = {seed}
-pre_contact_ms = 3
-post_separation_ms = 3
+pre_contact_ms = 1
+post_separation_ms = 1
 [surfaces.clay]
 texture = "clay"
 [surfaces.tape1]
