@@ -10,23 +10,12 @@
 
 use crate::look::{BallLook, Item, ItemKind, Look, SurfaceLook};
 use crate::rng::{Rng, ValueNoise};
-use crate::scene::{Shading, hash01, ramp};
+use crate::scene::{Layers, Shading, hash01, ramp};
 use crate::shot::{Geometry, ShotPlan};
 use std::f64::consts::{PI, TAU};
 
 /// Depth of the band's top strip over which its level and texture are normalised, pixels.
 const TOP_STRIP_PX: f64 = 16.0;
-
-/// The static layers of a shot with a look (see `ShotRenderer`): backdrop and band radiance (DN, lighting
-/// applied), the band's coverage, the illumination map (vignetting × gradient) and the ball's light.
-pub(crate) struct LookScene {
-    pub back: Vec<f32>,
-    pub band: Vec<f32>,
-    pub front: Vec<f32>,
-    pub vig: Vec<f32>,
-    pub light: [f64; 3],
-    pub shading: Shading,
-}
 
 /// A rough edge: height above a mean line (pixels, up positive) sampled at every pixel along the surface.
 #[derive(Debug, Clone)]
@@ -457,7 +446,7 @@ fn paint_item(c: &mut Canvas, it: &Item, g: Geometry, look: &Look, light: [f64; 
 }
 
 /// Builds the static layers of a shot with a look.
-pub(crate) fn build(plan: &ShotPlan, look: &Look) -> LookScene {
+pub(crate) fn build(plan: &ShotPlan, look: &Look) -> Layers {
     let cam = &plan.camera;
     let (w, h) = (cam.width as usize, cam.height as usize);
     let (wf, hf) = (w as f64, h as f64);
@@ -672,7 +661,7 @@ pub(crate) fn build(plan: &ShotPlan, look: &Look) -> LookScene {
             }
         }
     }
-    LookScene {
+    Layers {
         back,
         band,
         front,

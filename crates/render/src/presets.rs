@@ -79,8 +79,8 @@ pub fn preset_toml(name: &str) -> Option<String> {
             paper_model_tables()
         )),
         "none" => Some(effect_session("none", None)),
-        "looks" => Some(LOOKS.to_string()),
-        "looks-smoke" => Some(LOOKS_SMOKE.to_string()),
+        "looks" => Some(looks()),
+        "looks-smoke" => Some(looks_smoke()),
         _ => {
             let effect = name.strip_prefix("effect-")?;
             let info = builtin_effects().iter().find(|e| e.name == effect && !e.base)?;
@@ -123,13 +123,24 @@ fn effect_session(name: &str, effect: Option<&str>) -> String {
     )
 }
 
-/// 64 shots (32 on clay, 32 on tape) whose look and physics are drawn per shot: every look family of
-/// `docs/renderer.md`, at 320–512 px.
-const LOOKS: &str = r#"name = "looks"
-description = "64 shots, each with its own look (surface, contrast, lighting, clutter, ball, sensor, geometry) and physics"
-seed = 15
-pre_contact_ms = 8
-post_separation_ms = 8
+/// A session of `repeats` shots on clay and as many on tape (`white_tape` physics) whose look and physics
+/// are drawn per shot from `[random_physics]` (`physics`) and `[look]` (`look`) lines, filmed `flight_ms`
+/// before the touch and after separation.
+fn looks_session(
+    name: &str,
+    description: &str,
+    seed: u64,
+    flight_ms: f64,
+    repeats: u32,
+    physics: &str,
+    look: &str,
+) -> String {
+    format!(
+        r#"name = "{name}"
+description = "{description}"
+seed = {seed}
+pre_contact_ms = {flight_ms}
+post_separation_ms = {flight_ms}
 
 [ball]
 diameter_m = 0.067
@@ -155,57 +166,41 @@ texture = "clay"
 texture = "white_tape"
 
 [random_physics]
-drop_height_m = [0.15, 0.6]
-angle_deg = [0, 25]
-k = [20000, 36000]
-b = [8, 20]
-mu = [0.3, 0.7]
-
+{physics}
 [look]
-width_px = [320, 512]
-height_px = [320, 512]
-
+{look}
 [grid]
 surfaces = ["clay", "tape"]
 drop_heights_m = [0.3]
 angles_deg = [0]
-repeats = 32
-"#;
+repeats = {repeats}
+"#
+    )
+}
 
-/// 6 small shots (3 on clay, 3 on tape) with drawn looks and physics: 256 × 256, a 4-ms flight either
-/// side; renders in about a second, for tests of other crates.
-const LOOKS_SMOKE: &str = r#"name = "looks-smoke"
-description = "6 small shots with drawn looks and physics, for tests"
-seed = 3
-pre_contact_ms = 4
-post_separation_ms = 4
+/// `looks`: 64 shots (32 on clay, 32 on tape), every look family of `docs/renderer.md`, at 320–512 px.
+fn looks() -> String {
+    looks_session(
+        "looks",
+        "64 shots, each with its own look (surface, contrast, lighting, clutter, ball, sensor, geometry) and physics",
+        15,
+        8.0,
+        32,
+        "drop_height_m = [0.15, 0.6]\nangle_deg = [0, 25]\nk = [20000, 36000]\nb = [8, 20]\nmu = [0.3, 0.7]\n",
+        "width_px = [320, 512]\nheight_px = [320, 512]\n",
+    )
+}
 
-[ball]
-diameter_m = 0.067
-mass_kg = 0.0567
-inertia_factor = 0.6666666666666666
-
-[camera]
-fps = 10000
-exposure_s = 5e-5
-
-[surfaces.clay]
-texture = "clay"
-[surfaces.tape]
-texture = "white_tape"
-
-[random_physics]
-drop_height_m = [0.15, 0.35]
-angle_deg = [0, 20]
-
-[look]
-width_px = 256
-height_px = 256
-ball_radius_px = [20, 40]
-
-[grid]
-surfaces = ["clay", "tape"]
-drop_heights_m = [0.3]
-angles_deg = [0]
-repeats = 3
-"#;
+/// `looks-smoke`: 6 small shots (3 on clay, 3 on tape) with drawn looks and physics, 256 × 256, a 4-ms
+/// flight either side; renders in a few seconds, for tests of other crates.
+fn looks_smoke() -> String {
+    looks_session(
+        "looks-smoke",
+        "6 small shots with drawn looks and physics, for tests",
+        3,
+        4.0,
+        3,
+        "drop_height_m = [0.15, 0.35]\nangle_deg = [0, 20]\n",
+        "width_px = 256\nheight_px = 256\nball_radius_px = [20, 40]\n",
+    )
+}

@@ -77,6 +77,18 @@ impl Shading {
     };
 }
 
+/// The static layers of a shot: backdrop and band radiance (DN, lighting applied), the band's coverage
+/// (0–1, in front of the ball), the illumination map (vignetting and gradient) and the ball's light and
+/// shading.
+pub(crate) struct Layers {
+    pub back: Vec<f32>,
+    pub band: Vec<f32>,
+    pub front: Vec<f32>,
+    pub vig: Vec<f32>,
+    pub light: [f64; 3],
+    pub shading: Shading,
+}
+
 /// Makes the frames of one shot.
 #[derive(Debug)]
 pub struct ShotRenderer<'a> {
@@ -261,29 +273,22 @@ impl<'a> ShotRenderer<'a> {
                 }
             }
         }
-        let mut r = ShotRenderer {
-            plan,
-            w,
-            h,
-            back,
-            band,
-            front,
-            stat: Vec::new(),
-            vig,
-            albedo: Vec::new(),
-            amap: 0,
-            acen: 0.0,
-            fuzz: Vec::new(),
-            fuzz_max: 0.0,
-            sigma: Vec::new(),
-            fpn: fixed_pattern(cam, plan.session_seed),
-            light: {
-                let l = LIGHT;
-                let n = (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt();
-                [l[0] / n, l[1] / n, l[2] / n]
-            },
-            shading: Shading::CLASSIC,
+        let light = {
+            let l = LIGHT;
+            let n = (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt();
+            [l[0] / n, l[1] / n, l[2] / n]
         };
+        let mut r = ShotRenderer::assemble(
+            plan,
+            Layers {
+                back,
+                band,
+                front,
+                vig,
+                light,
+                shading: Shading::CLASSIC,
+            },
+        );
         r.distractors(&mut rng);
         r.finish(&mut rng, BALL_ALBEDO, true);
         r
@@ -291,17 +296,24 @@ impl<'a> ShotRenderer<'a> {
 
     /// The static images of a shot with a look (`appearance.rs`).
     fn with_look(plan: &'a ShotPlan, look: &crate::Look, mut rng: Rng) -> ShotRenderer<'a> {
+        let mut r = ShotRenderer::assemble(plan, crate::appearance::build(plan, look));
+        r.finish(&mut rng, look.ball_dn, look.ball == crate::BallLook::FeltSeam);
+        r
+    }
+
+    /// A renderer over the static layers, with the session's fixed pattern; the ball's texture and the
+    /// noise table come from [`ShotRenderer::finish`].
+    fn assemble(plan: &'a ShotPlan, l: Layers) -> ShotRenderer<'a> {
         let cam = &plan.camera;
-        let scene = crate::appearance::build(plan, look);
-        let mut r = ShotRenderer {
+        ShotRenderer {
             plan,
             w: cam.width as usize,
             h: cam.height as usize,
-            back: scene.back,
-            band: scene.band,
-            front: scene.front,
+            back: l.back,
+            band: l.band,
+            front: l.front,
             stat: Vec::new(),
-            vig: scene.vig,
+            vig: l.vig,
             albedo: Vec::new(),
             amap: 0,
             acen: 0.0,
@@ -309,11 +321,9 @@ impl<'a> ShotRenderer<'a> {
             fuzz_max: 0.0,
             sigma: Vec::new(),
             fpn: fixed_pattern(cam, plan.session_seed),
-            light: scene.light,
-            shading: scene.shading,
-        };
-        r.finish(&mut rng, look.ball_dn, look.ball == crate::BallLook::FeltSeam);
-        r
+            light: l.light,
+            shading: l.shading,
+        }
     }
 
     /// The composited static frame, the ball's texture (albedo `albedo` DN, with or without its seam) and

@@ -9,45 +9,12 @@ use bouncelab_render::*;
 use std::collections::BTreeSet;
 use testutil::*;
 
-fn render_to(s: &Scenario, dir: &std::path::Path, parallel: bool) -> Rendered {
-    let opts = RenderOptions {
-        parallel,
-        overwrite: false,
-    };
-    render_with(s, dir, &opts, &Silent).unwrap()
-}
-
 #[test]
 fn looks_are_byte_identical_for_a_seed_and_parallel_equals_sequential() {
     let text = tiny_look(11, "");
     let s = Scenario::parse(&text, "tiny-look").unwrap();
-    let (a, b, c) = (
-        tempfile::tempdir().unwrap(),
-        tempfile::tempdir().unwrap(),
-        tempfile::tempdir().unwrap(),
-    );
-    render_to(&s, a.path(), false);
-    render_to(&s, b.path(), false);
-    render_to(&s, c.path(), true);
-    let fa = files(a.path());
-    assert_eq!(fa, files(b.path()));
-    assert_eq!(fa, files(c.path()));
-    assert!(fa.len() > 60, "{} files", fa.len());
-    for f in &fa {
-        let x = std::fs::read(a.path().join(f)).unwrap();
-        assert_eq!(
-            x,
-            std::fs::read(b.path().join(f)).unwrap(),
-            "{} differs between runs",
-            f.display()
-        );
-        assert_eq!(
-            x,
-            std::fs::read(c.path().join(f)).unwrap(),
-            "{} differs in parallel",
-            f.display()
-        );
-    }
+    let n = assert_renders_identically(&s);
+    assert!(n > 60, "{n} files");
     // Another seed draws other looks.
     let mut s2 = s.clone();
     s2.seed = 12;

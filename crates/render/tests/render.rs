@@ -6,44 +6,11 @@ use bouncelab_model::{Phase, SimOptions, simulate_drop};
 use bouncelab_render::*;
 use testutil::*;
 
-fn render_to(s: &Scenario, dir: &std::path::Path, parallel: bool) -> Rendered {
-    let opts = RenderOptions {
-        parallel,
-        overwrite: false,
-    };
-    render_with(s, dir, &opts, &Silent).unwrap()
-}
-
 #[test]
 fn same_seed_is_byte_identical_and_parallel_equals_sequential() {
     let s = Scenario::parse(&tiny(7), "tiny").unwrap();
-    let (a, b, c) = (
-        tempfile::tempdir().unwrap(),
-        tempfile::tempdir().unwrap(),
-        tempfile::tempdir().unwrap(),
-    );
-    render_to(&s, a.path(), false);
-    render_to(&s, b.path(), false);
-    render_to(&s, c.path(), true);
-    let fa = files(a.path());
-    assert_eq!(fa, files(b.path()));
-    assert_eq!(fa, files(c.path()));
-    assert!(fa.len() > 50);
-    for f in &fa {
-        let x = std::fs::read(a.path().join(f)).unwrap();
-        assert_eq!(
-            x,
-            std::fs::read(b.path().join(f)).unwrap(),
-            "{} differs between runs",
-            f.display()
-        );
-        assert_eq!(
-            x,
-            std::fs::read(c.path().join(f)).unwrap(),
-            "{} differs sequential vs parallel",
-            f.display()
-        );
-    }
+    let n = assert_renders_identically(&s);
+    assert!(n > 50, "{n} files");
 }
 
 #[test]

@@ -2,7 +2,7 @@
 
 #![allow(dead_code)]
 
-use bouncelab_render::Frame;
+use bouncelab_render::{Frame, RenderOptions, Rendered, Scenario, Silent, render_with};
 use std::path::{Path, PathBuf};
 
 /// A tiny two-shot scenario: 160×160 frames, ball ≈ 42 px across, 2 ms before touch and after separation.
@@ -217,4 +217,35 @@ drop_height_m = 0.2
 "#,
         look.join("\n")
     )
+}
+
+/// Renders `s` into a fresh folder, in parallel or not, refusing to overwrite.
+pub fn render_to(s: &Scenario, dir: &Path, parallel: bool) -> Rendered {
+    let opts = RenderOptions {
+        parallel,
+        overwrite: false,
+    };
+    render_with(s, dir, &opts, &Silent).unwrap()
+}
+
+/// Renders `s` twice sequentially and once in parallel and asserts the three folders are byte-identical;
+/// returns how many files each holds.
+pub fn assert_renders_identically(s: &Scenario) -> usize {
+    let dirs = [(); 3].map(|_| tempfile::tempdir().unwrap());
+    for (d, parallel) in dirs.iter().zip([false, false, true]) {
+        render_to(s, d.path(), parallel);
+    }
+    let fa = files(dirs[0].path());
+    for (d, what) in [(&dirs[1], "between runs"), (&dirs[2], "sequential vs parallel")] {
+        assert_eq!(fa, files(d.path()), "the files differ {what}");
+        for f in &fa {
+            let x = std::fs::read(dirs[0].path().join(f)).unwrap();
+            assert!(
+                x == std::fs::read(d.path().join(f)).unwrap(),
+                "{} differs {what}",
+                f.display()
+            );
+        }
+    }
+    fa.len()
 }
