@@ -7,7 +7,9 @@
 //! times (motion blur), so the truth is the model's own output. The main design choice is that the
 //! expensive image work is split into a static background made once per shot and a per-frame pass that
 //! only shades the ball's bounding box, with every random stream derived from (seed, shot, frame): frames
-//! can be rendered in any order, in parallel, and come out byte-identical.
+//! can be rendered in any order, in parallel, and come out byte-identical. A scenario's `[look]` draws each
+//! shot's appearance and camera from wide ranges (`docs/renderer.md`, "Looks"), so the pipeline is tested
+//! on many looks, not on this renderer's one.
 
 mod appearance;
 mod error;

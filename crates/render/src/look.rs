@@ -48,6 +48,11 @@ impl Range {
         }
     }
 
+    /// A value drawn uniformly and rounded to a whole number within the interval (which must hold one).
+    pub(crate) fn draw_whole(&self, rng: &mut Rng) -> u32 {
+        self.draw(rng).round().clamp(self.lo.ceil(), self.hi.floor()).max(0.0) as u32
+    }
+
     /// True if `x` lies in the interval (with a relative tolerance of 1e-9 for values written to text).
     pub fn contains(&self, x: f64) -> bool {
         let tol = 1e-9 * (1.0 + self.lo.abs().max(self.hi.abs()));
@@ -485,13 +490,19 @@ pub(crate) struct Draft {
     pub tape_depth_frac: f64,
     /// Tape on clay: strip ends beyond the contact, in ball radii (left, right).
     pub tape_margins: (f64, f64),
-    /// Counts and choices drawn before placement.
+    /// Hot spots to place.
     pub hot_spots: u32,
+    /// A ruler to place.
     pub ruler: bool,
+    /// Fixtures to place.
     pub fixtures: u32,
+    /// Screws to place.
     pub screws: u32,
+    /// The range screw radii are drawn from at placement, pixels.
     pub screw_radius: Range,
+    /// A second ball-sized circle to place.
     pub second_circle: bool,
+    /// A hand to place.
     pub hand: bool,
     /// Tape on clay: the strip's ends along the surface, pixels from the line's origin.
     pub tape_s: (f64, f64),
@@ -571,6 +582,11 @@ impl LookSpec {
                     r.to_string(),
                     &format!("must lie within {min} to {max} {unit}"),
                 ));
+            }
+        }
+        for (name, r) in [("width_px", self.width_px), ("height_px", self.height_px)] {
+            if r.lo.ceil() > r.hi.floor() {
+                return Err(bad(name, r.to_string(), "must hold a whole number of pixels"));
             }
         }
         for (name, p) in [
@@ -668,8 +684,8 @@ impl LookSpec {
         let downslope = pick(rng, &self.downslopes);
         let roll_deg = self.roll_deg.draw(rng);
         let ball_radius_px = self.ball_radius_px.draw(rng);
-        let width_px = self.width_px.draw(rng).round() as u32;
-        let height_px = self.height_px.draw(rng).round() as u32;
+        let width_px = self.width_px.draw_whole(rng);
+        let height_px = self.height_px.draw_whole(rng);
         let draft = Draft {
             seed: rng.next_u64(),
             foreshortening: rng.range(1.2, 2.5),
@@ -1249,5 +1265,66 @@ impl Look {
             self.height_px.to_string(),
             serde_json::Value::Array(items).to_string(),
         ]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::{any, prop_assert, proptest};
+
+    proptest! {
+        /// Whatever valid ranges a `[look]` gives, every drawn value lies in its range, and the band stays
+        /// within the gray levels given to textured surfaces.
+        #[test]
+        fn drawn_values_lie_in_their_ranges(
+            seed in any::<u64>(), a in 0.0f64..1.0, b in 0.0f64..1.0, clay in any::<bool>()
+        ) {
+            let r = |lo: f64, hi: f64| Range::new(lo + (hi - lo) * a.min(b), lo + (hi - lo) * a.max(b));
+            let spec = LookSpec {
+                backdrop_dn: r(LEVEL_MIN, LEVEL_MAX),
+                band_offset_dn: r(-80.0, 80.0),
+                texture_dn: r(0.0, 40.0),
+                lip_dn: r(-30.0, 30.0),
+                edge_roughness_px: r(0.0, 10.0),
+                grain_px: r(0.5, 10.0),
+                read_noise_dn: r(0.0, 30.0),
+                roll_deg: r(-10.0, 10.0),
+                ball_radius_px: r(5.0, 200.0),
+                width_px: Range::new(64.0 + 900.0 * a.min(b), 65.0 + 900.0 * a.max(b)),
+                height_px: Range::new(64.0 + 900.0 * a.min(b), 65.0 + 900.0 * a.max(b)),
+                screws: r(0.0, 6.0),
+                ..LookSpec::default()
+            };
+            spec.check("test").unwrap();
+            let l = spec.draw(&mut Rng::new(seed), if clay { Texture::Clay } else { Texture::WhiteTape });
+            let backdrop = if l.ball == BallLook::Backlit { spec.backlit_backdrop_dn } else { spec.backdrop_dn };
+            prop_assert!(backdrop.contains(l.backdrop_dn));
+            prop_assert!((LEVEL_MIN - 1e-9..=LEVEL_MAX + 1e-9).contains(&l.band_dn));
+            let feasible = Range::new(
+                spec.band_offset_dn.lo.max(LEVEL_MIN - l.backdrop_dn),
+                spec.band_offset_dn.hi.min(LEVEL_MAX - l.backdrop_dn),
+            );
+            if feasible.lo <= feasible.hi {
+                prop_assert!(spec.band_offset_dn.contains(l.band_dn - l.backdrop_dn));
+            }
+            prop_assert!(spec.texture_dn.contains(l.texture_dn) && spec.lip_dn.contains(l.lip_dn));
+            prop_assert!(l.edge_roughness_px.is_none_or(|x| spec.edge_roughness_px.contains(x)));
+            prop_assert!(l.grain_px.is_none_or(|x| spec.grain_px.contains(x)));
+            prop_assert!(spec.read_noise_dn.contains(l.read_noise_dn) && spec.roll_deg.contains(l.roll_deg));
+            prop_assert!(spec.ball_radius_px.contains(l.ball_radius_px));
+            prop_assert!(spec.width_px.contains(l.width_px as f64) && spec.height_px.contains(l.height_px as f64));
+            prop_assert!((l.draft.screws as f64) >= spec.screws.lo.ceil() && (l.draft.screws as f64) <= spec.screws.hi.floor().max(spec.screws.lo.ceil()));
+            prop_assert!(l.grain_px.is_some() == (clay || l.surface == SurfaceLook::TapeOnClay));
+        }
+    }
+
+    #[test]
+    fn counts_are_whole_numbers_of_the_range() {
+        let mut rng = Rng::new(1);
+        let seen: std::collections::BTreeSet<u32> =
+            (0..400).map(|_| Range::new(0.5, 3.0).draw_count(&mut rng)).collect();
+        assert_eq!(seen.into_iter().collect::<Vec<_>>(), vec![1, 2, 3]);
+        assert_eq!(Range::new(2.0, 2.0).draw_count(&mut rng), 2);
     }
 }

@@ -518,12 +518,17 @@ fn look_and_random_physics_errors_name_the_field() {
     assert!(e.contains("look.bit_depths") && e.contains("10"), "{e}");
     let e = look("naming = [\"frame\"]");
     assert!(e.contains("look.naming") && e.contains("placeholder"), "{e}");
+    let e = look("width_px = [300.2, 300.8]");
+    assert!(e.contains("look.width_px") && e.contains("whole number"), "{e}");
     let e = look("hand = 1.5");
     assert!(e.contains("look.hand") && e.contains("probability"), "{e}");
     let e = look("balls = []");
     assert!(e.contains("look.balls") && e.contains("at least one"), "{e}");
     let e = look("width_px = \"wide\"");
-    assert!(e.contains("width_px") || e.contains("[low, high]"), "{e}");
+    assert!(
+        e.contains("line ") && e.contains("width_px") && e.contains("[low, high]"),
+        "{e}"
+    );
     let rp = |table: &str| err(&tiny(1).replacen("[[shots]]", &format!("[random_physics]\n{table}\n\n[[shots]]"), 1));
     let e = rp("angle_deg = [0, 80]");
     assert!(e.contains("random_physics.angle_deg") && e.contains("±60"), "{e}");
