@@ -546,14 +546,16 @@ fn contact_line(
                     no_impact,
                 });
             }
-            if let Some(alt) = track.surface_alternative {
+            for alt in track.surface_alternatives.iter().copied() {
                 let ma = relative(tc, &alt);
                 if agrees(&ma, &alt) {
                     notes.push(format!(
-                        "the {} cue's line is {:.1} px from where the ball lands; the {} cue's line, which agrees with the trajectory, is used",
+                        "the first surface line found ({} cue, y = {:.1} px) is {:.1} px from where the ball lands; a lower line ({} cue, y = {:.1} px), which agrees with the ball's trajectory, is used",
                         line.cue.name(),
+                        line.y0,
                         m.value,
-                        alt.cue.name()
+                        alt.cue.name(),
+                        alt.y0
                     ));
                     return Ok(ContactChoice {
                         line: alt,

@@ -61,7 +61,7 @@ fn shot(model: &Model, incline_deg: f64, drop_m: f64, after: f64, seed: u64) -> 
         })
         .collect();
     let track = Track {
-        surface_alternative: None,
+        surface_alternatives: Vec::new(),
         fixes,
         surface: Some(SurfaceLine {
             x0: 255.5,
@@ -183,7 +183,7 @@ fn a_clip_ending_close_to_the_impact_is_refused_with_a_reason() {
     let (track, truth) = shot(&model, 0.0, 0.3, 0.0, 3);
     let cut = truth.t_separation + 3e-4;
     let track = Track {
-        surface_alternative: None,
+        surface_alternatives: Vec::new(),
         fixes: track.fixes.into_iter().filter(|f| f.t_s <= cut).collect(),
         ..track
     };

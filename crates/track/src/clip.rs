@@ -113,9 +113,9 @@ pub struct Track {
     pub fixes: Vec<BallFix>,
     /// The surface line: found by one of its cues, or given by the user; `None` when neither.
     pub surface: Option<SurfaceLine>,
-    /// The other cue's line where the cues found different ones (the estimator chooses by the ball's
+    /// The other candidate lines below the ball, topmost first (the estimator chooses by the ball's
     /// trajectory).
-    pub surface_alternative: Option<SurfaceLine>,
+    pub surface_alternatives: Vec<SurfaceLine>,
     /// The scale, if the ball was measured in free flight.
     pub scale: Option<Scale>,
     /// Things a person should know, each naming its frame.
@@ -402,7 +402,7 @@ pub fn track_clip(
     Ok(Track {
         fixes,
         surface: tracker.surface().copied(),
-        surface_alternative: tracker.surface_alternative().copied(),
+        surface_alternatives: tracker.surface_alternatives().to_vec(),
         scale,
         warnings,
         seconds_waiting: waiting,

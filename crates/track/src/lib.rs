@@ -29,7 +29,7 @@ pub use hough::{Circle, CircleDetection, detect_circles, outermost, radius_bands
 pub use plane::{Pixel, Plane};
 pub use refine::{EdgeSearch, Refined, RimShape, RimShapeLearner, refine_circle, refined_candidates, rim_residuals};
 pub use surface::{LineCue, SurfaceLine, SurfaceLines, find_surface_line, find_surface_lines};
-pub use texture::{horizontal_gradient_energy, texture_line};
+pub use texture::{horizontal_gradient_energy, texture_line, texture_lines};
 pub use tracker::{BallFix, Status, TrackOptions, Tracker};
 
 #[doc(hidden)]

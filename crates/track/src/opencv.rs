@@ -397,7 +397,7 @@ pub fn track_clip_opencv(
     Ok(Track {
         fixes,
         surface,
-        surface_alternative: None,
+        surface_alternatives: Vec::new(),
         scale,
         warnings,
         seconds_waiting: waiting,

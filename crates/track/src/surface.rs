@@ -115,14 +115,14 @@ impl SurfaceLine {
     }
 }
 
-/// The surface line and, when the cues disagree, the other candidate.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// The surface line chosen and the other candidates.
+#[derive(Debug, Clone, PartialEq)]
 pub struct SurfaceLines {
-    /// The line taken: the band's top by the cue that found it highest.
+    /// The line taken: the topmost candidate (below the ball, when its position is known).
     pub line: SurfaceLine,
-    /// The other cue's line when it lies more than the edges' roughness away: a later stage may prefer it
-    /// if the ball's trajectory says the contact is there.
-    pub alternative: Option<SurfaceLine>,
+    /// The other candidates below it, topmost first: a later stage may prefer one if the ball's trajectory
+    /// says the contact is there.
+    pub alternatives: Vec<SurfaceLine>,
 }
 
 /// Column stride, px.
@@ -135,56 +135,61 @@ const MAX_SLOPE: f64 = 0.18;
 /// Finds the surface line, or `None` if no long near-horizontal edge crosses the image (see
 /// [`find_surface_lines`], whose chosen line this is).
 pub fn find_surface_line<P: Pixel>(img: &Plane<P>) -> Option<SurfaceLine> {
-    find_surface_lines(img).map(|l| l.line)
+    find_surface_lines(img, None).map(|l| l.line)
 }
 
-/// Finds the band's top by both cues and chooses (see the module's description). Cost ≈ 3 ms for 512×512.
-pub fn find_surface_lines<P: Pixel>(img: &Plane<P>) -> Option<SurfaceLines> {
-    let step = brightness_line(img);
-    let texture = crate::texture::texture_line(img);
-    choose(step, texture)
-}
-
-/// The brightness line where both cues see the same edge, else the topmost with the other as alternative.
-fn choose(step: Option<SurfaceLine>, texture: Option<SurfaceLine>) -> Option<SurfaceLines> {
-    match (step, texture) {
-        (Some(s), Some(t)) => {
-            let xc = s.x0;
-            let tol = 3.0 + 2.0 * t.roughness_px.max(s.roughness_px);
-            let gap = s.y_at(xc) - t.y_at(xc);
-            if gap.abs() <= tol {
-                Some(SurfaceLines {
-                    line: SurfaceLine {
-                        roughness_px: s.roughness_px.max(t.roughness_px),
-                        ..s
-                    },
-                    alternative: None,
-                })
-            } else if gap < 0.0 {
-                Some(SurfaceLines {
-                    line: s,
-                    alternative: Some(t),
-                })
-            } else {
-                Some(SurfaceLines {
-                    line: t,
-                    alternative: Some(s),
-                })
-            }
-        }
-        (Some(line), None) | (None, Some(line)) => Some(SurfaceLines {
-            line,
-            alternative: None,
-        }),
-        (None, None) => None,
+/// Finds the band's top by both cues (see the module's description): every candidate line, the topmost taken.
+/// With the ball's position `(x, y, r)` px known, a line the ball's centre is not at least half a radius above
+/// is not the surface (a ruler, a fixture's edge or a shadow crossing the frame above the ball) and is left
+/// out. Cost ≈ 3 ms for 512×512.
+pub fn find_surface_lines<P: Pixel>(img: &Plane<P>, ball: Option<(f64, f64, f64)>) -> Option<SurfaceLines> {
+    let step = brightness_lines(img);
+    let texture = crate::texture::texture_lines(img);
+    let mut candidates: Vec<SurfaceLine> = merge_cues(step, texture)
+        .into_iter()
+        .filter(|l| ball.is_none_or(|(x, y, r)| l.height_of(x, y) >= 0.5 * r))
+        .collect();
+    if candidates.is_empty() {
+        return None;
     }
+    let line = candidates.remove(0);
+    Some(SurfaceLines {
+        line,
+        alternatives: candidates,
+    })
 }
 
-/// The line of the strongest brightness steps (the brightness cue), or `None`.
-fn brightness_line<P: Pixel>(img: &Plane<P>) -> Option<SurfaceLine> {
+/// One list of candidates from both cues, topmost first: where a brightness line and a texture line see the
+/// same edge (within 3 px plus twice the roughness) the brightness line is kept (it is the sharper), with the
+/// larger roughness of the two.
+fn merge_cues(step: Vec<SurfaceLine>, texture: Vec<SurfaceLine>) -> Vec<SurfaceLine> {
+    let mut used = vec![false; texture.len()];
+    let mut out: Vec<SurfaceLine> = Vec::new();
+    for s in step {
+        let twin = texture.iter().enumerate().find(|(i, t)| {
+            !used[*i] && (s.y_at(s.x0) - t.y_at(s.x0)).abs() <= 3.0 + 2.0 * t.roughness_px.max(s.roughness_px)
+        });
+        match twin {
+            Some((i, t)) => {
+                used[i] = true;
+                out.push(SurfaceLine {
+                    roughness_px: s.roughness_px.max(t.roughness_px),
+                    ..s
+                });
+            }
+            None => out.push(s),
+        }
+    }
+    out.extend(texture.into_iter().zip(used).filter(|(_, u)| !u).map(|(t, _)| t));
+    out.sort_by(|a, b| a.y_at(a.x0).total_cmp(&b.y_at(b.x0)));
+    out
+}
+
+/// The lines of the strongest brightness steps (the brightness cue), topmost first.
+fn brightness_lines<P: Pixel>(img: &Plane<P>) -> Vec<SurfaceLine> {
     let (w, h) = (img.width, img.height);
     if w < 16 || h < 16 {
-        return None;
+        return Vec::new();
     }
     // Per sampled column: the strongest edges (position with sub-pixel offset, strength).
     let mut cands: Vec<(f64, f64, f64)> = Vec::new(); // (x, y, strength)
@@ -217,26 +222,27 @@ fn brightness_line<P: Pixel>(img: &Plane<P>) -> Option<SurfaceLine> {
             leans.push(edge - smoothed_edge(&d, y));
         }
     }
-    line_through(&cands, &leans, cols.len(), w, 1.5, 0.0)
+    lines_through(&cands, &leans, cols.len(), w, 1.5, 0.0)
 }
 
-/// The topmost well-supported, strong line through per-column edge candidates `(x, y, strength)` (in
-/// column order): RANSAC over pairs from distant columns (deterministic sampling), lines within `tol` px
-/// of at least half of the `columns` sampled, strong = mean strength at least 0.3 × the strongest such
-/// line's and at least `min_strength`; then least squares on its inliers. `leans[i]` is candidate i's edge
-/// definition (see [`SurfaceLine::edge_definition_px`]).
-pub(crate) fn line_through(
+/// The well-supported, strong lines through per-column edge candidates `(x, y, strength)` (in column
+/// order), topmost first: RANSAC over pairs from distant columns (deterministic sampling), lines within `tol`
+/// px of at least half of the `columns` sampled (and 0.7 × the best line's support), strong = mean strength
+/// at least 0.3 × the strongest such line's and at least `min_strength`; lines closer than 2 × `tol` to a
+/// higher one are the same line; each refined by least squares on its inliers. `leans[i]` is candidate i's
+/// edge definition (see [`SurfaceLine::edge_definition_px`]).
+pub(crate) fn lines_through(
     cands: &[(f64, f64, f64)],
     leans: &[f64],
     columns: usize,
     w: usize,
     tol: f64,
     min_strength: f64,
-) -> Option<SurfaceLine> {
+) -> Vec<SurfaceLine> {
     let mut lines: Vec<(f64, f64, f64, f64)> = Vec::new(); // (support, y at x=0, slope, mean strength)
     let n = cands.len();
     if n < 8 {
-        return None;
+        return Vec::new();
     }
     let mut state = 0x9E3779B97F4A7C15u64;
     let mut next = |m: usize| {
@@ -261,7 +267,7 @@ pub(crate) fn line_through(
     }
     let best = lines.iter().map(|l| l.0).fold(0.0, f64::max);
     if best < 0.5 * columns as f64 {
-        return None;
+        return Vec::new();
     }
     // A line must also be strong: the 8-bit steps of a smooth backdrop gradient are perfectly straight and
     // consistent across columns, but weak.
@@ -270,14 +276,29 @@ pub(crate) fn line_through(
         .filter(|l| l.0 >= 0.7 * best)
         .map(|l| l.3)
         .fold(0.0, f64::max);
-    // The topmost of the well-supported, strong lines (y smallest at the centre).
     let xc = (w as f64 - 1.0) / 2.0;
-    let (_, c, slope, _) = lines
-        .iter()
+    let mut good: Vec<(f64, f64, f64, f64)> = lines
+        .into_iter()
         .filter(|l| l.0 >= 0.7 * best && l.3 >= 0.3 * strongest && l.3 >= min_strength)
-        .min_by(|a, b| (a.1 + a.2 * xc).total_cmp(&(b.1 + b.2 * xc)))
-        .copied()?;
-    refine_line(cands, leans, c, slope, tol, xc)
+        .collect();
+    // Topmost first (y smallest at the centre).
+    good.sort_by(|a, b| (a.1 + a.2 * xc).total_cmp(&(b.1 + b.2 * xc)));
+    let wf = w as f64;
+    let mut kept: Vec<(f64, f64)> = Vec::new();
+    let mut out: Vec<SurfaceLine> = Vec::new();
+    for (_, c, slope, _) in good {
+        let same = |k: &(f64, f64)| (k.0 - c).abs() <= 2.0 * tol && (k.0 + k.1 * wf - c - slope * wf).abs() <= 2.0 * tol;
+        if kept.iter().any(same) {
+            continue;
+        }
+        kept.push((c, slope));
+        if let Some(line) = refine_line(cands, leans, c, slope, tol, xc)
+            && !out.iter().any(|o| (o.y0 - line.y0).abs() <= tol && (o.slope - line.slope).abs() * wf <= tol)
+        {
+            out.push(line);
+        }
+    }
+    out
 }
 
 /// The edge at the smoothed derivative `d`'s peak row `y`, to a fraction of a row: a parabola through

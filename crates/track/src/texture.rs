@@ -11,7 +11,7 @@
 //! filter passes over the frame).
 
 use crate::plane::{Pixel, Plane};
-use crate::surface::{LineCue, SurfaceLine, line_through};
+use crate::surface::{LineCue, SurfaceLine, lines_through};
 use imageproc::image::{ImageBuffer, Luma};
 
 /// Column stride, px.
@@ -47,13 +47,18 @@ pub fn horizontal_gradient_energy<P: Pixel>(img: &Plane<P>) -> Vec<f32> {
     energy.into_raw()
 }
 
-/// The band's top by the texture cue, or `None` when no long near-horizontal change of texture crosses the
-/// image. The line's `edge_definition_px` is twice its roughness: on a ragged band the plane the ball
-/// rests on lies somewhere between the edge's mean and its highest grains.
+/// The topmost line of the texture cue (see [`texture_lines`]), or `None`.
 pub fn texture_line<P: Pixel>(img: &Plane<P>) -> Option<SurfaceLine> {
+    texture_lines(img).into_iter().next()
+}
+
+/// The long near-horizontal changes of texture across the image, topmost first. Each line's
+/// `edge_definition_px` is twice its roughness: on a ragged band the plane the ball rests on lies somewhere
+/// between the edge's mean and its highest grains.
+pub fn texture_lines<P: Pixel>(img: &Plane<P>) -> Vec<SurfaceLine> {
     let (w, h) = (img.width, img.height);
     if w < 4 * HALF_BOX || h < 4 * STEP_ROWS + 8 {
-        return None;
+        return Vec::new();
     }
     let energy = horizontal_gradient_energy(img);
     let cols: Vec<usize> = (HALF_BOX + 1..w - HALF_BOX - 1).step_by(STRIDE).collect();
@@ -70,12 +75,14 @@ pub fn texture_line<P: Pixel>(img: &Plane<P>) -> Option<SurfaceLine> {
         }
     }
     let leans = vec![0.0; cands.len()];
-    let line = line_through(&cands, &leans, cols.len(), w, TOLERANCE_PX, MIN_STRENGTH)?;
-    Some(SurfaceLine {
-        edge_definition_px: 2.0 * line.roughness_px,
-        cue: LineCue::Texture,
-        ..line
-    })
+    lines_through(&cands, &leans, cols.len(), w, TOLERANCE_PX, MIN_STRENGTH)
+        .into_iter()
+        .map(|line| SurfaceLine {
+            edge_definition_px: 2.0 * line.roughness_px,
+            cue: LineCue::Texture,
+            ..line
+        })
+        .collect()
 }
 
 /// The strongest steps of a column's log-energy profile: `(row, strength)`, the edge lying between `row` and

@@ -122,8 +122,8 @@ pub struct Tracker {
     /// is being learned (its residuals teach the shape without a second search); empty otherwise.
     rim_rays: Vec<(usize, [f64; 2])>,
     surface: Option<SurfaceLine>,
-    /// The other cue's line, where the two cues disagreed (see [`crate::SurfaceLines`]).
-    surface_alternative: Option<SurfaceLine>,
+    /// The other candidate lines below the ball (see [`crate::SurfaceLines`]).
+    surface_alternatives: Vec<SurfaceLine>,
     surface_tries: usize,
     warnings: Vec<String>,
     /// Distance between the last prediction and its measurement, px.
@@ -161,7 +161,7 @@ impl Tracker {
             rim_frozen: false,
             rim_rays: Vec::new(),
             surface: None,
-            surface_alternative: None,
+            surface_alternatives: Vec::new(),
             surface_tries: 0,
             warnings: Vec::new(),
             last_innovation: 0.0,
@@ -185,9 +185,9 @@ impl Tracker {
         self.surface.as_ref()
     }
 
-    /// The other cue's line, where the brightness and texture cues found different lines.
-    pub fn surface_alternative(&self) -> Option<&SurfaceLine> {
-        self.surface_alternative.as_ref()
+    /// The other candidate lines below the ball, topmost first.
+    pub fn surface_alternatives(&self) -> &[SurfaceLine] {
+        &self.surface_alternatives
     }
 
     /// Things a person should know (a second ball, a lost track), each naming its frame.
@@ -250,9 +250,11 @@ impl Tracker {
     pub fn observe<P: Pixel>(&mut self, frame: usize, t_s: f64, img: &Plane<P>) -> BallFix {
         if self.surface.is_none() && self.surface_tries < 5 {
             self.surface_tries += 1;
-            if let Some(lines) = find_surface_lines(img) {
+            // Where the ball is expected, a line above it is not the surface.
+            let ball = self.predict(t_s).zip(self.expected_radius()).map(|((x, y), r)| (x, y, r));
+            if let Some(lines) = find_surface_lines(img, ball) {
                 self.surface = Some(lines.line);
-                self.surface_alternative = lines.alternative;
+                self.surface_alternatives = lines.alternatives;
             }
         }
         // 1. Around the prediction.
