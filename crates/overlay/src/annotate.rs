@@ -21,7 +21,7 @@ pub struct Style {
     pub stroke_px: f64,
     /// Opacity of the strokes (0–1). Default 0.9.
     pub opacity: f32,
-    /// Half-length of the centre cross's arms, canvas px. Default 5.
+    /// Half-length of the centre cross's arms, canvas px. Default 6.
     pub cross_px: f64,
     /// Length of the dashes of a circle fitted to part of the rim (occluded, cut by the border), canvas px.
     /// Default 6.
@@ -37,7 +37,7 @@ impl Default for Style {
             levels: Levels::FULL,
             stroke_px: 1.25,
             opacity: 0.9,
-            cross_px: 5.0,
+            cross_px: 6.0,
             dash_px: 6.0,
             font_scale: None,
         }

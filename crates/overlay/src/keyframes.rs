@@ -104,11 +104,13 @@ impl KeyFrames {
     }
 }
 
-/// How contact is told from the trajectory: the same rule as the estimate's (`docs/overlay.md`).
+/// How contact is told from the trajectory (`docs/overlay.md`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ContactRule {
     /// A frame is in contact when the ball's lowest point (centre + radius) is within this of the surface
-    /// line, px. Default 1.0, the estimate's margin.
+    /// line or below it, px. Default 0: the ball reaches the line. (The estimate uses 1 px to keep frames
+    /// near the surface out of its flight fits, so its contact phase starts a few frames earlier; on the
+    /// rendered `smoke` clips margin 0 puts touch and separation within one frame of the truth.)
     pub margin_px: f64,
     /// The ball's radius, px (the clip's flight radius, e.g. the scale's `radius_px`); `None` takes the
     /// median radius of the frames measured with status `ok`.
@@ -118,7 +120,7 @@ pub struct ContactRule {
 impl Default for ContactRule {
     fn default() -> Self {
         ContactRule {
-            margin_px: 1.0,
+            margin_px: 0.0,
             radius_px: None,
         }
     }
@@ -149,8 +151,8 @@ fn median(mut v: Vec<f64>) -> Option<f64> {
 
 /// The shot's phases from its trajectory and surface line: the contact is the run of frames around the one
 /// whose ball comes closest to the line (its clearance `line − (y + R)` smallest) while that clearance stays
-/// within `rule.margin_px`; the flights are the frames either side. This is the estimate's rule, so the
-/// colours match its phases.
+/// within `rule.margin_px`; the flights are the frames either side. With the estimate's margin (1 px) this
+/// is the estimate's rule.
 ///
 /// Marks need not be sorted; frames not `ok`/`occluded` are skipped. Errors: no usable frame, or the ball
 /// never within the margin of the line.
@@ -244,7 +246,7 @@ mod tests {
     const R: f64 = 30.0;
 
     /// A ball falling onto the line y = 200 (slope 0), pressed `depth` px in at frame 20, and rising:
-    /// centre y = 170 + depth − 0.4·(f − 20)² (px), so it is within 1 px of the line for |f − 20| ≤ a few.
+    /// centre y = 170 + depth − 0.4·(f − 20)² (px).
     fn bounce(depth: f64, status_at: impl Fn(u64) -> Status) -> Vec<BallMark> {
         (0..41u64)
             .map(|f| {
@@ -271,7 +273,7 @@ mod tests {
 
     #[test]
     fn the_five_frames_of_a_synthetic_bounce() {
-        // Clearance = 0.4 d² − 2; ≤ 1 px while d² ≤ 7.5, i.e. frames 18–22.
+        // Clearance = 0.4 d² − 2; ≤ 0 while d² ≤ 5, i.e. frames 18–22.
         let marks = bounce(2.0, |_| Status::Ok);
         let p = phases_from_trajectory(&marks, &flat(200.0), &ContactRule::default()).unwrap();
         assert_eq!(
@@ -305,6 +307,32 @@ mod tests {
                 Phase::FlightOut
             ]
         );
+    }
+
+    #[test]
+    fn a_margin_widens_the_contact() {
+        // With the estimate's 1 px: 0.4 d² − 2 ≤ 1 while d² ≤ 7.5, still frames 18–22; with 2 px, d² ≤ 10:
+        // frames 17–23.
+        let marks = bounce(2.0, |_| Status::Ok);
+        let rule = |margin_px| ContactRule {
+            margin_px,
+            radius_px: Some(R),
+        };
+        let p = phases_from_trajectory(&marks, &flat(200.0), &rule(1.0)).unwrap();
+        assert_eq!((p.contact_first, p.contact_last), (18, 22));
+        let p = phases_from_trajectory(&marks, &flat(200.0), &rule(2.0)).unwrap();
+        assert_eq!((p.contact_first, p.contact_last), (17, 23));
+        // A radius given 1 px smaller leaves the ball 1 px further from the line: d² ≤ 2.5.
+        let p = phases_from_trajectory(
+            &marks,
+            &flat(200.0),
+            &ContactRule {
+                margin_px: 0.0,
+                radius_px: Some(R - 1.0),
+            },
+        )
+        .unwrap();
+        assert_eq!((p.contact_first, p.contact_last), (19, 21));
     }
 
     #[test]

@@ -59,7 +59,7 @@ fn legend_items() -> Vec<LegendItem> {
     for p in [Phase::FlightIn, Phase::Contact, Phase::FlightOut] {
         items.push((Some(p.colour()), p.name().replace('_', " ")));
     }
-    items.push((None, "DASHED = PART OF RIM".into()));
+    items.push((None, "(DASHED: FIT TO PART OF THE RIM)".into()));
     items.push((Some(SurfaceLine::colour()), "SURFACE LINE".into()));
     items.push((None, "STATUS:".into()));
     for s in Status::ALL {
@@ -71,7 +71,7 @@ fn legend_items() -> Vec<LegendItem> {
 /// Lays the legend out in lines no wider than `width`; returns each item's position and the height used.
 fn legend_layout(width: u32, scale: u32) -> (Vec<PlacedItem>, u32) {
     let line_h = (GLYPH_H + 3) * scale;
-    let gap = 4 * scale;
+    let gap = 6 * scale;
     let (mut x, mut y) = (0u32, 0u32);
     let mut placed = Vec::new();
     for (swatch, text) in legend_items() {
