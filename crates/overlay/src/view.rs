@@ -194,44 +194,78 @@ pub fn render_gray(pixels: &GrayPixels, view: &View, levels: Levels) -> Result<R
     })
 }
 
+/// Sampling positions along one axis: for each canvas column (or row), the two frame pixels either side and
+/// the weight of the second, or `None` outside the frame.
+fn axis_taps(start: f64, scale: f64, n: u32, size: u32) -> Vec<Option<(usize, usize, f32)>> {
+    let last = size as usize - 1;
+    let limit = f64::from(size) - 0.5;
+    (0..n)
+        .map(|k| {
+            let f = start + f64::from(k) / scale;
+            if !(-0.5..limit).contains(&f) {
+                return None;
+            }
+            let base = f.floor();
+            let i = base.max(0.0) as usize;
+            Some((i.min(last), (i + usize::from(base >= 0.0)).min(last), (f - base) as f32))
+        })
+        .collect()
+}
+
+/// Gray value (fraction of full scale) → display level, rounded half up.
+#[inline]
+fn to_level(n: f32, black: f32, gain: f32) -> u8 {
+    (((n - black) * gain).clamp(0.0, 1.0) * 255.0 + 0.5) as u8
+}
+
 fn render_plane<T: Copy + Into<f32>>(data: &[T], w: u32, h: u32, full: f32, view: &View, levels: Levels) -> RgbImage {
     let gain = 1.0 / (levels.white - levels.black);
-    let level = |v: T| -> u8 {
-        let n = v.into() / full;
-        (((n - levels.black) * gain).clamp(0.0, 1.0) * 255.0).round() as u8
-    };
-    let levelf = |n: f32| -> u8 { (((n - levels.black) * gain).clamp(0.0, 1.0) * 255.0).round() as u8 };
+    let black = levels.black;
     let mut out = RgbImage::new(view.width, view.height);
-    let (wi, hi) = (w as usize, h as usize);
+    let wi = w as usize;
     // A whole frame at zoom 1 lands pixel on pixel: no interpolation to do.
     if view.scale == 1.0 && view.left == 0.0 && view.top == 0.0 && view.width == w && view.height == h {
+        // 8-bit values through a table of their 256 levels (the same formula, so the same picture).
+        let table: Option<Vec<u8>> = (full == 255.0).then(|| {
+            (0..=255u8)
+                .map(|v| to_level(f32::from(v) / full, black, gain))
+                .collect()
+        });
         for (o, &v) in out.pixels_mut().zip(data) {
-            let g = level(v);
+            let n: f32 = v.into();
+            let g = match &table {
+                Some(t) => t[n as usize],
+                None => to_level(n / full, black, gain),
+            };
             *o = Rgb([g, g, g]);
         }
         return out;
     }
-    let (wf, hf) = (f64::from(w), f64::from(h));
-    for v in 0..view.height {
-        let fy = view.top + f64::from(v) / view.scale;
-        for u in 0..view.width {
-            let fx = view.left + f64::from(u) / view.scale;
-            if fx < -0.5 || fy < -0.5 || fx >= wf - 0.5 || fy >= hf - 0.5 {
-                out.put_pixel(u, v, OUTSIDE);
-                continue;
+    // Bilinear between the four nearest pixel centres, clamped at the frame's edge; the taps of every
+    // column and row are worked out once.
+    let cols = axis_taps(view.left, view.scale, view.width, w);
+    let rows = axis_taps(view.top, view.scale, view.height, h);
+    let width = view.width as usize;
+    let outside = OUTSIDE.0;
+    for (row, line) in rows.iter().zip(out.chunks_exact_mut(3 * width)) {
+        let Some((ya, yb, ay)) = *row else {
+            for px in line.chunks_exact_mut(3) {
+                px.copy_from_slice(&outside);
             }
-            // Bilinear between the four nearest pixel centres, clamped at the frame's edge.
-            let (x0, y0) = (fx.floor(), fy.floor());
-            let (ax, ay) = ((fx - x0) as f32, (fy - y0) as f32);
-            let xa = (x0.max(0.0) as usize).min(wi - 1);
-            let xb = ((x0 + 1.0).max(0.0) as usize).min(wi - 1);
-            let ya = (y0.max(0.0) as usize).min(hi - 1);
-            let yb = ((y0 + 1.0).max(0.0) as usize).min(hi - 1);
-            let p = |x: usize, y: usize| data[y * wi + x].into() / full;
-            let top = p(xa, ya) * (1.0 - ax) + p(xb, ya) * ax;
-            let bottom = p(xa, yb) * (1.0 - ax) + p(xb, yb) * ax;
-            let g = levelf(top * (1.0 - ay) + bottom * ay);
-            out.put_pixel(u, v, Rgb([g, g, g]));
+            continue;
+        };
+        let (ra, rb) = (&data[ya * wi..(ya + 1) * wi], &data[yb * wi..(yb + 1) * wi]);
+        for (col, px) in cols.iter().zip(line.chunks_exact_mut(3)) {
+            let rgb = match *col {
+                Some((xa, xb, ax)) => {
+                    let top = ra[xa].into() / full * (1.0 - ax) + ra[xb].into() / full * ax;
+                    let bottom = rb[xa].into() / full * (1.0 - ax) + rb[xb].into() / full * ax;
+                    let g = to_level(top * (1.0 - ay) + bottom * ay, black, gain);
+                    [g, g, g]
+                }
+                None => outside,
+            };
+            px.copy_from_slice(&rgb);
         }
     }
     out
