@@ -89,7 +89,7 @@ const LABEL_BG: Rgb<u8> = Rgb([0, 0, 0]);
 /// Circle, line and cross are anti-aliased at their sub-pixel positions (see `paint`).
 ///
 /// Cost: O(r · stroke) for the circle plus O(canvas width) for the line plus ~20 rectangles per label
-/// character: about 10 µs on a 512×512 frame (`docs/performance.md`).
+/// character: about 0.2 ms on a 512×512 frame with an 84 px ball (`docs/performance.md`).
 pub fn draw_annotations(
     canvas: &mut RgbImage,
     view: &View,
@@ -221,7 +221,7 @@ impl Default for Crop {
 /// Give every tile of a strip the same `radius_px` (e.g. the clip's flight radius) so they share one
 /// magnification.
 ///
-/// Cost: ~5 ns per output pixel plus the annotations: about 0.15 ms for 160 px.
+/// Cost: ~5 ns per output pixel plus the annotations: about 0.2 ms for 160 px.
 #[allow(clippy::too_many_arguments)]
 pub fn crop_at(
     pixels: &GrayPixels,

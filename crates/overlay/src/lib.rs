@@ -49,13 +49,13 @@ pub enum PngSpeed {
     /// Smallest files; for sheets and strips embedded in a report.
     #[default]
     Small,
-    /// Several times faster, files ~1.5× larger; for writing every frame of a clip.
+    /// 50–100× faster on noisy frames, files about twice as large; for writing every frame of a clip.
     Fast,
 }
 
 /// The picture as PNG bytes (8-bit RGB), with the encoder's default compression.
 ///
-/// Cost: ~2–4 ms for a 512×512 frame (`docs/performance.md`).
+/// Cost: 70–150 ms for a noisy 512×512 frame (`docs/performance.md`); [`PngSpeed::Fast`] takes ~1.4 ms.
 pub fn encode_png(img: &RgbImage) -> Result<Vec<u8>, OverlayError> {
     encode_png_with(img, PngSpeed::Small)
 }

@@ -61,15 +61,15 @@ pub enum Dash {
 /// to the band of dense ones (tested against 0.125 px spacing: within 2 % of full coverage; 0.5 px was 4 %
 /// off on a thin small ring).
 const SPLAT_STEP: f64 = 0.35;
-/// Most points around a ring (a guard for absurd radii; a 10,000 px ring still gets ≤ 0.25 px spacing).
+/// Most points around a ring (a guard for absurd radii; a 10,000 px ring still keeps the 0.35 px spacing).
 const MAX_RING_POINTS: usize = 1 << 18;
 
 /// Draws a circle of radius `r` centred on (cx, cy), all in canvas px, as an anti-aliased stroke `width`
 /// px wide, blended at `opacity` (0–1); `Dash::Dashed` leaves gaps along it.
 ///
-/// Cost: ~ (2πr / 0.25) · (width / 0.25) bilinear splats into a buffer the size of the ring's box, then
-/// one blend per pixel of that box: about 20 µs for r = 50 px, width 1.25 px. A ring outside the canvas
-/// costs nothing; a huge one is bounded by the canvas and `MAX_RING_POINTS`.
+/// Cost: ~ (2πr / 0.35) · (width / 0.35) bilinear splats into a buffer the size of the ring's box, then
+/// one blend per pixel of that box: about 0.2 ms for r = 84 px, width 1.25 px (`docs/performance.md`). A
+/// ring outside the canvas costs nothing; a huge one is bounded by the canvas and `MAX_RING_POINTS`.
 #[allow(clippy::too_many_arguments)]
 pub fn draw_ring(img: &mut RgbImage, cx: f64, cy: f64, r: f64, width: f64, colour: Rgb<u8>, opacity: f32, dash: Dash) {
     ring_with_step(img, cx, cy, r, width, colour, opacity, dash, SPLAT_STEP);
@@ -180,7 +180,7 @@ fn splat(acc: &mut [f32], bw: usize, bh: usize, x: f64, y: f64, weight: f32) {
 /// Each column (each row, for a line steeper than 45°) is the band's cross-section through a tent
 /// footprint, so its coverage-weighted height is the line's height there exactly.
 ///
-/// Cost: a few pixels per column: about 3 µs across 512 px.
+/// Cost: a few pixels per column: about 25 µs across 512 px.
 pub fn draw_line_across(img: &mut RgbImage, x0: f64, y0: f64, slope: f64, width: f64, colour: Rgb<u8>, opacity: f32) {
     if !(x0.is_finite() && y0.is_finite() && slope.is_finite() && width.is_finite()) || width <= 0.0 {
         return;

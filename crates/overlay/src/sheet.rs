@@ -92,7 +92,7 @@ fn legend_layout(width: u32, scale: u32) -> (Vec<PlacedItem>, u32) {
 ///
 /// Errors: no tiles, a zero column count or font scale, or a sheet over the size limit.
 ///
-/// Cost: one copy of every tile plus the captions: ~0.1 ms for five 160 px tiles.
+/// Cost: one copy of every tile plus the captions and legend, small beside making the tiles.
 pub fn contact_sheet(tiles: &[Tile], layout: &SheetLayout) -> Result<RgbImage, OverlayError> {
     if tiles.is_empty() {
         return Err(OverlayError::EmptySheet);
@@ -172,7 +172,7 @@ pub struct StripFrame<'a> {
 ///
 /// Errors: no frames, or no frame with a measured ball; a mark or style that the crop refuses.
 ///
-/// Cost: one crop per frame plus the sheet: ~1 ms for five 160 px tiles.
+/// Cost: one crop per frame plus the sheet: ~3 ms for five 160 px tiles.
 pub fn key_frame_strip(
     frames: &[StripFrame<'_>],
     line: Option<&SurfaceLine>,
