@@ -6,6 +6,7 @@ pub mod diagnose;
 pub mod effects;
 pub mod estimate;
 pub mod model;
+pub mod overlay;
 pub mod render;
 pub mod simulate;
 pub mod track;

@@ -2,7 +2,7 @@
 
 use anyhow::Context;
 use bouncelab_frames::{Clip, ClipOptions, Downslope, Session};
-use bouncelab_track::{ClipTracking, track_clip};
+use bouncelab_track::{ClipTracking, Track, track_clip};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -13,6 +13,13 @@ pub struct Args {
     /// Trajectory CSV to write; standard output when omitted.
     #[arg(long)]
     out: Option<PathBuf>,
+    #[command(flatten)]
+    tracking: Tracking,
+}
+
+/// How a clip is tracked: shared by `track` and `overlay`.
+#[derive(clap::Args)]
+pub struct Tracking {
     /// Detector: the built-in Hough tracker (opencv needs the `opencv` feature).
     #[arg(long, value_enum, default_value_t = Detector::Hough)]
     detector: Detector,
@@ -53,7 +60,8 @@ fn session_settings(clip_dir: &Path) -> (Option<f64>, bool) {
     }
 }
 
-pub fn run(a: Args) -> anyhow::Result<()> {
+/// Opens the clip and tracks it as `bouncelab track` does (warnings printed, a progress bar on a terminal).
+pub fn track_clip_dir(clip_dir: &Path, a: &Tracking) -> anyhow::Result<(Clip, Track)> {
     #[cfg(not(feature = "opencv"))]
     if matches!(a.detector, Detector::Opencv) {
         anyhow::bail!("--detector opencv needs a build with `--features opencv` (not implemented in this build yet)");
@@ -62,18 +70,14 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         Some(f) => ClipOptions::with_fps(f),
         None => ClipOptions::default(),
     };
-    let clip = Clip::open_with(&a.clip_dir, &options)?;
+    let clip = Clip::open_with(clip_dir, &options)?;
     for w in clip.warnings() {
         eprintln!("warning: {w}");
     }
     if !clip.gaps().is_empty() {
-        eprintln!(
-            "warning: {} dropped frame(s) in {}",
-            clip.dropped(),
-            a.clip_dir.display()
-        );
+        eprintln!("warning: {} dropped frame(s) in {}", clip.dropped(), clip_dir.display());
     }
-    let (session_diameter, minus_x) = session_settings(&a.clip_dir);
+    let (session_diameter, minus_x) = session_settings(clip_dir);
     let diameter = a.diameter.or(session_diameter).unwrap_or(0.067);
     if !(diameter > 0.0 && diameter.is_finite()) {
         anyhow::bail!("--diameter {diameter} must be a positive number of metres");
@@ -99,11 +103,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         #[cfg(not(feature = "opencv"))]
         Detector::Opencv => unreachable!("refused above"),
     }
-    .with_context(|| format!("tracking {}", a.clip_dir.display()))?;
+    .with_context(|| format!("tracking {}", clip_dir.display()))?;
     bar.finish_and_clear();
     for w in &track.warnings {
         eprintln!("warning: {w}");
     }
+    Ok((clip, track))
+}
+
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let (_, track) = track_clip_dir(&a.clip_dir, &a.tracking)?;
     let mut out: Box<dyn Write> = match &a.out {
         Some(p) => Box::new(std::fs::File::create(p).with_context(|| format!("creating {}", p.display()))?),
         None => Box::new(std::io::stdout().lock()),
