@@ -121,15 +121,15 @@ pub struct Frame {
 }
 
 /// What holds a clip's frames, before any setting is applied.
-struct Frames {
-    files: Vec<FrameFile>,
-    size: (u32, u32),
-    camera: Option<Arc<CameraFile>>,
+pub(crate) struct Frames {
+    pub(crate) files: Vec<FrameFile>,
+    pub(crate) size: (u32, u32),
+    pub(crate) camera: Option<Arc<CameraFile>>,
 }
 
 impl Frames {
     /// Lists a folder (or opens the camera file) at `path`.
-    fn probe(path: &Path, max_pixels: u64) -> Result<Self> {
+    pub(crate) fn probe(path: &Path, max_pixels: u64) -> Result<Self> {
         if path.is_dir() {
             let files = list_frames(path)?;
             // A folder holding one multi-page TIFF is that stack.
@@ -223,6 +223,9 @@ impl Clip {
     /// `session.toml` > default) and checks the region of interest and contact line against the size.
     pub fn open_with(path: impl AsRef<Path>, options: &ClipOptions) -> Result<Self> {
         let path = path.as_ref().to_path_buf();
+        if let Some(fps) = options.fps {
+            crate::settings::check_fps(fps, "command line", "--fps")?;
+        }
         check_overrides(&options.overrides)?;
         let frames = Frames::probe(&path, options.max_frame_pixels)?;
         let own = camera_keys_at(&clip_toml_path(&path))?;

@@ -144,6 +144,12 @@ pub enum FramesError {
         /// Every row with empty cells, in file order.
         rows: Vec<UnfilledRow>,
     },
+    /// `bouncelab init` would overwrite an existing file.
+    #[error("{}: exists already; move it away or give --force to overwrite it", path.display())]
+    WouldOverwrite {
+        /// The file.
+        path: PathBuf,
+    },
     /// A `clips.csv` clip name without extension that matches several camera files.
     #[error(
         "clip `{clip}` matches several camera files ({}): write the file name with its extension in clips.csv",

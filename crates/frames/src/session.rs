@@ -8,8 +8,8 @@ use crate::camera::{CameraFile, DEFAULT_MAX_FRAME_PIXELS, Kind};
 use crate::clip::Clip;
 use crate::error::{FramesError, Result, UnfilledRow};
 use crate::settings::{
-    ClipSettings, DIAMETER_RANGE_M, Downslope, FpsSource, SettingOverrides, Warning, camera_keys,
-    camera_keys_at, check_range, choose_fps, choose_settings, clip_toml_path, number, read_toml,
+    ClipSettings, DIAMETER_RANGE_M, Downslope, FpsSource, SettingOverrides, Warning, camera_keys, camera_keys_at,
+    check_range, choose_fps, choose_settings, clip_toml_path, number, read_toml,
 };
 
 /// The ball, from `session.toml`'s `[ball]` table.
@@ -204,8 +204,7 @@ pub(crate) fn resolve_clip(session: &Path, name: &str) -> Result<PathBuf> {
     if let Ok(entries) = std::fs::read_dir(session) {
         for entry in entries.flatten() {
             let path = entry.path();
-            if !path.is_file() || path.file_stem().and_then(|s| s.to_str()) != Some(name) || Kind::of(&path).is_none()
-            {
+            if !path.is_file() || path.file_stem().and_then(|s| s.to_str()) != Some(name) || Kind::of(&path).is_none() {
                 continue;
             }
             candidates.push(path);
@@ -228,7 +227,12 @@ pub(crate) fn resolve_clip(session: &Path, name: &str) -> Result<PathBuf> {
 
 /// Camera files with a Photron clip's `.cihx`/`.cih`/`.mraw` reduced to one (its header, `.cihx` first).
 pub(crate) fn photron_grouped(paths: Vec<PathBuf>) -> Vec<PathBuf> {
-    let ext = |p: &Path| p.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
+    let ext = |p: &Path| {
+        p.extension()
+            .and_then(|e| e.to_str())
+            .unwrap_or_default()
+            .to_ascii_lowercase()
+    };
     let rank = |p: &Path| match ext(p).as_str() {
         "cihx" => 0,
         "cih" => 1,

@@ -322,10 +322,11 @@ fn roi(path: &Path, value: &toml::Value) -> Result<Roi> {
         field: field.into(),
         problem,
     };
-    let items = value
-        .as_array()
-        .filter(|a| a.len() == 4)
-        .ok_or_else(|| bad(format!("{value} is not [x, y, width, height] (four whole numbers of pixels)")))?;
+    let items = value.as_array().filter(|a| a.len() == 4).ok_or_else(|| {
+        bad(format!(
+            "{value} is not [x, y, width, height] (four whole numbers of pixels)"
+        ))
+    })?;
     let mut v = [0u32; 4];
     for (slot, item) in v.iter_mut().zip(items) {
         *slot = item
@@ -392,7 +393,13 @@ pub(crate) fn camera_keys(path: &Path, doc: &toml::Table) -> Result<CameraKeys> 
     if let Some(ball) = table(path, doc, "ball")? {
         if let Some(v) = ball.get("diameter_m") {
             let field = "[ball] diameter_m";
-            keys.diameter_m = Some(check_range(number(path, field, v)?, DIAMETER_RANGE_M, "m", path, field)?);
+            keys.diameter_m = Some(check_range(
+                number(path, field, v)?,
+                DIAMETER_RANGE_M,
+                "m",
+                path,
+                field,
+            )?);
         }
     }
     if let Some(surface) = table(path, doc, "surface")? {
@@ -429,7 +436,10 @@ pub(crate) fn camera_keys(path: &Path, doc: &toml::Table) -> Result<CameraKeys> 
                     path,
                     "[surface] line_tilt_deg",
                 )?;
-                keys.contact_line = Some(ContactLine { y_px: y, tilt_deg: tilt });
+                keys.contact_line = Some(ContactLine {
+                    y_px: y,
+                    tilt_deg: tilt,
+                });
             }
         }
     }
@@ -452,7 +462,10 @@ pub fn clip_toml_path(clip: &Path) -> PathBuf {
     if clip.is_dir() {
         return clip.join("clip.toml");
     }
-    let stem = clip.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    let stem = clip
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
     clip.with_file_name(format!("{stem}.clip.toml"))
 }
 

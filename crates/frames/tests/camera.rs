@@ -40,7 +40,10 @@ fn the_real_photron_recording_decodes_pixel_exact() {
     let dir = fixture();
     let clip = Clip::open(dir.join("ball_12bit.cihx")).unwrap();
     assert_eq!((clip.len(), clip.dimensions()), (15, (384, 384)));
-    assert_eq!((clip.fps(), clip.fps_source()), (30_000.0, &FpsSource::Header(dir.join("ball_12bit.cihx"))));
+    assert_eq!(
+        (clip.fps(), clip.fps_source()),
+        (30_000.0, &FpsSource::Header(dir.join("ball_12bit.cihx")))
+    );
     let info = clip.camera();
     assert_eq!(info.format, SourceFormat::PhotronMraw);
     assert_eq!(info.fps, Some(30_000.0));
@@ -64,22 +67,34 @@ fn the_real_photron_recording_decodes_pixel_exact() {
                 .into_luma16();
             let got = f.pixels.as_u16().expect("12-bit frames decode to 16-bit");
             assert_eq!(got.dimensions(), reference.dimensions());
-            let diff = got.as_raw().iter().zip(reference.as_raw()).filter(|(a, b)| a != b).count();
+            let diff = got
+                .as_raw()
+                .iter()
+                .zip(reference.as_raw())
+                .filter(|(a, b)| a != b)
+                .count();
             assert_eq!(diff, 0, "frame {}: {diff} pixels differ", f.index);
             assert!((f.t_s - f.index as f64 / 30_000.0).abs() < 1e-15);
         }
     }
     // The .mraw names the same clip.
     let by_data = Clip::open(dir.join("ball_12bit.mraw")).unwrap();
-    assert_eq!(by_data.read(7, Default::default()).unwrap().unwrap().pixels, read_all(&clip, 1)[7].pixels);
+    assert_eq!(
+        by_data.read(7, Default::default()).unwrap().unwrap().pixels,
+        read_all(&clip, 1)[7].pixels
+    );
     assert_eq!(by_data.source_files().len(), 2);
 }
 
 #[test]
 fn written_mraw_round_trips_at_8_12_and_16_bits_with_both_headers() {
     let tmp = tempfile::tempdir().unwrap();
-    for (bits, effective, max, shift) in [(8, 8, 255u16, 0u32), (12, 12, 4095, 4), (16, 12, 4095, 4), (16, 16, 65535, 0)]
-    {
+    for (bits, effective, max, shift) in [
+        (8, 8, 255u16, 0u32),
+        (12, 12, 4095, 4),
+        (16, 12, 4095, 4),
+        (16, 16, 65535, 0),
+    ] {
         for header in [PhotronHeader::Cihx, PhotronHeader::Cih] {
             let mut spec = Mraw::new(24, 10, bits);
             (spec.effective, spec.header, spec.start_frame) = (effective, header, -7);
@@ -89,7 +104,10 @@ fn written_mraw_round_trips_at_8_12_and_16_bits_with_both_headers() {
             let clip = Clip::open(&path).unwrap();
             assert_eq!((clip.len(), clip.dimensions()), (5, (24, 10)), "{stem}");
             assert_eq!(clip.fps(), 30_000.0);
-            assert_eq!((clip.camera().start_frame, clip.camera().trigger_frame), (Some(-7), Some(7)));
+            assert_eq!(
+                (clip.camera().start_frame, clip.camera().trigger_frame),
+                (Some(-7), Some(7))
+            );
             assert!((clip.camera().exposure_s.unwrap() - 2e-5).abs() < 1e-15);
             assert_eq!(clip.camera().camera_model.as_deref(), Some("FASTCAM test"));
             for f in read_all(&clip, 2) {
@@ -116,7 +134,9 @@ fn written_cine_round_trips_at_every_depth_with_its_metadata() {
             let mut spec = Cine::new(20, 12, packing);
             spec.annotation = annotation;
             let frames = moving_disc(20, 12, 6, max, u64::from(max));
-            let path = tmp.path().join(format!("{packing:?}_{annotation}.cine").replace(['{', '}', ' ', ':'], ""));
+            let path = tmp
+                .path()
+                .join(format!("{packing:?}_{annotation}.cine").replace(['{', '}', ' ', ':'], ""));
             spec.write(&path, &frames);
             let clip = Clip::open(&path).unwrap();
             assert_eq!((clip.len(), clip.dimensions(), clip.fps()), (6, (20, 12), 25_000.0));
@@ -128,7 +148,9 @@ fn written_cine_round_trips_at_every_depth_with_its_metadata() {
             assert_eq!(info.camera_model.as_deref(), Some("Phantom v2512"));
             assert_eq!(info.camera_serial.as_deref(), Some("31337"));
             assert_eq!(
-                clip.warnings().iter().any(|w| matches!(w, Warning::NonLinearPixels { .. })),
+                clip.warnings()
+                    .iter()
+                    .any(|w| matches!(w, Warning::NonLinearPixels { .. })),
                 packing == CinePacking::P10
             );
             for f in read_all(&clip, 2) {
@@ -143,7 +165,12 @@ fn written_cine_round_trips_at_every_depth_with_its_metadata() {
 fn tiff_stacks_read_every_page_with_any_compression() {
     let tmp = tempfile::tempdir().unwrap();
     for bits in [8u32, 16] {
-        for c in [TiffCompression::None, TiffCompression::Lzw, TiffCompression::Deflate, TiffCompression::PackBits] {
+        for c in [
+            TiffCompression::None,
+            TiffCompression::Lzw,
+            TiffCompression::Deflate,
+            TiffCompression::PackBits,
+        ] {
             let max = if bits == 8 { 255 } else { 65535 };
             let frames = moving_disc(30, 14, 7, max, 3);
             let path = tmp.path().join(format!("stack_{bits}_{c:?}.tif"));
@@ -153,7 +180,12 @@ fn tiff_stacks_read_every_page_with_any_compression() {
             assert_eq!(clip.camera().format, SourceFormat::TiffStack);
             for threads in [1, 2] {
                 for f in read_all(&clip, threads) {
-                    assert_eq!(u16s(&f.pixels), frames[f.index as usize], "{bits} {c:?} page {}", f.index);
+                    assert_eq!(
+                        u16s(&f.pixels),
+                        frames[f.index as usize],
+                        "{bits} {c:?} page {}",
+                        f.index
+                    );
                 }
             }
         }
@@ -173,7 +205,14 @@ fn a_folder_holding_only_a_stack_is_that_stack_and_a_stack_among_frames_is_refus
 
     let mixed = tmp.path().join("mixed");
     std::fs::create_dir(&mixed).unwrap();
-    write_tiff_stack(&mixed.join("img_001.tif"), 16, 8, 8, &frames[..1], TiffCompression::None);
+    write_tiff_stack(
+        &mixed.join("img_001.tif"),
+        16,
+        8,
+        8,
+        &frames[..1],
+        TiffCompression::None,
+    );
     write_tiff_stack(&mixed.join("img_002.tif"), 16, 8, 8, &frames, TiffCompression::None);
     let clip = Clip::open_with(&mixed, &ClipOptions::with_fps(100.0)).unwrap();
     let results: Vec<_> = clip.frames().collect();
@@ -189,13 +228,19 @@ fn header_fps_beats_session_toml_and_loses_to_clip_toml_and_the_command_line() {
     let spec = Cine::new(8, 8, CinePacking::U8);
     let path = tmp.path().join("shot1.cine");
     spec.write(&path, &moving_disc(8, 8, 2, 255, 0));
-    std::fs::write(tmp.path().join("session.toml"), "[ball]\ndiameter_m = 0.067\nmass_kg = 0.05\n[camera]\nfps = 4000\n")
-        .unwrap();
+    std::fs::write(
+        tmp.path().join("session.toml"),
+        "[ball]\ndiameter_m = 0.067\nmass_kg = 0.05\n[camera]\nfps = 4000\n",
+    )
+    .unwrap();
     assert_eq!(Clip::open(&path).unwrap().fps(), 25_000.0);
     std::fs::write(tmp.path().join("shot1.clip.toml"), "[camera]\nfps = 5000\n").unwrap();
     let clip = Clip::open(&path).unwrap();
     assert_eq!(clip.fps(), 5000.0);
-    assert_eq!(clip.fps_source(), &FpsSource::ClipToml(tmp.path().join("shot1.clip.toml")));
+    assert_eq!(
+        clip.fps_source(),
+        &FpsSource::ClipToml(tmp.path().join("shot1.clip.toml"))
+    );
     let clip = Clip::open_with(&path, &ClipOptions::with_fps(1000.0)).unwrap();
     assert_eq!((clip.fps(), clip.fps_source()), (1000.0, &FpsSource::Override));
     // Without an fps in the header, session.toml applies.
@@ -218,7 +263,10 @@ fn a_truncated_or_padded_mraw_is_refused_naming_the_file_and_the_frame_count() {
     std::fs::write(&data, &bytes[..bytes.len() - 100]).unwrap();
     let err = Clip::open(&header).unwrap_err();
     assert!(matches!(err, FramesError::CameraHeader { .. }), "{err:?}");
-    names(&err, &["cut.mraw", "<frameInfo><totalFrame>", "truncated", "3 whole frames"]);
+    names(
+        &err,
+        &["cut.mraw", "<frameInfo><totalFrame>", "truncated", "3 whole frames"],
+    );
     let mut longer = bytes.clone();
     longer.extend([0u8; 192]);
     std::fs::write(&data, longer).unwrap();
@@ -236,7 +284,11 @@ fn unknown_bit_depths_huge_sizes_and_missing_data_are_refused() {
         spec.bits = 14;
         std::fs::write(&path, spec.header_text(1)).unwrap();
         let err = Clip::open(&path).unwrap_err();
-        let field = if header == PhotronHeader::Cihx { "<imageDataInfo><colorInfo><bit>" } else { "Color Bit" };
+        let field = if header == PhotronHeader::Cihx {
+            "<imageDataInfo><colorInfo><bit>"
+        } else {
+            "Color Bit"
+        };
         names(&err, &["odd.ci", field, "unknown bit depth 14"]);
         spec.bits = 8;
         (spec.width, spec.height) = (1_000_000, 1_000_000);
@@ -253,7 +305,10 @@ fn unknown_bit_depths_huge_sizes_and_missing_data_are_refused() {
     let mut small = ClipOptions::default();
     small.max_frame_pixels = 63;
     let path = Mraw::new(8, 8, 8).write(tmp.path(), "limit", &frames);
-    assert!(matches!(Clip::open_with(&path, &small), Err(FramesError::FrameTooLarge { limit: 63, .. })));
+    assert!(matches!(
+        Clip::open_with(&path, &small),
+        Err(FramesError::FrameTooLarge { limit: 63, .. })
+    ));
 }
 
 #[test]
@@ -272,11 +327,23 @@ fn a_cine_with_a_bad_offset_table_or_header_is_refused_naming_the_field() {
     let err = patch(layout.off_offsets + 8, &(good.len() as u64 + 5).to_le_bytes());
     assert!(matches!(err, FramesError::CameraHeader { .. }), "{err:?}");
     names(&err, &["bad.cine", "pImage[1]", "leaves no room"]);
-    names(&patch(32, &(good.len() as u32 - 4).to_le_bytes()), &["OffImageOffsets", "runs past the end"]);
-    names(&patch(44 + 16, &7u32.to_le_bytes()), &["biCompression", "unknown image packing 7"]);
-    names(&patch(44 + 14, &12u16.to_le_bytes()), &["biBitCount", "unknown bit depth 12"]);
+    names(
+        &patch(32, &(good.len() as u32 - 4).to_le_bytes()),
+        &["OffImageOffsets", "runs past the end"],
+    );
+    names(
+        &patch(44 + 16, &7u32.to_le_bytes()),
+        &["biCompression", "unknown image packing 7"],
+    );
+    names(
+        &patch(44 + 14, &12u16.to_le_bytes()),
+        &["biBitCount", "unknown bit depth 12"],
+    );
     names(&patch(0, b"XX"), &["CINEFILEHEADER.Type"]);
-    names(&patch(24, &(good.len() as u32).to_le_bytes()), &["OffImageHeader", "BITMAPINFOHEADER"]);
+    names(
+        &patch(24, &(good.len() as u32).to_le_bytes()),
+        &["OffImageHeader", "BITMAPINFOHEADER"],
+    );
     // An annotation that claims the wrong image size fails that frame only, naming it.
     let mut b = good.clone();
     let at = layout.images[2] + 4;
@@ -311,7 +378,10 @@ fn video_and_other_files_say_what_reads_them() {
     let err = Clip::open(&other).unwrap_err();
     assert!(matches!(err, FramesError::NotAClip { .. }));
     names(&err, &["notes.txt", ".cihx", ".cine"]);
-    names(&Clip::open(tmp.path().join("nope")).unwrap_err(), &["nope", "no such clip folder or camera file"]);
+    names(
+        &Clip::open(tmp.path().join("nope")).unwrap_err(),
+        &["nope", "no such clip folder or camera file"],
+    );
 }
 
 mod fuzz {

@@ -43,7 +43,8 @@ fn i32_at(b: &[u8], at: usize) -> Option<i32> {
 }
 
 fn u64_at(b: &[u8], at: usize) -> Option<u64> {
-    b.get(at..at + 8).map(|s| u64::from_le_bytes(s.try_into().expect("8 bytes")))
+    b.get(at..at + 8)
+        .map(|s| u64::from_le_bytes(s.try_into().expect("8 bytes")))
 }
 
 /// Where a CINE file's frames are and how they are stored.
@@ -101,7 +102,10 @@ pub(crate) fn open(path: &Path, max_pixels: u64) -> Result<CameraFile> {
     let bad = |field: &str, problem: String| header_error(path, field, problem);
     let short = |field: &str| header_error(path, field, "the file ends before this field (truncated header)");
     if b.get(0..2) != Some(b"CI".as_slice()) {
-        return Err(bad("CINEFILEHEADER.Type", "not \"CI\": not a Phantom .cine file".into()));
+        return Err(bad(
+            "CINEFILEHEADER.Type",
+            "not \"CI\": not a Phantom .cine file".into(),
+        ));
     }
     let compression = u16_at(b, 4).ok_or_else(|| short("CINEFILEHEADER.Compression"))?;
     if compression != 0 {
@@ -109,7 +113,11 @@ pub(crate) fn open(path: &Path, max_pixels: u64) -> Result<CameraFile> {
             "CINEFILEHEADER.Compression",
             format!(
                 "{compression} ({}): only uncompressed (0) images are read; save the cine uncompressed",
-                if compression == 1 { "JPEG" } else { "uninterpolated colour raw" }
+                if compression == 1 {
+                    "JPEG"
+                } else {
+                    "uninterpolated colour raw"
+                }
             ),
         ));
     }
@@ -169,7 +177,9 @@ pub(crate) fn open(path: &Path, max_pixels: u64) -> Result<CameraFile> {
         (other, _) => {
             return Err(bad(
                 "BITMAPINFOHEADER.biCompression",
-                format!("unknown image packing {other} (this reader knows 0 = plain, 256 = 10-bit, 1024 = 12-bit packed)"),
+                format!(
+                    "unknown image packing {other} (this reader knows 0 = plain, 256 = 10-bit, 1024 = 12-bit packed)"
+                ),
             ));
         }
     };
@@ -177,7 +187,10 @@ pub(crate) fn open(path: &Path, max_pixels: u64) -> Result<CameraFile> {
     let frame_bytes = packing.frame_bytes(pixels).ok_or_else(|| {
         bad(
             "BITMAPINFOHEADER.biCompression",
-            format!("{}×{} px cannot be stored whole at {field_bits} bits packed", size.0, size.1),
+            format!(
+                "{}×{} px cannot be stored whole at {field_bits} bits packed",
+                size.0, size.1
+            ),
         )
     })?;
 
@@ -197,7 +210,10 @@ pub(crate) fn open(path: &Path, max_pixels: u64) -> Result<CameraFile> {
         })?;
     for (k, entry) in b[table..table_end].chunks_exact(8).enumerate() {
         let offset = u64::from_le_bytes(entry.try_into().expect("8 bytes"));
-        if offset.checked_add(frame_bytes + 8).is_none_or(|end| end > b.len() as u64) {
+        if offset
+            .checked_add(frame_bytes + 8)
+            .is_none_or(|end| end > b.len() as u64)
+        {
             return Err(bad(
                 &format!("pImage[{k}]"),
                 format!(
@@ -241,6 +257,7 @@ pub(crate) fn open(path: &Path, max_pixels: u64) -> Result<CameraFile> {
         trigger_frame: Some(-i64::from(first_image_no)),
     };
     Ok(CameraFile {
+        sources: vec![path.into()],
         path: path.into(),
         data_path: path.into(),
         layout: Layout::Cine(Frames {

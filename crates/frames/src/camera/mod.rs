@@ -126,6 +126,8 @@ pub(crate) struct CameraFile {
     pub path: PathBuf,
     /// The file holding the frames (for Photron, the `.mraw`).
     pub data_path: PathBuf,
+    /// Every file the clip is made of (for Photron, header and `.mraw`).
+    sources: Vec<PathBuf>,
     map: memmap2::Mmap,
     layout: Layout,
     pub info: CameraInfo,
@@ -151,11 +153,14 @@ impl CameraFile {
         match &self.layout {
             Layout::Contiguous { packing, frame_bytes } => {
                 let start = k * frame_bytes;
-                let bytes = self.map.get(start..start + frame_bytes).ok_or_else(|| FramesError::Decode {
-                    path: self.data_path.clone(),
-                    index: k as u64,
-                    message: "frame beyond the end of the file".into(),
-                })?;
+                let bytes = self
+                    .map
+                    .get(start..start + frame_bytes)
+                    .ok_or_else(|| FramesError::Decode {
+                        path: self.data_path.clone(),
+                        index: k as u64,
+                        message: "frame beyond the end of the file".into(),
+                    })?;
                 Ok(packing.unpack(bytes, w, h, false))
             }
             Layout::Cine(frames) => frames.decode(&self.map, &self.data_path, k, w, h),
@@ -165,11 +170,7 @@ impl CameraFile {
 
     /// Every file the clip is made of (header and data), for fingerprints.
     pub(crate) fn files(&self) -> Vec<PathBuf> {
-        if self.path == self.data_path {
-            vec![self.path.clone()]
-        } else {
-            vec![self.path.clone(), self.data_path.clone()]
-        }
+        self.sources.clone()
     }
 }
 

@@ -48,7 +48,11 @@ fn sibling(path: &Path, exts: &[&str]) -> Option<PathBuf> {
 
 /// The header and data paths of a Photron clip given by either file.
 pub(crate) fn pair(path: &Path) -> Result<(PathBuf, PathBuf)> {
-    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or_default()
+        .to_ascii_lowercase();
     if ext == "mraw" {
         let header = sibling(path, &["cihx", "cih"]).ok_or_else(|| FramesError::MissingCompanion {
             path: path.into(),
@@ -84,7 +88,11 @@ pub(crate) fn read_header(path: &Path) -> Result<Header> {
         .extension()
         .and_then(|e| e.to_str())
         .is_some_and(|e| e.eq_ignore_ascii_case("cihx"));
-    if is_xml { parse_cihx(path, &bytes) } else { parse_cih(path, &bytes) }
+    if is_xml {
+        parse_cihx(path, &bytes)
+    } else {
+        parse_cih(path, &bytes)
+    }
 }
 
 fn parse_number<T: std::str::FromStr>(path: &Path, field: &str, text: &str) -> Result<T> {
@@ -152,14 +160,18 @@ pub(crate) fn parse_cih(path: &Path, bytes: &[u8]) -> Result<Header> {
 pub(crate) fn parse_cihx(path: &Path, bytes: &[u8]) -> Result<Header> {
     let find = |needle: &[u8]| bytes.windows(needle.len()).position(|w| w == needle);
     let (Some(start), Some(end)) = (find(b"<cih>"), find(b"</cih>")) else {
-        return Err(header_error(path, "<cih>", "no <cih> … </cih> XML element in the header"));
+        return Err(header_error(
+            path,
+            "<cih>",
+            "no <cih> … </cih> XML element in the header",
+        ));
     };
     if end < start {
         return Err(header_error(path, "<cih>", "</cih> comes before <cih>"));
     }
     let xml = String::from_utf8_lossy(&bytes[start..end + b"</cih>".len()]);
-    let doc = roxmltree::Document::parse(&xml)
-        .map_err(|e| header_error(path, "<cih>", format!("malformed XML: {e}")))?;
+    let doc =
+        roxmltree::Document::parse(&xml).map_err(|e| header_error(path, "<cih>", format!("malformed XML: {e}")))?;
     let get = |route: &[&str]| -> Option<String> {
         let mut node = doc.root_element();
         for name in route {
@@ -199,8 +211,7 @@ pub(crate) fn parse_cihx(path: &Path, bytes: &[u8]) -> Result<Header> {
         fps: num(&["recordInfo", "recordRate"])?,
         exposure_s,
         bits: uint(&["imageDataInfo", "colorInfo", "bit"])?,
-        effective_depth: uint(&["imageDataInfo", "effectiveBit", "depth"])?
-            .map(|d| u8::try_from(d).unwrap_or(u8::MAX)),
+        effective_depth: uint(&["imageDataInfo", "effectiveBit", "depth"])?.map(|d| u8::try_from(d).unwrap_or(u8::MAX)),
         side: get(&["imageDataInfo", "effectiveBit", "side"])
             .map(|s| parse_side(path, "<imageDataInfo><effectiveBit><side>", &s))
             .transpose()?,
@@ -215,10 +226,14 @@ pub(crate) fn parse_cihx(path: &Path, bytes: &[u8]) -> Result<Header> {
 pub(crate) fn open(path: &Path, max_pixels: u64) -> Result<CameraFile> {
     let (header_path, data_path) = pair(path)?;
     let h = read_header(&header_path)?;
-    let xml = header_path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("cihx"));
-    let name = |xml_name: &str, text_name: &str| if xml { xml_name.to_string() } else { text_name.to_string() };
+    let xml = header_path.extension().is_some_and(|e| e.eq_ignore_ascii_case("cihx"));
+    let name = |xml_name: &str, text_name: &str| {
+        if xml {
+            xml_name.to_string()
+        } else {
+            text_name.to_string()
+        }
+    };
     let missing = |f: String| header_error(&header_path, &f, "missing from the header");
     if let Some(ff) = &h.file_format {
         if !ff.eq_ignore_ascii_case("mraw") {
@@ -238,9 +253,15 @@ pub(crate) fn open(path: &Path, max_pixels: u64) -> Result<CameraFile> {
             ));
         }
     }
-    let width = h.width.ok_or_else(|| missing(name("<imageDataInfo><resolution><width>", "Image Width")))?;
-    let height = h.height.ok_or_else(|| missing(name("<imageDataInfo><resolution><height>", "Image Height")))?;
-    let frames = h.frames.ok_or_else(|| missing(name("<frameInfo><totalFrame>", "Total Frame")))?;
+    let width = h
+        .width
+        .ok_or_else(|| missing(name("<imageDataInfo><resolution><width>", "Image Width")))?;
+    let height = h
+        .height
+        .ok_or_else(|| missing(name("<imageDataInfo><resolution><height>", "Image Height")))?;
+    let frames = h
+        .frames
+        .ok_or_else(|| missing(name("<frameInfo><totalFrame>", "Total Frame")))?;
     let bits_field = name("<imageDataInfo><colorInfo><bit>", "Color Bit");
     let bits = h.bits.ok_or_else(|| missing(bits_field.clone()))?;
     let size = check_size(&header_path, width, height, max_pixels)?;
@@ -311,6 +332,7 @@ pub(crate) fn open(path: &Path, max_pixels: u64) -> Result<CameraFile> {
         trigger_frame: h.start_frame.map(|s| -s),
     };
     Ok(CameraFile {
+        sources: vec![header_path.clone(), data_path.clone()],
         path: path.into(),
         data_path,
         map,
@@ -336,7 +358,10 @@ mod tests {
                     Color Bit : 16\nFile Format : MRaw\nEffectiveBit Depth : 12\nEffectiveBit Side : Lower\n\
                     Camera Type : FASTCAM SA-Z\nPartition Number: 1\n";
         let h = parse_cih(Path::new("a.cih"), text.as_bytes()).unwrap();
-        assert_eq!((h.width, h.height, h.frames, h.bits), (Some(896), Some(368), Some(12), Some(16)));
+        assert_eq!(
+            (h.width, h.height, h.frames, h.bits),
+            (Some(896), Some(368), Some(12), Some(16))
+        );
         assert_eq!((h.fps, h.start_frame), (Some(60_000.0), Some(49_300)));
         assert!((h.exposure_s.unwrap() - 1.25e-6).abs() < 1e-18);
         assert_eq!((h.effective_depth, h.side), (Some(12), Some(BitSide::Lower)));
@@ -346,7 +371,10 @@ mod tests {
     #[test]
     fn bad_numbers_name_the_key() {
         let err = parse_cih(Path::new("a.cih"), b"Image Width : wide\n").unwrap_err();
-        assert!(err.to_string().contains("Image Width") && err.to_string().contains("a.cih"), "{err}");
+        assert!(
+            err.to_string().contains("Image Width") && err.to_string().contains("a.cih"),
+            "{err}"
+        );
         let err = parse_cihx(Path::new("b.cihx"), b"junk").unwrap_err();
         assert!(err.to_string().contains("<cih>"), "{err}");
     }

@@ -43,7 +43,11 @@ impl Form {
     }
 
     fn first_ifd(self, b: &[u8]) -> Option<u64> {
-        if self.big { read_u64(b, 8, self.little) } else { read_u32(b, 4, self.little).map(u64::from) }
+        if self.big {
+            read_u64(b, 8, self.little)
+        } else {
+            read_u32(b, 4, self.little).map(u64::from)
+        }
     }
 
     /// The offset of the directory after the one at `ifd`, 0 at the end.
@@ -66,12 +70,20 @@ impl Form {
         if self.big {
             h[2..4].copy_from_slice(&put16(43));
             h[4..6].copy_from_slice(&put16(8));
-            h[8..16].copy_from_slice(&if self.little { ifd.to_le_bytes() } else { ifd.to_be_bytes() });
+            h[8..16].copy_from_slice(&if self.little {
+                ifd.to_le_bytes()
+            } else {
+                ifd.to_be_bytes()
+            });
             (h, 16)
         } else {
             h[2..4].copy_from_slice(&put16(42));
             let ifd = ifd as u32;
-            h[4..8].copy_from_slice(&if self.little { ifd.to_le_bytes() } else { ifd.to_be_bytes() });
+            h[4..8].copy_from_slice(&if self.little {
+                ifd.to_le_bytes()
+            } else {
+                ifd.to_be_bytes()
+            });
             (h, 8)
         }
     }
@@ -79,17 +91,29 @@ impl Form {
 
 fn read_u16(b: &[u8], at: usize, little: bool) -> Option<u16> {
     let s: [u8; 2] = b.get(at..at.checked_add(2)?)?.try_into().ok()?;
-    Some(if little { u16::from_le_bytes(s) } else { u16::from_be_bytes(s) })
+    Some(if little {
+        u16::from_le_bytes(s)
+    } else {
+        u16::from_be_bytes(s)
+    })
 }
 
 fn read_u32(b: &[u8], at: usize, little: bool) -> Option<u32> {
     let s: [u8; 4] = b.get(at..at.checked_add(4)?)?.try_into().ok()?;
-    Some(if little { u32::from_le_bytes(s) } else { u32::from_be_bytes(s) })
+    Some(if little {
+        u32::from_le_bytes(s)
+    } else {
+        u32::from_be_bytes(s)
+    })
 }
 
 fn read_u64(b: &[u8], at: usize, little: bool) -> Option<u64> {
     let s: [u8; 8] = b.get(at..at.checked_add(8)?)?.try_into().ok()?;
-    Some(if little { u64::from_le_bytes(s) } else { u64::from_be_bytes(s) })
+    Some(if little {
+        u64::from_le_bytes(s)
+    } else {
+        u64::from_be_bytes(s)
+    })
 }
 
 /// True if these TIFF bytes hold more than one page (cheap: reads the first directory's link only).
@@ -110,7 +134,9 @@ struct Overlay<'a> {
 
 impl Read for Overlay<'_> {
     fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
-        let Ok(pos) = usize::try_from(self.pos) else { return Ok(0) };
+        let Ok(pos) = usize::try_from(self.pos) else {
+            return Ok(0);
+        };
         if pos >= self.data.len() {
             return Ok(0);
         }
@@ -186,7 +212,9 @@ fn to_gray(colour: ColorType, data: DecodingResult, (w, h): (u32, u32)) -> Optio
         }
         (ColorType::RGB(8), DecodingResult::U8(v)) => DynamicImage::ImageRgb8(image::RgbImage::from_raw(w, h, v)?),
         (ColorType::RGBA(8), DecodingResult::U8(v)) => DynamicImage::ImageRgba8(image::RgbaImage::from_raw(w, h, v)?),
-        (ColorType::RGB(16), DecodingResult::U16(v)) => DynamicImage::ImageRgb16(image::ImageBuffer::from_raw(w, h, v)?),
+        (ColorType::RGB(16), DecodingResult::U16(v)) => {
+            DynamicImage::ImageRgb16(image::ImageBuffer::from_raw(w, h, v)?)
+        }
         (ColorType::RGBA(16), DecodingResult::U16(v)) => {
             DynamicImage::ImageRgba16(image::ImageBuffer::from_raw(w, h, v)?)
         }
@@ -201,7 +229,8 @@ fn to_gray(colour: ColorType, data: DecodingResult, (w, h): (u32, u32)) -> Optio
 pub(crate) fn open(path: &Path, max_pixels: u64) -> Result<CameraFile> {
     let map = map(path)?;
     let b: &[u8] = &map;
-    let form = Form::of(b).ok_or_else(|| header_error(path, "TIFF header", "not a TIFF file (no II*/MM* signature)"))?;
+    let form =
+        Form::of(b).ok_or_else(|| header_error(path, "TIFF header", "not a TIFF file (no II*/MM* signature)"))?;
     let mut ifds = Vec::new();
     let mut seen = std::collections::HashSet::new();
     let mut next = form.first_ifd(b).unwrap_or(0);
@@ -250,6 +279,7 @@ pub(crate) fn open(path: &Path, max_pixels: u64) -> Result<CameraFile> {
         ..CameraInfo::default()
     };
     Ok(CameraFile {
+        sources: vec![path.into()],
         path: path.into(),
         data_path: path.into(),
         layout: Layout::Tiff(pages),

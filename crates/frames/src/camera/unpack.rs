@@ -120,7 +120,9 @@ impl Packing {
                 } else {
                     unpack_all(src, &mut out);
                 }
-                crate::GrayPixels::U16(crate::Gray16Image::from_raw(width, height, out).expect("size checked by caller"))
+                crate::GrayPixels::U16(
+                    crate::Gray16Image::from_raw(width, height, out).expect("size checked by caller"),
+                )
             }
         }
     }

@@ -60,7 +60,13 @@ impl Mraw {
                 "#Camera Information Header\nCamera Type : {}\nRecord Rate(fps) : {}\nShutter Speed(s) : 1/{}\n\
                  Total Frame : {frames}\nStart Frame : {}\nImage Width : {}\nImage Height : {}\nColor Type : Mono\n\
                  Color Bit : {}\nFile Format : MRaw\nEffectiveBit Depth : {}\nEffectiveBit Side : Lower\n\nEND\n",
-                self.model, self.fps, self.shutter_per_s, self.start_frame, self.width, self.height, self.bits,
+                self.model,
+                self.fps,
+                self.shutter_per_s,
+                self.start_frame,
+                self.width,
+                self.height,
+                self.bits,
                 self.effective
             )
             .into_bytes(),
@@ -126,7 +132,13 @@ pub fn pack(samples: &[u16], bits: u32, _unused: bool) -> Vec<u8> {
             .chunks_exact(4)
             .flat_map(|p| {
                 let v = (u64::from(p[0]) << 30) | (u64::from(p[1]) << 20) | (u64::from(p[2]) << 10) | u64::from(p[3]);
-                [(v >> 32) as u8, (v >> 24) as u8, (v >> 16) as u8, (v >> 8) as u8, v as u8]
+                [
+                    (v >> 32) as u8,
+                    (v >> 24) as u8,
+                    (v >> 16) as u8,
+                    (v >> 8) as u8,
+                    v as u8,
+                ]
             })
             .collect(),
         other => panic!("pack: {other} bits"),
@@ -200,8 +212,9 @@ impl Cine {
         let (off_bitmap, off_setup) = (44usize, 84usize);
         let off_offsets = off_setup + SETUP_LEN;
         let first_image = off_offsets + 8 * frames.len();
-        let images: Vec<usize> =
-            (0..frames.len()).map(|k| first_image + k * (self.annotation as usize + image_bytes)).collect();
+        let images: Vec<usize> = (0..frames.len())
+            .map(|k| first_image + k * (self.annotation as usize + image_bytes))
+            .collect();
         let mut out = Vec::with_capacity(first_image + frames.len() * (image_bytes + 8));
         out.extend(b"CI");
         out.extend(44u16.to_le_bytes());
@@ -301,7 +314,9 @@ pub fn write_tiff_stack(path: &Path, width: u32, height: u32, bits: u32, frames:
 pub fn moving_disc(width: u32, height: u32, count: usize, max: u16, seed: u64) -> Vec<Vec<u16>> {
     let mut s = seed;
     let mut next = move || {
-        s = s.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+        s = s
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
         (s >> 33) as u32
     };
     (0..count)
@@ -315,7 +330,11 @@ pub fn moving_disc(width: u32, height: u32, count: usize, max: u16, seed: u64) -
                 .flat_map(|y| (0..width).map(move |x| (x, y)))
                 .map(|(x, y)| {
                     let d = ((f64::from(x) - cx).powi(2) + (f64::from(y) - cy).powi(2)).sqrt();
-                    let base = if d < r { 0.85 } else { 0.2 + 0.3 * f64::from(y) / f64::from(height) };
+                    let base = if d < r {
+                        0.85
+                    } else {
+                        0.2 + 0.3 * f64::from(y) / f64::from(height)
+                    };
                     let noise = f64::from(next() % 1000) / 1000.0 * 0.05;
                     ((base + noise).min(1.0) * f64::from(max)).round() as u16
                 })
