@@ -131,7 +131,16 @@ impl Frames {
     /// Lists a folder (or opens the camera file) at `path`.
     pub(crate) fn probe(path: &Path, max_pixels: u64) -> Result<Self> {
         if path.is_dir() {
-            let files = list_frames(path)?;
+            let files = match list_frames(path) {
+                // A folder holding no frame files but one camera file is that camera file.
+                Err(FramesError::NoFrames { dir }) => {
+                    return match lone_camera_file(&dir) {
+                        Some((file, kind)) => Self::camera(&file, kind, max_pixels),
+                        None => Err(FramesError::NoFrames { dir }),
+                    };
+                }
+                other => other?,
+            };
             // A folder holding one multi-page TIFF is that stack.
             if let [only] = &files[..] {
                 if FrameFormat::from_path(&only.path) == Some(FrameFormat::Tiff) && tiff_is_stack(&only.path)? {
@@ -180,6 +189,24 @@ impl Frames {
     }
 }
 
+/// The one camera file (Photron header and data counted once; no video) in a folder, if there is exactly one.
+fn lone_camera_file(dir: &Path) -> Option<(PathBuf, Kind)> {
+    let mut found: Vec<PathBuf> = std::fs::read_dir(dir)
+        .ok()?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.is_file()
+                && p.file_name().and_then(|n| n.to_str()).is_some_and(|n| !n.starts_with('.'))
+                && Kind::of(p).is_some_and(|k| k != Kind::Video)
+        })
+        .collect();
+    found.sort();
+    match &crate::session::photron_grouped(found)[..] {
+        [one] => Kind::of(one).map(|k| (one.clone(), k)),
+        _ => None,
+    }
+}
+
 /// True if the TIFF file at `path` has more than one page (through a memory map: only its header and first
 /// directory are read).
 fn tiff_is_stack(path: &Path) -> Result<bool> {
@@ -214,7 +241,8 @@ impl Clip {
     /// A folder: lists every supported image file (`.png .tif .tiff .bmp .pgm .ppm .pnm .jpg .jpeg`, any
     /// case; the formats may be mixed) and ignores everything else, including hidden files. Orders them by
     /// the last number in the file name, finds the dropped frames and reads the first frame's header for the
-    /// clip's size. A folder whose only frame file is a multi-page TIFF is that stack.
+    /// clip's size. A folder whose only frame file is a multi-page TIFF is that stack; a folder with no frame
+    /// files but one camera file is that camera file.
     ///
     /// A camera file (`.cihx`/`.cih`/`.mraw`, `.cine`, `.tif`/`.tiff`): reads its header and checks it
     /// against the data (see [`CameraInfo`]); one frame per stored image, indexed from 0.

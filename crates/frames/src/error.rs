@@ -163,7 +163,7 @@ pub enum FramesError {
     },
     /// The clip folder holds no frame files.
     #[error(
-        "{}: no frames in this folder (looked for .png, .tif, .tiff, .bmp, .pgm, .ppm, .pnm, .jpg, .jpeg)",
+        "{}: no frames in this folder (looked for .png, .tif, .tiff, .bmp, .pgm, .ppm, .pnm, .jpg, .jpeg, or one camera file: .cihx/.cih/.mraw, .cine)",
         dir.display()
     )]
     NoFrames {

@@ -223,6 +223,20 @@ fn a_folder_holding_only_a_stack_is_that_stack_and_a_stack_among_frames_is_refus
 }
 
 #[test]
+fn a_folder_holding_one_camera_file_is_that_file() {
+    let tmp = tempfile::tempdir().unwrap();
+    let frames = moving_disc(16, 8, 3, 4095, 1);
+    let dir = tmp.path().join("shot");
+    Mraw::new(16, 8, 12).write(&dir, "take", &frames);
+    let clip = Clip::open(&dir).unwrap();
+    assert_eq!((clip.len(), clip.camera().format), (3, SourceFormat::PhotronMraw));
+    assert_eq!(u16s(&read_all(&clip, 1)[2].pixels), frames[2].iter().map(|v| v << 4).collect::<Vec<_>>());
+    Cine::new(16, 8, CinePacking::U8).write(&dir.join("other.cine"), &moving_disc(16, 8, 2, 255, 1));
+    let err = Clip::open(&dir).unwrap_err();
+    assert!(matches!(err, FramesError::NoFrames { .. }), "two camera files: {err:?}");
+}
+
+#[test]
 fn header_fps_beats_session_toml_and_loses_to_clip_toml_and_the_command_line() {
     let tmp = tempfile::tempdir().unwrap();
     let spec = Cine::new(8, 8, CinePacking::U8);
