@@ -34,12 +34,18 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     let mut o = InitOptions::default();
     (o.diameter_m, o.mass_kg, o.force) = (a.diameter, a.mass, a.force);
-    o.downslope = if a.downslope == "-x" { Downslope::MinusX } else { Downslope::PlusX };
+    o.downslope = if a.downslope == "-x" {
+        Downslope::MinusX
+    } else {
+        Downslope::PlusX
+    };
     let written = draft.write(&o)?;
     println!("{} clip(s) in {}:", draft.clips.len(), a.dir.display());
     let cell = |x: Option<f64>| x.map_or_else(|| "?".to_string(), |v| v.to_string());
     for c in &draft.clips {
-        let fps = c.fps.map_or_else(|| "no header fps".to_string(), |f| format!("{f} fps"));
+        let fps = c
+            .fps
+            .map_or_else(|| "no header fps".to_string(), |f| format!("{f} fps"));
         let frames = c.frames.map_or_else(|| "?".to_string(), |n| n.to_string());
         println!(
             "  {:<32} {:?}, {frames} frames, {fps}; surface {}, angle {}, height {}",
@@ -73,7 +79,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         todo.push(&cells);
     }
     if todo.is_empty() {
-        println!("next: check the guesses in clips.csv, then `bouncelab analyze {}`", a.dir.display());
+        println!(
+            "next: check the guesses in clips.csv, then `bouncelab analyze {}`",
+            a.dir.display()
+        );
     } else {
         println!(
             "next: fill {}, then `bouncelab analyze {}`",

@@ -196,7 +196,9 @@ fn lone_camera_file(dir: &Path) -> Option<(PathBuf, Kind)> {
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| {
             p.is_file()
-                && p.file_name().and_then(|n| n.to_str()).is_some_and(|n| !n.starts_with('.'))
+                && p.file_name()
+                    .and_then(|n| n.to_str())
+                    .is_some_and(|n| !n.starts_with('.'))
                 && Kind::of(p).is_some_and(|k| k != Kind::Video)
         })
         .collect();

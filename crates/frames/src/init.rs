@@ -26,11 +26,21 @@ const GENERIC: [&str; 16] = [
     "img", "image",
 ];
 
+/// A word that may name a surface: two or more letters, then optional digits (`clay`, `tape1`), not a
+/// generic word; `r1`, `s001` and camera counters such as `c001h001s0001` are not.
+fn surface_word(t: &str) -> Option<String> {
+    let letters = t.bytes().take_while(u8::is_ascii_alphabetic).count();
+    let rest = &t[letters..];
+    (letters >= 2 && rest.bytes().all(|b| b.is_ascii_digit()) && !GENERIC.contains(&&t[..letters]))
+        .then(|| t.to_string())
+}
+
 /// Guesses surface, angle and drop height from a clip name such as `clay_15deg_550mm` or `tape-0deg-1.2m-03`.
 ///
 /// The name (without its extension) is split at `_`, `-` and spaces. A word `<number>deg` (or `°`) is the
-/// angle; `<number>mm`, `cm` or `m` the drop height; the remaining purely alphabetic words, less generic ones,
-/// form the surface — only when an angle or a height was found too, so that `shot_01` guesses nothing.
+/// angle; `<number>mm`, `cm` or `m` the drop height; the remaining words of two or more letters (optionally
+/// followed by digits: `tape1`), less generic ones (`shot`, `run` …) and repeats, form the surface — only
+/// when an angle or a height was found too, so that `shot_01` guesses nothing.
 pub fn guess_from_name(name: &str) -> NameGuess {
     let mut g = NameGuess::default();
     let mut words = Vec::new();
@@ -49,8 +59,10 @@ pub fn guess_from_name(name: &str) -> NameGuess {
             g.drop_height_m.get_or_insert(h / 100.0);
         } else if let Some(h) = num("m") {
             g.drop_height_m.get_or_insert(h);
-        } else if t.chars().all(|c| c.is_ascii_alphabetic()) && !GENERIC.contains(&t.as_str()) {
-            words.push(t);
+        } else if let Some(word) = surface_word(&t) {
+            if !words.contains(&word) {
+                words.push(word);
+            }
         }
     }
     if (g.angle_deg.is_some() || g.drop_height_m.is_some()) && !words.is_empty() {
@@ -332,5 +344,9 @@ mod tests {
         assert_eq!(guess_from_name("shot_01"), NameGuess::default());
         assert_eq!(guess_from_name("ball_12bit"), NameGuess::default());
         assert_eq!(guess_from_name("C001H001S0001").surface, None);
+        let g = guess_from_name("S002_tape1_15deg_250mm_r1");
+        assert_eq!(g.surface.as_deref(), Some("tape1"));
+        assert_eq!((g.angle_deg, g.drop_height_m), (Some(15.0), Some(0.25)));
+        assert_eq!(guess_from_name("run2_clay_clay_0deg").surface.as_deref(), Some("clay"));
     }
 }

@@ -230,7 +230,10 @@ fn a_folder_holding_one_camera_file_is_that_file() {
     Mraw::new(16, 8, 12).write(&dir, "take", &frames);
     let clip = Clip::open(&dir).unwrap();
     assert_eq!((clip.len(), clip.camera().format), (3, SourceFormat::PhotronMraw));
-    assert_eq!(u16s(&read_all(&clip, 1)[2].pixels), frames[2].iter().map(|v| v << 4).collect::<Vec<_>>());
+    assert_eq!(
+        u16s(&read_all(&clip, 1)[2].pixels),
+        frames[2].iter().map(|v| v << 4).collect::<Vec<_>>()
+    );
     Cine::new(16, 8, CinePacking::U8).write(&dir.join("other.cine"), &moving_disc(16, 8, 2, 255, 1));
     let err = Clip::open(&dir).unwrap_err();
     assert!(matches!(err, FramesError::NoFrames { .. }), "two camera files: {err:?}");

@@ -100,12 +100,19 @@ pub fn fingerprint_clip_dir(dir: &Path, settings: &str, mode: ClipFingerprint) -
         move |source| StoreError::Io { path, source }
     };
     let (folder, prefix) = if dir.is_file() {
-        let stem = dir.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let stem = dir
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
         (dir.parent().unwrap_or(Path::new(".")), Some(format!("{stem}.")))
     } else {
         (dir, None)
     };
-    let folder = if folder.as_os_str().is_empty() { Path::new(".") } else { folder };
+    let folder = if folder.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        folder
+    };
     let mut files = Vec::new();
     for entry in fs::read_dir(folder).map_err(io(dir))? {
         let entry = entry.map_err(io(dir))?;

