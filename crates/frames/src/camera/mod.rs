@@ -203,7 +203,11 @@ pub(crate) fn map(path: &Path) -> Result<memmap2::Mmap> {
     // SAFETY: the map is read-only and private to this process. If another program truncates or rewrites
     // the file while it is mapped, reads may see the new bytes or fault; camera files are not written while
     // they are analysed, and every offset read from the map is checked against its length first.
-    unsafe { memmap2::Mmap::map(&file) }.map_err(io)
+    let map = unsafe { memmap2::Mmap::map(&file) }.map_err(io)?;
+    // Frames are mostly read in order: let the kernel read ahead and drop pages behind. Only a hint.
+    #[cfg(unix)]
+    let _ = map.advise(memmap2::Advice::Sequential);
+    Ok(map)
 }
 
 fn header_error(path: &Path, field: &str, problem: impl Into<String>) -> FramesError {
