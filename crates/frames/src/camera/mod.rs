@@ -25,6 +25,10 @@ use crate::settings::Warning;
 /// Largest frame accepted by default, in pixels (8192 × 8192).
 pub const DEFAULT_MAX_FRAME_PIXELS: u64 = 1 << 26;
 
+/// Most frames accepted in one camera file: the frame list is allocated from the header's count (checked
+/// against the file's length first), so a tiny frame size must not make it unbounded.
+pub(crate) const MAX_FRAMES: usize = 10_000_000;
+
 /// What a clip is stored as.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -139,12 +143,20 @@ pub(crate) struct CameraFile {
 impl CameraFile {
     /// Opens a camera file of a known kind.
     pub(crate) fn open(path: &Path, kind: Kind, max_pixels: u64) -> Result<Self> {
-        match kind {
+        let cam = match kind {
             Kind::Photron => photron::open(path, max_pixels),
             Kind::Cine => cine::open(path, max_pixels),
             Kind::Tiff => tiffstack::open(path, max_pixels),
             Kind::Video => Err(video_error(path)),
+        }?;
+        if cam.count > MAX_FRAMES {
+            return Err(header_error(
+                path,
+                "frame count",
+                format!("{} frames is over the limit of {MAX_FRAMES} frames a file", cam.count),
+            ));
         }
+        Ok(cam)
     }
 
     /// Decodes the frame at position `k` (0-based).
