@@ -5,6 +5,7 @@ pub mod demo;
 pub mod diagnose;
 pub mod effects;
 pub mod estimate;
+pub mod init;
 pub mod model;
 pub mod overlay;
 pub mod render;
