@@ -356,7 +356,7 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
     let contact = &points[first..=last];
     let (t_max, delta_max) = deepest(contact, radius, sigma_level, rel_scale);
     let mut notes = choice.notes;
-    let mut flags = Vec::new();
+    let mut flags = impossible(vin[1].value, vout[1].value, cor, mu, t_touch.value, t_sep.value);
     let gravity = gravity_check(&incoming, &outgoing, a, c.gravity);
     if let Some(g) = &gravity {
         if !g.consistent {
@@ -419,6 +419,29 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
         flags,
         notes,
     })
+}
+
+/// What no bounce of a ball can give, each as a sentence: the ball must come in towards the surface and leave
+/// it, with COR in [0, 1.05] (a little over 1 for the measurement's error), a contact of 0.1–50 ms that
+/// starts before it ends, and |μ_eff| ≤ 1.5.
+fn impossible(v_in_n: f64, v_out_n: f64, cor: f64, mu: f64, t_touch: f64, t_sep: f64) -> Vec<String> {
+    let mut flags = Vec::new();
+    if !(v_in_n < 0.0 && v_out_n > 0.0) {
+        flags.push(format!(
+            "the normal velocity is {v_in_n:.3} m/s in and {v_out_n:.3} m/s out: the ball does not come in and go out"
+        ));
+    }
+    if !(0.0..=1.05).contains(&cor) {
+        flags.push(format!("COR {cor:.3} is impossible (it lies in 0–1)"));
+    }
+    let contact_ms = (t_sep - t_touch) * 1e3;
+    if !(0.1..=50.0).contains(&contact_ms) {
+        flags.push(format!("a contact of {contact_ms:.3} ms is impossible for a ball (0.1–50 ms)"));
+    }
+    if !(mu.abs() <= 1.5) {
+        flags.push(format!("μ_eff {mu:.3} is implausible (|μ_eff| ≤ 1.5)"));
+    }
+    flags
 }
 
 /// The flights fitted with their acceleration free, weighted together, against gravity's `expected`

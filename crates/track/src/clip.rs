@@ -6,9 +6,8 @@
 //! round things (screw heads, fixtures, a second ball at rest) by its motion: it is the circle that moved
 //! between two frames.
 
-use crate::hough::CircleDetection;
+use crate::refine::{EdgeSearch, NOISY_SIGMA};
 use crate::plane::{Pixel, Plane};
-use crate::refine::refined_candidates;
 use crate::local::SurfaceFrame;
 use crate::surface::SurfaceLine;
 use crate::tracker::{BallFix, CLEAN_QUALITY, Status, TrackOptions, Tracker};
@@ -179,7 +178,7 @@ impl Track {
     }
 }
 
-fn with_plane<R>(px: &GrayPixels, gain: f32, f: impl FnOnce(PlaneRef<'_>) -> R) -> R {
+pub(crate) fn with_plane<R>(px: &GrayPixels, gain: f32, f: impl FnOnce(PlaneRef<'_>) -> R) -> R {
     let (w, h) = (px.width() as usize, px.height() as usize);
     match px {
         GrayPixels::U8(img) => f(PlaneRef::U8(Plane::new(img.as_raw(), w, h).with_gain(gain))),
@@ -188,133 +187,21 @@ fn with_plane<R>(px: &GrayPixels, gain: f32, f: impl FnOnce(PlaneRef<'_>) -> R) 
 }
 
 /// A plane of either bit depth.
-enum PlaneRef<'a> {
+pub(crate) enum PlaneRef<'a> {
     U8(Plane<'a, u8>),
     U16(Plane<'a, u16>),
 }
 
+/// Runs `$body` with `$v` bound to the plane, whatever its bit depth.
 macro_rules! on_plane {
     ($p:expr, $v:ident => $body:expr) => {
         match $p {
-            PlaneRef::U8($v) => $body,
-            PlaneRef::U16($v) => $body,
+            $crate::clip::PlaneRef::U8($v) => $body,
+            $crate::clip::PlaneRef::U16($v) => $body,
         }
     };
 }
-
-/// The ball seen at (t, x, y): s, px, px.
-type Sighting = (f64, f64, f64);
-
-/// What acquisition learnt: the ball's radius range in px, and two positions (t, x, y).
-struct Acquired {
-    radius: (f64, f64),
-    seed: (Sighting, Sighting),
-}
-
-/// The smallest ball radius searched without a scale, px: below it a ball's rim has too few pixels for a
-/// sub-pixel circle.
-pub const MIN_BALL_RADIUS_PX: f64 = 8.0;
-
-/// The least quality of a circle that acquisition considers.
-const CANDIDATE_QUALITY: f64 = 0.6;
-
-/// The ball's radius range in px and two sightings, told from other circles by its motion between two
-/// frames: the clean circle that moved. A circle that does not move (a screw head, a mark, a fixture, a ball
-/// at rest) is never taken for the ball; when nothing moves, the error lists the static circles seen. With a
-/// scale hint only radii within ±20 % of the ball's are searched.
-fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32) -> Result<Acquired, TrackError> {
-    let n = clip.len();
-    let (w, h) = clip.dimensions();
-    let (min_radius, max_radius) = match opts.scale_hint_m_per_px {
-        Some(scale) => {
-            let r = opts.ball_diameter_m / (2.0 * scale);
-            (0.8 * r, 1.2 * r)
-        }
-        None => (MIN_BALL_RADIUS_PX, w.min(h) as f64 / 2.0),
-    };
-    let read = |k: usize| clip.read(k, opts.read.png_decoder).expect("index in range");
-    let gap = 10.min(n.saturating_sub(1)).max(1);
-    let mut k = 0;
-    // The clearest circles that did not move, for the error: (x, y, r).
-    let mut still: Vec<(f64, f64, f64, f64)> = Vec::new();
-    while k + gap < n && k <= n / 2 {
-        let (frame_a, frame_b) = (read(k)?, read(k + gap)?);
-        // An octave of radii at a time, largest first: the large bands are searched on coarse images and
-        // cost little, so a ball of any usual size is found before the full-resolution search for small
-        // circles is needed; and the ball's rim comes before the smaller circles drawn on it (a seam).
-        for (lo, hi) in crate::hough::radius_bands(min_radius, max_radius) {
-            let det = CircleDetection {
-                min_radius: lo,
-                max_radius: hi,
-                // A seam drawn as a dark line can out-vote the rim: keep enough candidates for the rim to be
-                // among them.
-                max_candidates: 24,
-                ..CircleDetection::default()
-            };
-            let circles_in = |frame: &bouncelab_frames::Frame| -> Vec<crate::Circle> {
-                let found = with_plane(
-                    &frame.pixels,
-                    gain,
-                    |p| on_plane!(p, p => refined_candidates(&p, &det, &opts.tracker.search, None, CANDIDATE_QUALITY)),
-                );
-                found.into_iter().map(|(c, _)| c).collect()
-            };
-            let (a, b) = (circles_in(&frame_a), circles_in(&frame_b));
-            // Both ends of a pair must be clean circles (a ball's rim refines to a quality near 1; a seam or a
-            // texture ghost does not), or the seed would start the track on the wrong circle.
-            let good = |c: &&crate::Circle| c.support > CLEAN_QUALITY;
-            // Circles that moved between the two frames, with their positions in both.
-            let mut moving: Vec<(crate::Circle, crate::Circle)> = Vec::new();
-            for ca in a.iter().filter(good) {
-                for cb in b.iter().filter(good) {
-                    let same_size = (ca.r - cb.r).abs() <= 0.05 * ca.r + 1.0;
-                    let moved = (ca.x - cb.x).hypot(ca.y - cb.y);
-                    if same_size && moved > 1.5 && moved < 0.5 * w as f64 {
-                        moving.push((*ca, *cb));
-                    }
-                }
-            }
-            let best = moving
-                .iter()
-                .max_by(|p, q| p.0.support.min(p.1.support).total_cmp(&q.0.support.min(q.1.support)))
-                .map(|(ca, cb)| (ca.support, *ca, *cb));
-            if let Some((_, ca, cb)) = best {
-                let r = 0.5 * (ca.r + cb.r);
-                // `k` counts files; time follows frame indices, which count dropped frames too.
-                let t = |pos: usize| clip.time_of(clip.files()[pos].index);
-                let seed = ((t(k), ca.x, ca.y), (t(k + gap), cb.x, cb.y));
-                return Ok(Acquired {
-                    radius: (0.85 * r, 1.15 * r),
-                    seed,
-                });
-            }
-            for c in a.iter().filter(good) {
-                if !still.iter().any(|s| (s.0 - c.x).hypot(s.1 - c.y) < 0.5 * c.r) {
-                    still.push((c.x, c.y, c.r, c.support));
-                }
-            }
-        }
-        k += gap;
-    }
-    still.sort_by(|p, q| q.3.total_cmp(&p.3));
-    let clip_name = clip.dir().display().to_string();
-    if still.is_empty() {
-        return Err(TrackError::NoBall {
-            clip: clip_name,
-            min_radius,
-            max_radius,
-        });
-    }
-    Err(TrackError::NothingMoves {
-        clip: clip_name,
-        circles: still
-            .iter()
-            .take(3)
-            .map(|c| format!("radius {:.1} px at ({:.0}, {:.0})", c.2, c.0, c.1))
-            .collect::<Vec<_>>()
-            .join(", "),
-    })
-}
+pub(crate) use on_plane;
 
 /// Tracks the ball through `clip`. `progress` is called with (frames done, frames total).
 pub fn track_clip(
@@ -325,16 +212,33 @@ pub fn track_clip(
     let mut warnings = Vec::new();
     // The stream starts decoding at once, so its first frames are ready when acquisition is done.
     let frames = clip.frames_with(&opts.read)?;
-    let gain = match clip.read(0, opts.read.png_decoder) {
-        Some(first) => with_plane(&first?.pixels, 1.0, |p| on_plane!(p, p => crate::plane::level_gain(&p))),
-        None => 1.0,
+    let (gain, noise) = match clip.read(0, opts.read.png_decoder) {
+        Some(first) => {
+            let first = first?;
+            let gain = with_plane(&first.pixels, 1.0, |p| on_plane!(p, p => crate::plane::level_gain(&p)));
+            let noise = with_plane(&first.pixels, gain, |p| on_plane!(p, p => crate::plane::noise_sigma(&p)));
+            (gain, noise)
+        }
+        None => (1.0, 0.0),
     };
+    // In heavy sensor noise a ray's largest step is as often a noise spike as the rim: sample the rays smoothed.
+    let noisy = ClipTracking {
+        tracker: TrackOptions {
+            search: EdgeSearch {
+                smooth: opts.tracker.search.smooth || noise > NOISY_SIGMA,
+                ..opts.tracker.search.clone()
+            },
+            ..opts.tracker.clone()
+        },
+        ..opts.clone()
+    };
+    let opts = &noisy;
     if gain >= 2.0 {
         warnings.push(format!(
             "the frames use little of their gray scale: levels stretched {gain:.1}× for the ball and line searches"
         ));
     }
-    let Acquired { radius, seed } = acquire(clip, opts, gain)?;
+    let crate::acquire::Acquired { radius, seed } = crate::acquire::acquire(clip, opts, gain, noise)?;
     let mut tracker = Tracker::new(TrackOptions {
         radius_px: Some(radius),
         ..opts.tracker.clone()
@@ -500,12 +404,28 @@ pub(crate) fn scale_from(
     edge_definition_px: f64,
     rim_shape_rms_px: f64,
 ) -> Option<Scale> {
-    let radii: Vec<f64> = fixes
+    let clear_of_line: Vec<f64> = fixes
         .iter()
         .filter(|f| f.status == Status::Ok)
         .filter(|f| surface.is_none_or(|l| f.y_px + f.r_px < l.y_at(f.x_px) - 3.0))
         .map(|f| f.r_px)
         .collect();
+    // A line the ball never clears is not where it lands (the estimator will say so): the frames well above
+    // the lowest centre (half a radius, where no contact flattens the ball) then give the radius.
+    let radii = if clear_of_line.len() >= 3 {
+        clear_of_line
+    } else {
+        let lowest = fixes
+            .iter()
+            .filter(|f| f.status.measured())
+            .map(|f| f.y_px)
+            .fold(f64::NEG_INFINITY, f64::max);
+        fixes
+            .iter()
+            .filter(|f| f.status == Status::Ok && f.y_px < lowest - 0.5 * f.r_px)
+            .map(|f| f.r_px)
+            .collect()
+    };
     if radii.len() < 3 {
         return None;
     }

@@ -20,6 +20,11 @@ pub struct CircleDetection {
     pub edge_fraction: f64,
     /// Most candidates returned per octave of radius (default 8).
     pub max_candidates: usize,
+    /// The frame's noise σ, 0–255 scale, when known: then every gradient standing 4σ of the Sobel's noise
+    /// above it votes, instead of only the strongest `edge_fraction` (default `None`). A soft, dim rim in a
+    /// cluttered frame (rulers, seams, a hand) is outshone by the clutter's edges but stands well out of the
+    /// noise; the price is many more votes on textured frames.
+    pub noise_sigma: Option<f64>,
 }
 
 impl Default for CircleDetection {
@@ -29,6 +34,7 @@ impl Default for CircleDetection {
             max_radius: 200.0,
             edge_fraction: 0.06,
             max_candidates: 8,
+            noise_sigma: None,
         }
     }
 }
@@ -116,7 +122,9 @@ pub fn detect_circles<P: Pixel>(img: &Plane<P>, opts: &CircleDetection) -> Vec<C
         if !scales.iter().any(|s| s.0 == f) {
             let (p, w, h) = downsample(img, f);
             let g = sobel(&p, w, h);
-            let edges = strong_edges(&g, opts.edge_fraction);
+            // Downsampling by f averages f² pixels; a Sobel component sums 12 of them with weights ±1, ±2.
+            let floor = opts.noise_sigma.map(|s| (4.0 * 12f64.sqrt() * s / f as f64) as f32);
+            let edges = strong_edges(&g, opts.edge_fraction, floor);
             scales.push((f, g, edges));
         }
         let (_, g, edges) = scales.iter().find(|s| s.0 == f).expect("just added");
@@ -192,7 +200,7 @@ fn detect_band(
         }
     }
     let acc = box3(&acc, w, h);
-    let peaks = local_maxima(&acc, w, h, (rmin * 0.5).max(2.0) as usize, max_candidates * 3);
+    let peaks = local_maxima(&acc, w, h, (rmin * 0.25).max(2.0) as usize, max_candidates * 8);
     let mut out: Vec<Circle> = peaks
         .into_iter()
         .filter_map(|(cx, cy)| radius_at(g, edges, cx, cy, rmin, rmax))
@@ -208,15 +216,16 @@ fn detect_band(
     out
 }
 
-/// Indices of the strongest `fraction` of gradient magnitudes that are also local maxima across the edge.
-fn strong_edges(g: &Gradients, fraction: f64) -> Vec<usize> {
+/// Indices of the gradient magnitudes above the strongest `fraction`'s threshold, or above `floor` when given,
+/// that are also local maxima across the edge.
+fn strong_edges(g: &Gradients, fraction: f64, floor: Option<f32>) -> Vec<usize> {
     let mut mags: Vec<f32> = g.mag.iter().copied().filter(|m| *m > 0.0).collect();
     if mags.is_empty() {
         return Vec::new();
     }
     let k = ((mags.len() as f64 * (1.0 - fraction.clamp(0.001, 1.0))) as usize).min(mags.len() - 1);
     let (_, thr, _) = mags.select_nth_unstable_by(k, f32::total_cmp);
-    let thr = thr.max(1e-3);
+    let thr = floor.unwrap_or(*thr).max(1e-3);
     let w = g.w;
     let mut out = Vec::new();
     for y in 1..g.h.saturating_sub(1) {

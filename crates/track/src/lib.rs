@@ -10,6 +10,7 @@
 //!
 //! Everything works on [`Plane`], a borrowed 8- or 16-bit grayscale image, so no frame is copied.
 
+mod acquire;
 mod clip;
 mod fit;
 mod hough;
@@ -27,7 +28,9 @@ pub use fit::{CircleFit, fit_circle};
 pub use local::SurfaceFrame;
 pub use hough::{Circle, CircleDetection, detect_circles, outermost, radius_bands};
 pub use plane::{Pixel, Plane};
-pub use refine::{EdgeSearch, Refined, RimShape, RimShapeLearner, refine_circle, refined_candidates, rim_residuals};
+pub use refine::{
+    EdgeSearch, Refined, RimShape, RimShapeLearner, refine_candidates, refine_circle, refined_candidates, rim_residuals,
+};
 pub use surface::{LineCue, SurfaceLine, SurfaceLines, find_surface_line, find_surface_lines};
 pub use texture::{horizontal_gradient_energy, texture_line, texture_lines};
 pub use tracker::{BallFix, Status, TrackOptions, Tracker};

@@ -30,7 +30,15 @@ pub struct EdgeSearch {
     /// The rim's own shape (see [`RimShape`]), subtracted from each ray's edge distance; `None` for a
     /// perfect circle (default).
     pub rim_shape: Option<RimShape>,
+    /// Sample the rays through a 3 × 3 binomial filter ([`Plane::sample_smooth_inside`]): in heavy sensor
+    /// noise a single noisy sample otherwise out-steps a soft rim (default false; the clip tracker turns it
+    /// on when a frame's noise exceeds [`NOISY_SIGMA`]).
+    pub smooth: bool,
 }
+
+/// Sensor noise σ (0–255 scale) above which rays are sampled smoothed: where the per-sample noise of a
+/// central difference reaches the step of a soft, dim rim (a few DN per px).
+pub const NOISY_SIGMA: f32 = 5.0;
 
 impl Default for EdgeSearch {
     fn default() -> Self {
@@ -42,6 +50,7 @@ impl Default for EdgeSearch {
             surface_margin: 2.0,
             edge_definition: false,
             rim_shape: None,
+            smooth: false,
         }
     }
 }
@@ -344,11 +353,12 @@ fn refine_once<P: Pixel>(
                 }
             }
         }
-        // A straight segment is inside the image when both its ends are.
+        // A straight segment is inside the image when both its ends are (with the smoothing's half pixel).
         let end = start + (len - 1) as f64 * search.step;
+        let m = if search.smooth { 0.51 } else { 0.01 };
         let inside = |d: f64| {
             let (px, py) = (x + d * c, y + d * s);
-            px >= 0.01 && py >= 0.01 && px < wmax - 0.01 && py < hmax - 0.01
+            px >= m && py >= m && px < wmax - m && py < hmax - m
         };
         if !inside(start) || !inside(end) {
             outside += 1;
@@ -357,12 +367,19 @@ fn refine_once<P: Pixel>(
         let profile = &mut profile[..len];
         let (mut px, mut py) = ((x + start * c) as f32, (y + start * s) as f32);
         let (sx, sy) = ((search.step * c) as f32, (search.step * s) as f32);
-        for p in profile.iter_mut() {
-            *p = img.sample_inside(px, py);
-            px += sx;
-            py += sy;
+        if search.smooth {
+            for p in profile.iter_mut() {
+                *p = img.sample_smooth_inside(px, py);
+                px += sx;
+                py += sy;
+            }
+        } else {
+            for p in profile.iter_mut() {
+                *p = img.sample_inside(px, py);
+                px += sx;
+                py += sy;
+            }
         }
-        // Central differences; the edge is the largest |change|.
         let (mut best, mut best_j) = (0.0f32, 0);
         for j in 1..len - 1 {
             let d = (profile[j + 1] - profile[j - 1]).abs();
@@ -476,14 +493,28 @@ pub fn refined_candidates<P: Pixel>(
     surface: Option<&SurfaceLine>,
     min_quality: f64,
 ) -> Vec<(crate::Circle, Refined)> {
-    let wide = EdgeSearch {
-        half_width: search.half_width.max(6.0),
-        ..search.clone()
-    };
     // Most vote peaks are texture, not circles. Each is first followed to where it settles with a quarter of
     // the rays (the wide, re-centring searches are most of the cost), and only a peak that is still a
     // plausible circle there (half the quality asked for: a quarter of the rays measures the kept fraction to
     // about ±0.08) is measured with every ray.
+    refine_candidates(img, crate::detect_circles(img, detection), detection, search, surface, min_quality)
+}
+
+/// [`refined_candidates`] from vote peaks found elsewhere (e.g. on the part of the frame that moves): each
+/// peak refined on `img` (followed with a quarter of the rays, grown out to a containing rim, measured with
+/// every ray), duplicates merged, nested and seam-like circles dropped. Best first.
+pub fn refine_candidates<P: Pixel>(
+    img: &Plane<P>,
+    peaks: Vec<crate::Circle>,
+    detection: &crate::CircleDetection,
+    search: &EdgeSearch,
+    surface: Option<&SurfaceLine>,
+    min_quality: f64,
+) -> Vec<(crate::Circle, Refined)> {
+    let wide = EdgeSearch {
+        half_width: search.half_width.max(6.0),
+        ..search.clone()
+    };
     let screen = EdgeSearch {
         rays: (search.rays / 4).max(16),
         ..wide.clone()
@@ -493,7 +524,7 @@ pub fn refined_candidates<P: Pixel>(
         ..search.clone()
     };
     let mut out: Vec<(crate::Circle, Refined)> = Vec::new();
-    for c in crate::detect_circles(img, detection) {
+    for c in peaks {
         // A vote peak next to a circle already refined would converge onto it again.
         if out
             .iter()

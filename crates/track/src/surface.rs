@@ -125,6 +125,11 @@ pub struct SurfaceLines {
     pub alternatives: Vec<SurfaceLine>,
 }
 
+/// How far above a candidate line the ball's centre must be, in radii, for the line to be the surface: in
+/// flight its whole disc is above the surface, and even pressed into it the centre stays above 0.8 radii (a
+/// tennis ball sinks 0.05–0.15). A ruler or a fixture's edge the ball crosses is not the surface.
+const BALL_CLEARANCE_RADII: f64 = 0.8;
+
 /// Column stride, px.
 const STRIDE: usize = 4;
 /// Columns averaged around each sampled column.
@@ -139,15 +144,15 @@ pub fn find_surface_line<P: Pixel>(img: &Plane<P>) -> Option<SurfaceLine> {
 }
 
 /// Finds the band's top by both cues (see the module's description): every candidate line, the topmost taken.
-/// With the ball's position `(x, y, r)` px known, a line the ball's centre is not at least half a radius above
-/// is not the surface (a ruler, a fixture's edge or a shadow crossing the frame above the ball) and is left
+/// With the ball's position `(x, y, r)` px known, a line the ball's centre is not at least 0.8 radii above is
+/// not the surface (a ruler, a fixture's edge or a shadow crossing the frame above the ball) and is left
 /// out. Cost ≈ 3 ms for 512×512.
 pub fn find_surface_lines<P: Pixel>(img: &Plane<P>, ball: Option<(f64, f64, f64)>) -> Option<SurfaceLines> {
     let step = brightness_lines(img);
     let texture = crate::texture::texture_lines(img);
     let mut candidates: Vec<SurfaceLine> = merge_cues(step, texture)
         .into_iter()
-        .filter(|l| ball.is_none_or(|(x, y, r)| l.height_of(x, y) >= 0.5 * r))
+        .filter(|l| ball.is_none_or(|(x, y, r)| l.height_of(x, y) >= BALL_CLEARANCE_RADII * r))
         .collect();
     if candidates.is_empty() {
         return None;
@@ -222,14 +227,15 @@ fn brightness_lines<P: Pixel>(img: &Plane<P>) -> Vec<SurfaceLine> {
             leans.push(edge - smoothed_edge(&d, y));
         }
     }
-    lines_through(&cands, &leans, cols.len(), w, 1.5, 0.0)
+    lines_through(&cands, &leans, cols.len(), w, 1.5, 0.0, 0.3)
 }
 
 /// The well-supported, strong lines through per-column edge candidates `(x, y, strength)` (in column
 /// order), topmost first: RANSAC over pairs from distant columns (deterministic sampling), lines within `tol`
-/// px of at least half of the `columns` sampled (and 0.7 × the best line's support), strong = mean strength
-/// at least 0.3 × the strongest such line's and at least `min_strength`; lines closer than 2 × `tol` to a
-/// higher one are the same line; each refined by least squares on its inliers. `leans[i]` is candidate i's
+/// px of at least half of the `columns` sampled (and half the best line's support: a hand or a fixture may
+/// hide part of the band's top where a ruler crosses the whole frame), strong = mean strength at least
+/// `relative_strength` × the strongest such line's and at least `min_strength`; lines closer than 2 × `tol` to
+/// a higher one are the same line; each refined by least squares on its inliers. `leans[i]` is candidate i's
 /// edge definition (see [`SurfaceLine::edge_definition_px`]).
 pub(crate) fn lines_through(
     cands: &[(f64, f64, f64)],
@@ -238,6 +244,7 @@ pub(crate) fn lines_through(
     w: usize,
     tol: f64,
     min_strength: f64,
+    relative_strength: f64,
 ) -> Vec<SurfaceLine> {
     let mut lines: Vec<(f64, f64, f64, f64)> = Vec::new(); // (support, y at x=0, slope, mean strength)
     let n = cands.len();
@@ -271,15 +278,12 @@ pub(crate) fn lines_through(
     }
     // A line must also be strong: the 8-bit steps of a smooth backdrop gradient are perfectly straight and
     // consistent across columns, but weak.
-    let strongest = lines
-        .iter()
-        .filter(|l| l.0 >= 0.7 * best)
-        .map(|l| l.3)
-        .fold(0.0, f64::max);
+    let supported = |l: &(f64, f64, f64, f64)| l.0 >= 0.5 * best && l.0 >= 0.5 * columns as f64;
+    let strongest = lines.iter().filter(|l| supported(l)).map(|l| l.3).fold(0.0, f64::max);
     let xc = (w as f64 - 1.0) / 2.0;
     let mut good: Vec<(f64, f64, f64, f64)> = lines
         .into_iter()
-        .filter(|l| l.0 >= 0.7 * best && l.3 >= 0.3 * strongest && l.3 >= min_strength)
+        .filter(|l| supported(l) && l.3 >= relative_strength * strongest && l.3 >= min_strength)
         .collect();
     // Topmost first (y smallest at the centre).
     good.sort_by(|a, b| (a.1 + a.2 * xc).total_cmp(&(b.1 + b.2 * xc)));

@@ -21,7 +21,7 @@ const HALF_BOX: usize = 4;
 /// Rows on either side whose mean log energy a step compares.
 const STEP_ROWS: usize = 6;
 /// Steps kept per column.
-const PEAKS: usize = 4;
+const PEAKS: usize = 8;
 /// Least mean strength of a line's steps, in units of each column's robust scatter of the step measure.
 const MIN_STRENGTH: f64 = 5.0;
 /// How far a column's edge may lie from a line and still support it, px: the edge of a ragged band
@@ -75,7 +75,7 @@ pub fn texture_lines<P: Pixel>(img: &Plane<P>) -> Vec<SurfaceLine> {
         }
     }
     let leans = vec![0.0; cands.len()];
-    lines_through(&cands, &leans, cols.len(), w, TOLERANCE_PX, MIN_STRENGTH)
+    lines_through(&cands, &leans, cols.len(), w, TOLERANCE_PX, MIN_STRENGTH, 0.0)
         .into_iter()
         .map(|line| SurfaceLine {
             edge_definition_px: 2.0 * line.roughness_px,

@@ -252,6 +252,7 @@ impl Tracker {
             self.surface_tries += 1;
             // Where the ball is expected, a line above it is not the surface.
             let ball = self.predict(t_s).zip(self.expected_radius()).map(|((x, y), r)| (x, y, r));
+            if std::env::var("LINE_DEBUG").is_ok() { eprintln!("LINE frame {frame} ball {ball:?} cands {:?}", find_surface_lines(img, None).map(|l| std::iter::once(l.line).chain(l.alternatives).map(|l| (l.y0, l.cue)).collect::<Vec<_>>())); }
             if let Some(lines) = find_surface_lines(img, ball) {
                 self.surface = Some(lines.line);
                 self.surface_alternatives = lines.alternatives;
@@ -308,65 +309,101 @@ impl Tracker {
             ..CircleDetection::default()
         };
         let mut cands = refined_candidates(img, &det, &self.opts.search, self.surface.as_ref(), 0.3);
+        let Some((px, py)) = self.predict_after_gap(t_s) else {
+            return self.first_sighting(frame, t_s, img, cands);
+        };
+        // Only a circle where the ball can be continues the track: within half a radius of the prediction,
+        // and further by the ground the ball covers per frame for every frame it has been missed (a bounce or
+        // a turn unseen). Anything else is another object, and the frame is absent, never `ok`.
+        let r_expected = self.expected_radius().unwrap_or(0.5 * (lo + hi));
+        let gate = 0.5 * r_expected + (2.0 * self.speed_px_per_s() * self.frame_period() + 1.0) * self.missed as f64;
+        let d = |c: &(Circle, Refined)| (c.1.fit.x - px).hypot(c.1.fit.y - py);
+        cands.retain(|c| d(c) <= gate);
         if cands.is_empty() {
-            if !self.history.is_empty() && self.history.len() < 1_000_000 {
-                self.warnings.push(format!("frame {frame}: ball lost"));
+            self.missed += 1;
+            if self.missed == 3 {
+                self.warnings.push(format!("frame {frame}: ball lost; looking for it along its path"));
             }
-            self.history.clear();
             return BallFix::absent(frame, t_s, Status::Absent);
         }
         cands.sort_by(|a, b| b.1.quality().total_cmp(&a.1.quality()));
         let best_q = cands[0].1.quality();
         let rivals = cands.iter().filter(|c| c.1.quality() >= RIVAL_SUPPORT * best_q).count();
-        match self.predict(t_s) {
-            Some((px, py)) => {
-                // Continuity decides: the candidate nearest the track.
-                let d = |c: &(Circle, Refined)| (c.1.fit.x - px).hypot(c.1.fit.y - py);
-                let (i, _) = cands
-                    .iter()
-                    .enumerate()
-                    .min_by(|a, b| d(a.1).total_cmp(&d(b.1)))
-                    .expect("non-empty");
-                let chosen = cands.swap_remove(i);
-                // A circle far from where the ball must be is not the ball: say it is missing, and give up the
-                // track after a few such frames so the ball can be found afresh.
-                let r_expected = self.expected_radius().unwrap_or(chosen.1.fit.r);
-                if (chosen.1.fit.x - px).hypot(chosen.1.fit.y - py) > 0.5 * r_expected {
-                    self.missed += 1;
-                    if self.missed >= 3 {
-                        self.history.clear();
-                        self.warnings.push(format!(
-                            "frame {frame}: track given up after {} frames without the ball",
-                            self.missed
-                        ));
-                        self.missed = 0;
-                    }
-                    return BallFix::absent(frame, t_s, Status::Absent);
-                }
-                if rivals > 1 {
-                    self.warnings.push(format!(
-                        "frame {frame}: {rivals} ball-like circles; tracking the one at ({:.1}, {:.1}) because it continues the track",
-                        chosen.1.fit.x, chosen.1.fit.y
-                    ));
-                }
-                self.accept(frame, t_s, img, chosen.1, Status::Ok)
-            }
-            None => {
-                let chosen = cands.swap_remove(0);
-                if rivals > 1 {
-                    self.warnings.push(format!(
-                        "frame {frame}: {rivals} ball-like circles and no track yet to tell which is the ball; taking the clearest at ({:.1}, {:.1})",
-                        chosen.1.fit.x, chosen.1.fit.y
-                    ));
-                    let fix = self.accept(frame, t_s, img, chosen.1, Status::Ambiguous);
-                    return BallFix {
-                        status: Status::Ambiguous,
-                        ..fix
-                    };
-                }
-                self.accept(frame, t_s, img, chosen.1, Status::Ok)
-            }
+        // Continuity decides: the candidate nearest the track.
+        let (i, _) = cands
+            .iter()
+            .enumerate()
+            .min_by(|a, b| d(a.1).total_cmp(&d(b.1)))
+            .expect("non-empty");
+        let chosen = cands.swap_remove(i);
+        if rivals > 1 {
+            self.warnings.push(format!(
+                "frame {frame}: {rivals} ball-like circles near the track; tracking the one at ({:.1}, {:.1}) because it continues it",
+                chosen.1.fit.x, chosen.1.fit.y
+            ));
         }
+        self.accept(frame, t_s, img, chosen.1, Status::Ok)
+    }
+
+    /// Without any history (a tracker never seeded): the clearest circle, `ambiguous` when others are nearly
+    /// as clear.
+    fn first_sighting<P: Pixel>(
+        &mut self,
+        frame: usize,
+        t_s: f64,
+        img: &Plane<P>,
+        mut cands: Vec<(Circle, Refined)>,
+    ) -> BallFix {
+        if cands.is_empty() {
+            return BallFix::absent(frame, t_s, Status::Absent);
+        }
+        cands.sort_by(|a, b| b.1.quality().total_cmp(&a.1.quality()));
+        let best_q = cands[0].1.quality();
+        let rivals = cands.iter().filter(|c| c.1.quality() >= RIVAL_SUPPORT * best_q).count();
+        let chosen = cands.swap_remove(0);
+        if rivals > 1 {
+            self.warnings.push(format!(
+                "frame {frame}: {rivals} ball-like circles and no track yet to tell which is the ball; taking the clearest at ({:.1}, {:.1})",
+                chosen.1.fit.x, chosen.1.fit.y
+            ));
+            let fix = self.accept(frame, t_s, img, chosen.1, Status::Ambiguous);
+            return BallFix {
+                status: Status::Ambiguous,
+                ..fix
+            };
+        }
+        self.accept(frame, t_s, img, chosen.1, Status::Ok)
+    }
+
+    /// Where the ball should be at `t`: the quadratic through the last three fixes while the track holds, a
+    /// straight line from the last two once frames have been missed (a parabola extrapolated far runs away).
+    fn predict_after_gap(&self, t: f64) -> Option<(f64, f64)> {
+        let h = &self.history;
+        if self.missed < 2 || h.len() < 2 {
+            return self.predict(t);
+        }
+        let (a, b) = (h[h.len() - 2], h[h.len() - 1]);
+        let s = (t - b.0) / (b.0 - a.0);
+        Some((b.1 + s * (b.1 - a.1), b.2 + s * (b.2 - a.2)))
+    }
+
+    /// The ball's speed over its last two fixes, px/s (0 before two).
+    fn speed_px_per_s(&self) -> f64 {
+        let h = &self.history;
+        if h.len() < 2 {
+            return 0.0;
+        }
+        let (a, b) = (h[h.len() - 2], h[h.len() - 1]);
+        (b.1 - a.1).hypot(b.2 - a.2) / (b.0 - a.0).abs().max(1e-12)
+    }
+
+    /// The time between the last two fixes, s (the frame period while none are missed).
+    fn frame_period(&self) -> f64 {
+        let h = &self.history;
+        if h.len() < 2 {
+            return 0.0;
+        }
+        (h[h.len() - 1].0 - h[h.len() - 2].0).abs()
     }
 
     fn plausible(&self, f: &Refined, px: f64, py: f64, r: f64, max_jump: f64) -> bool {
