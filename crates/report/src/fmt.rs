@@ -21,6 +21,30 @@ pub(crate) fn esc(s: &str) -> String {
     out
 }
 
+/// [`esc`] of a sentence in which `name` in backticks marks a name to type (an effect, a command): those
+/// spans become `<code>`, an unpaired backtick stays as it is.
+pub(crate) fn esc_code(s: &str) -> String {
+    let parts: Vec<&str> = s.split('`').collect();
+    if parts.len() < 3 {
+        return esc(s);
+    }
+    let mut out = String::with_capacity(s.len() + 16);
+    let pairs = (parts.len() - 1) / 2;
+    for (i, p) in parts.iter().enumerate() {
+        if i % 2 == 1 && i < 2 * pairs {
+            out.push_str("<code>");
+            out.push_str(&esc(p));
+            out.push_str("</code>");
+        } else {
+            if i > 2 * pairs {
+                out.push('`');
+            }
+            out.push_str(&esc(p));
+        }
+    }
+    out
+}
+
 /// A typographic minus sign for negative numbers.
 fn minus(s: String) -> String {
     if let Some(rest) = s.strip_prefix('-') {
@@ -105,9 +129,35 @@ pub(crate) fn p_value(p: f64) -> String {
     }
 }
 
-/// A value in metres shown in millimetres.
-pub(crate) fn mm(v_m: f64, sig: usize) -> String {
-    num(v_m * 1e3, sig)
+/// A value in metres shown in micrometres (residuals), one decimal below 100 µm.
+pub(crate) fn um(v_m: f64) -> String {
+    let v = v_m * 1e6;
+    if v.is_finite() && v.abs() < 100.0 {
+        fixed(v, 1)
+    } else {
+        num(v, 3)
+    }
+}
+
+/// A value and its standard error, the error to two significant digits and the value to the same decimal
+/// place ("0.7160", "0.0012"; "123.4", "5.6"), so the error is never shown as zero; without a usable error
+/// the value to `sig` significant digits and `None`.
+pub(crate) fn pm(v: f64, se: Option<f64>, sig: usize) -> (String, Option<String>) {
+    match se.filter(|e| e.is_finite() && *e > 0.0) {
+        Some(e) if v.is_finite() && v.abs() < 1e9 && e < 1e9 => {
+            let decimals = (1 - e.log10().floor() as i32).clamp(0, 12) as usize;
+            (fixed(v, decimals), Some(fixed(e, decimals)))
+        }
+        _ => (num(v, sig), None),
+    }
+}
+
+/// [`pm`] as one text: "0.7160 ± 0.0012", or the value alone.
+pub(crate) fn pm_text(v: f64, se: Option<f64>, sig: usize) -> String {
+    match pm(v, se, sig) {
+        (v, Some(e)) => format!("{v} ± {e}"),
+        (v, None) => v,
+    }
 }
 
 /// A pixel coordinate for SVG: one decimal, no trailing ".0", clamped to ±1e5 (never NaN).
@@ -158,6 +208,17 @@ mod tests {
     }
 
     #[test]
+    fn backticks_become_code() {
+        assert_eq!(
+            esc_code("add `hertz` & <go>"),
+            "add <code>hertz</code> &amp; &lt;go&gt;"
+        );
+        assert_eq!(esc_code("a `b` c `d"), "a <code>b</code> c `d");
+        assert_eq!(esc_code("`<x>`"), "<code>&lt;x&gt;</code>");
+        assert_eq!(esc_code("no ticks"), "no ticks");
+    }
+
+    #[test]
     fn numbers() {
         assert_eq!(num(0.77012, 4), "0.7701");
         assert_eq!(num(25650.0, 4), "25650");
@@ -176,6 +237,22 @@ mod tests {
         assert_eq!(short(0.05, 3), "0.05");
         assert_eq!(short(1e-7, 3), "1.00e-7");
         assert_eq!(p_value(2.1e-9), "2.1e-9");
+        assert_eq!(um(7.8e-6), "7.8");
+        assert_eq!(um(1.234e-4), "123");
+    }
+
+    #[test]
+    fn errors_set_the_digits_and_are_never_zero() {
+        assert_eq!(
+            pm(0.68612, Some(0.00031), 3),
+            ("0.68612".into(), Some("0.00031".into()))
+        );
+        assert_eq!(pm_text(0.686, Some(0.0004), 3), "0.68600 ± 0.00040");
+        assert_eq!(pm_text(123.44, Some(5.6), 3), "123.4 ± 5.6");
+        assert_eq!(pm_text(1234.0, Some(56.0), 3), "1234 ± 56");
+        assert_eq!(pm_text(0.5, Some(0.0), 3), "0.500");
+        assert_eq!(pm_text(0.5, Some(f64::NAN), 3), "0.500");
+        assert_eq!(pm_text(f64::NAN, Some(0.1), 3), "NaN");
     }
 
     #[test]
