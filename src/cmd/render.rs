@@ -7,7 +7,7 @@ use std::path::PathBuf;
 #[derive(clap::Args)]
 #[command(group = clap::ArgGroup::new("source").required(true).args(["preset", "scenario"]))]
 pub struct Args {
-    /// Built-in scenario: smoke, paper, none, effect-<name> (see --list).
+    /// Built-in scenario: smoke, paper, none, or effect-<name> for a library effect (names: `bouncelab effects`).
     #[arg(long)]
     preset: Option<String>,
     /// Scenario file (TOML; see docs/renderer.md).

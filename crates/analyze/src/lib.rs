@@ -584,7 +584,10 @@ fn diagnose_stage(
     {
         progress.finish(
             Stage::Diagnose,
-            &format!("unchanged since the last run: {}", d.verdict.sentence),
+            &format!(
+                "unchanged since the last run ({} candidate(s) in diagnosis.json)",
+                d.candidates.len()
+            ),
         );
         return Ok(d);
     }
@@ -603,7 +606,14 @@ fn diagnose_stage(
     let d = find_missing_effect_with(spec, &measured, extras, &options, &report)?;
     outputs::write_atomic(&path, |w| w.write_all(d.to_json().as_bytes()))?;
     outputs::write_atomic(&key_path, |w| w.write_all(key.as_bytes()))?;
-    progress.finish(Stage::Diagnose, &d.verdict.sentence);
+    progress.finish(
+        Stage::Diagnose,
+        &format!(
+            "{} candidate effect(s) fitted in {:.1} s",
+            d.candidates.len(),
+            d.seconds
+        ),
+    );
     Ok(d)
 }
 

@@ -32,6 +32,9 @@ td.wide{min-width:18em;white-space:normal}
 .se{color:var(--muted);font-size:.86em}
 td .se{margin-left:.15em}
 table.quantities td.n{min-width:7em}
+table.stacked td .se{display:block;margin-left:0}
+table.stacked th{white-space:normal;vertical-align:bottom}
+table.stacked td.wide{min-width:14em}
 tr.total td{font-weight:600;border-top:1.5px solid #999}
 table.facts th{background:none;font-weight:normal;color:var(--muted);padding-left:0}
 .scroll{overflow-x:auto}
@@ -382,7 +385,7 @@ fn warnings(r: &Report) -> String {
     let shared = crate::shots::shared_notes(r);
     let mut s = String::new();
     if r.warnings.is_empty() {
-        s.push_str("<p>No warnings.</p>\n");
+        s.push_str("<p>No warnings were raised by this run.</p>\n");
     } else {
         s.push_str("<ul class=\"warnings\">");
         for w in &r.warnings {

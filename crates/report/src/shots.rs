@@ -213,7 +213,8 @@ fn measured_table(ctx: &Ctx) -> String {
             ]
         })
         .collect();
-    table(
+    crate::page::table_with_class(
+        "stacked",
         &[
             nc("#"),
             tc("Clip"),
@@ -264,7 +265,8 @@ fn model_table(ctx: &Ctx, worst: &[usize], best: &[usize], shared: &[String]) ->
             esc(&own_notes(sh, shared).join("; ")),
         ]);
     }
-    table(
+    crate::page::table_with_class(
+        "stacked",
         &[
             tc("Clip"),
             tc("Surface"),
