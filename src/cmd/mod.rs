@@ -60,7 +60,7 @@ pub fn rate(per_sec: f64, unit: &str) -> String {
 /// same decimal place, so the error never reads as zero ("0.6860 ± 0.0004"); a negative zero as zero.
 pub fn pm(v: f64, se: f64) -> String {
     if !(se.is_finite() && se > 0.0 && v.is_finite()) {
-        return format!("{}", no_minus_zero(&format!("{v:.4}")));
+        return no_minus_zero(&format!("{v:.4}"));
     }
     let d = (1 - se.log10().floor() as i32).clamp(0, 12) as usize;
     format!("{} ± {se:.d$}", no_minus_zero(&format!("{v:.d$}")))

@@ -718,9 +718,9 @@ mod tests {
     fn the_inverse_of_a_3x3_matrix() {
         let m = [[4.0, 1.0, 0.5], [1.0, 3.0, 0.2], [0.5, 0.2, 2.0]];
         let inv = invert3(&m).unwrap();
-        for i in 0..3 {
+        for (i, row) in m.iter().enumerate() {
             for j in 0..3 {
-                let v: f64 = (0..3).map(|k| m[i][k] * inv[k][j]).sum();
+                let v: f64 = row.iter().zip(&inv).map(|(a, b)| a * b[j]).sum();
                 assert!((v - f64::from(u8::from(i == j))).abs() < 1e-12, "{i}{j}: {v}");
             }
         }

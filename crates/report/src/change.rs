@@ -133,9 +133,9 @@ pub(crate) fn render(ctx: &mut Ctx, c: &ModelChange) -> String {
     s.push_str("<h3>The earlier verdict</h3>\n");
     match &c.verdict_before {
         Some(v) => {
-            let _ = write!(
+            let _ = writeln!(
                 s,
-                "<div class=\"verdict v-{}\"><p class=\"kind\">{}</p><p class=\"text\">{}</p></div>\n",
+                "<div class=\"verdict v-{}\"><p class=\"kind\">{}</p><p class=\"text\">{}</p></div>",
                 crate::diagnosis::kind_class(v.kind),
                 v.kind.label(),
                 crate::fmt::esc_code(&v.text)

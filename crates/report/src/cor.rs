@@ -8,13 +8,16 @@ use crate::fmt::{fixed, num, pm_text, short};
 use crate::page::{Ctx, nc, table, tc, unavailable};
 use crate::svg::{Chart, ErrorBar, Item, Key, Mark};
 
+/// A shot's value and standard error, in display units, if it has the quantity.
+type Reading = Option<(f64, Option<f64>)>;
+
 /// One panel: a measured quantity and the same from the model, in display units.
 struct Panel {
     title: &'static str,
     y_label: &'static str,
     unit: &'static str,
     sig: usize,
-    measured: fn(&ShotMeasurement) -> Option<(f64, Option<f64>)>,
+    measured: fn(&ShotMeasurement) -> Reading,
     model: fn(&ShotPrediction) -> f64,
 }
 

@@ -7,7 +7,7 @@ use std::fmt::Write;
 
 use crate::data::{Phase, Report, ShotMeasurement, ShotPlot};
 use crate::fmt::{esc, num, opt, short, um};
-use crate::page::{Ctx, nc, pm_cell, table, tc, wc};
+use crate::page::{Ctx, nc, pm_cell, tc, wc};
 use crate::svg::{Bar, Chart, Item, Key, Mark, Shape};
 use crate::thin::thin_indices;
 

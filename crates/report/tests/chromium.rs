@@ -208,12 +208,11 @@ fn reports_load_in_headless_chromium_without_console_errors() {
     );
 
     // The layout check catches a table that runs past the viewport and an empty section.
-    let wide = format!(
-        "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>x</title></head><body><main>\
-         <section id=\"a\"><h2>A</h2><div class=\"scroll\" style=\"overflow-x:auto\"><table><tr><td style=\"min-width:3000px\">wide</td></tr></table></div></section>\
-         <section id=\"b\"><h2>B</h2></section></main></body></html>"
-    );
-    let (problems, _) = layout(&wide, dir.path(), "wide");
+    let wide = "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>x</title></head><body><main>\
+         <section id=\"a\"><h2>A</h2><div class=\"scroll\" style=\"overflow-x:auto\"><table><tr>\
+         <td style=\"min-width:3000px\">wide</td></tr></table></div></section>\
+         <section id=\"b\"><h2>B</h2></section></main></body></html>";
+    let (problems, _) = layout(wide, dir.path(), "wide");
     assert!(
         problems.iter().any(|p| p.starts_with("overflow table in a")),
         "{problems:?}"

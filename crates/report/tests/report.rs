@@ -69,13 +69,15 @@ fn the_comparisons_are_the_ancovas_adjusted_ones() {
             "{tail}"
         );
     }
-    // The coefficients carry SE, t and p.
+    // The coefficients carry SE, t, p and an interval: six cells in the v_in_n row.
     let c = inf.coefficients.row("v_in_n").unwrap();
+    let at = html.find("<td><code>v_in_n</code></td>").expect("no v_in_n row");
+    let row = &html[at..at + html[at..].find("</tr>").unwrap()];
+    assert_eq!(row.matches("<td").count(), 6, "{row}");
     assert!(
-        html.contains(&format!("<td><code>v_in_n</code></td><td class=\"n\">")),
-        "no v_in_n row"
+        row.contains(&format!("<td class=\"n\">{}</td>", p_text_of(c.p))),
+        "{row}"
     );
-    assert!(c.se > 0.0);
     // The residual caption says what the tests found.
     let caption = inf.residual_tests.caption();
     assert!(
