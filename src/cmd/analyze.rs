@@ -110,6 +110,11 @@ impl Progress for StageBars {
             b.set_message(format!("iteration {iteration}, reduced χ² {chi2_red:.3}"));
         }
     }
+    fn doing(&self, _stage: Stage, what: &str) {
+        if let Some(b) = self.bar.lock().expect("progress lock").as_ref() {
+            b.set_message(format!("fitting {what}"));
+        }
+    }
     fn finish(&self, stage: Stage, summary: &str) {
         if let Some(b) = self.bar.lock().expect("progress lock").take() {
             b.finish_and_clear();

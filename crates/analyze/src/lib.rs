@@ -73,6 +73,8 @@ pub trait Progress: Sync {
     /// A solver of the stage finished iteration `iteration` (0 is the starting point) at reduced χ²
     /// `chi2_red` (χ²/ν, the fit's definition); calls come from the thread that runs the stage.
     fn iteration(&self, _stage: Stage, _iteration: usize, _chi2_red: f64) {}
+    /// What the stage works on now, in a few words (e.g. "+ hertz": fitting the model with `hertz` added).
+    fn doing(&self, _stage: Stage, _what: &str) {}
     /// The stage is done; `summary` says what it did in one line.
     fn finish(&self, _stage: Stage, _summary: &str) {}
     /// Something a person should know (a shot that failed, a surface the model did not know …).
@@ -602,6 +604,7 @@ fn diagnose_stage(
     let report = |p: bouncelab_diagnose::Progress| {
         let before = last.swap(p.done, std::sync::atomic::Ordering::Relaxed);
         progress.advance(Stage::Diagnose, p.done.saturating_sub(before) as u64);
+        progress.doing(Stage::Diagnose, &p.what);
     };
     let d = find_missing_effect_with(spec, &measured, extras, &options, &report)?;
     outputs::write_atomic(&path, |w| w.write_all(d.to_json().as_bytes()))?;

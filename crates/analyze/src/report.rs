@@ -411,14 +411,16 @@ fn shot_plot(a: &Analysis, c: &ShotComparison) -> r::ShotPlot {
         .collect();
     let mut notes = data.map(|s| s.estimate.notes.clone()).unwrap_or_default();
     if let Some(level) = surface_level(a, &c.surface, &c.shot) {
-        let (where_, size) = if level >= 0.0 {
-            ("above", level)
+        // The level is the true surface's height in the measured frame: a negative one lies below the line
+        // found in the image, so the line lies above the plane the ball touches.
+        let (where_, size) = if level <= 0.0 {
+            ("above", -level)
         } else {
-            ("below", -level)
+            ("below", level)
         };
         notes.push(format!(
-            "fitted surface level {:+.1} µm: the surface line found in the image lies {:.1} µm {where_} the plane the ball touches",
-            level * 1e6,
+            "fitted surface level {} µm: the surface line found in the image lies {:.1} µm {where_} the plane the ball touches",
+            format!("{:+.1}", level * 1e6).replace('-', "\u{2212}"),
             size * 1e6
         ));
     }

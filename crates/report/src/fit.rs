@@ -42,13 +42,19 @@ pub(crate) fn render(ctx: &mut Ctx, f: &FitSummary) -> String {
         .parameters
         .iter()
         .map(|p| {
+            // A length parameter (a surface level) is a fraction of a millimetre: shown in µm.
+            let (k, unit) = if p.unit == "m" {
+                (1e6, "µm".to_string())
+            } else {
+                (1.0, p.unit.clone())
+            };
             vec![
                 format!("<code>{}</code>", esc(&p.name)),
-                num(p.value, 4),
-                opt(p.std_error, 2),
+                num(p.value * k, 4),
+                opt(p.std_error.map(|e| e * k), 2),
                 p.interval
-                    .map_or("—".into(), |[a, b]| format!("{} – {}", num(a, 4), num(b, 4))),
-                esc(&p.unit),
+                    .map_or("—".into(), |[a, b]| format!("{} – {}", num(a * k, 4), num(b * k, 4))),
+                crate::fmt::esc_code(&unit),
                 if p.at_bound {
                     r#"<span class="bad">at a bound of the fit</span>"#.into()
                 } else {

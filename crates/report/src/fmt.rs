@@ -22,11 +22,12 @@ pub(crate) fn esc(s: &str) -> String {
 }
 
 /// [`esc`] of a sentence in which `name` in backticks marks a name to type (an effect, a command): those
-/// spans become `<code>`, an unpaired backtick stays as it is.
+/// spans become `<code>`, an unpaired backtick stays as it is; outside them a power written `x^1.5`,
+/// `δ^n` or `m^(1+n)` becomes a superscript.
 pub(crate) fn esc_code(s: &str) -> String {
     let parts: Vec<&str> = s.split('`').collect();
     if parts.len() < 3 {
-        return esc(s);
+        return powers(&esc(s));
     }
     let mut out = String::with_capacity(s.len() + 16);
     let pairs = (parts.len() - 1) / 2;
@@ -39,9 +40,44 @@ pub(crate) fn esc_code(s: &str) -> String {
             if i > 2 * pairs {
                 out.push('`');
             }
-            out.push_str(&esc(p));
+            out.push_str(&powers(&esc(p)));
         }
     }
+    out
+}
+
+/// `^(…)` and `^token` (letters, digits, `.`, `+`, `-`) of escaped text as `<sup>`.
+fn powers(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    let mut rest = s;
+    while let Some(i) = rest.find('^') {
+        out.push_str(&rest[..i]);
+        let after = &rest[i + 1..];
+        let (exp, tail) = if let Some(inner) = after.strip_prefix('(') {
+            match inner.find(')') {
+                Some(j) => (&inner[..j], &inner[j + 1..]),
+                None => ("", after),
+            }
+        } else {
+            let end = after
+                .char_indices()
+                .find(|(k, c)| !(c.is_alphanumeric() || *c == '.' || ((*c == '+' || *c == '-') && *k == 0)))
+                .map_or(after.len(), |(k, _)| k);
+            // A trailing full stop ends the sentence, not the exponent.
+            let end = if after[..end].ends_with('.') { end - 1 } else { end };
+            (&after[..end], &after[end..])
+        };
+        if exp.is_empty() {
+            out.push('^');
+            rest = after;
+        } else {
+            out.push_str("<sup>");
+            out.push_str(exp);
+            out.push_str("</sup>");
+            rest = tail;
+        }
+    }
+    out.push_str(rest);
     out
 }
 
@@ -216,6 +252,12 @@ mod tests {
         assert_eq!(esc_code("a `b` c `d"), "a <code>b</code> c `d");
         assert_eq!(esc_code("`<x>`"), "<code>&lt;x&gt;</code>");
         assert_eq!(esc_code("no ticks"), "no ticks");
+        assert_eq!(esc_code("P = λ·δ^n·dδ/dt"), "P = λ·δ<sup>n</sup>·dδ/dt");
+        assert_eq!(
+            esc_code("N·s/m^(1+n) and k·δ^1.5."),
+            "N·s/m<sup>1+n</sup> and k·δ<sup>1.5</sup>."
+        );
+        assert_eq!(esc_code("a ^ b"), "a ^ b");
     }
 
     #[test]

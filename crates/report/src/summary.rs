@@ -280,7 +280,7 @@ pub(crate) fn render(ctx: &mut Ctx) -> String {
         rows.push((
             "Surfaces at equal impact speed".into(),
             format!(
-                r##"{} of {} pairs differ (Tukey–Kramer, α = {}){} (<a href="#comparisons">adjusted means</a>)"##,
+                r##"pairs that differ: {} of {} (Tukey–Kramer, α = {}){} (<a href="#comparisons">adjusted means</a>)"##,
                 differ.len(),
                 m.pairs.len(),
                 crate::fmt::short(m.alpha, 3),
