@@ -515,7 +515,7 @@ fn shot_figure(ctx: &mut Ctx, i: usize, budget: usize) -> String {
     let ridx = thin_indices(sh.residuals.len(), budget, |k| in_contact(sh, sh.residuals[k].t_s));
     let sigma = median(sh.measured.iter().map(|p| p.sigma_m).collect());
     let model_color = "#D55E00";
-    let data_color = "#3b3b3b";
+    let data_color = "#7a7a7a";
     let (n, id) = ctx.next_figure();
     let mut charts = Vec::new();
     for (k, (title, label, normal)) in [
@@ -543,8 +543,9 @@ fn shot_figure(ctx: &mut Ctx, i: usize, budget: usize) -> String {
                 .collect(),
             color: data_color,
             shape: Shape::Circle,
-            size: 3.0,
+            size: 4.6,
         });
+        // Thinner than the dots, so where they coincide both stay visible.
         if !sh.model.is_empty() {
             c.items.push(Item::Line {
                 pts: sh
@@ -553,7 +554,7 @@ fn shot_figure(ctx: &mut Ctx, i: usize, budget: usize) -> String {
                     .map(|p| (ms(p.t_s), coord((p.x_m, p.y_m)) * 1e3))
                     .collect(),
                 color: model_color,
-                width: 1.8,
+                width: 1.4,
                 dash: false,
             });
         }
