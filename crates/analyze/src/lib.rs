@@ -400,7 +400,7 @@ pub fn analyze(
 
     let t = std::time::Instant::now();
     create_dir(&options.out_dir)?;
-    let mut outputs = outputs::write_all(&options.out_dir, &shots, &fit)?;
+    let mut outputs = outputs::write_all(&options.out_dir, &shots, &fit, &spec)?;
     outputs.push(outputs::write_comparison(&options.out_dir, &comparison)?);
     if let Ok(st) = &stats {
         outputs.push(outputs::write_anova(&options.out_dir, &st.ancova)?);

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 /// The columns of `estimates.csv`, in order. Every name ends in its unit (`_m_s`, `_ms`, `_mm`, `_deg`,
 /// `_rad_s`, `_m_s2`, `_s`, `_m`); `cor`, `mu_eff`, their `_se` and `chi2_red_flight` are dimensionless. A
 /// standard error is `<quantity>_se_<unit>` (see `docs/outputs.md`).
-pub const ESTIMATE_COLUMNS: [&str; 36] = [
+pub const ESTIMATE_COLUMNS: [&str; 38] = [
     "clip",
     "surface",
     "angle_deg",
@@ -41,6 +41,8 @@ pub const ESTIMATE_COLUMNS: [&str; 36] = [
     "spin_out_se_rad_s",
     "peak_decel_track_m_s2",
     "peak_decel_track_se_m_s2",
+    "peak_force_track_n",
+    "peak_force_track_se_n",
     "t_touch_s",
     "t_touch_se_s",
     "t_sep_s",
@@ -132,23 +134,31 @@ fn num(v: f64) -> String {
     if v.is_finite() { format!("{v}") } else { String::new() }
 }
 
-/// `estimates.csv`: one row per measured shot with every estimate and its standard error.
-pub fn write_estimates_csv(out: &mut dyn Write, shots: &[ShotData]) -> Result<(), csv::Error> {
+/// `estimates.csv`: one row per measured shot with every estimate and its standard error; the ball's mass
+/// (kg) and gravity (m/s²) turn the track's peak deceleration into a force.
+pub fn write_estimates_csv(
+    out: &mut dyn Write,
+    shots: &[ShotData],
+    ball_mass_kg: f64,
+    gravity: f64,
+) -> Result<(), csv::Error> {
     let mut w = csv::Writer::from_writer(out);
     w.write_record(ESTIMATE_COLUMNS)?;
     for s in shots {
         let e = &s.estimate;
-        let m = crate::report::measurement(s, None);
+        let m = crate::report::measurement(s, None, ball_mass_kg, gravity);
         let opt = |m: Option<bouncelab_estimate::Measured>| {
             m.map_or((String::new(), String::new()), |m| (num(m.value), num(m.se)))
         };
         let (si, si_se) = opt(e.spin_in);
         let (so, so_se) = opt(e.spin_out);
-        let (pd, pd_se) = m
-            .peak_deceleration_track_m_s2
-            .map_or((String::new(), String::new()), |a| {
+        let pair = |v: Option<r::Measured>| {
+            v.map_or((String::new(), String::new()), |a| {
                 (num(a.value), a.se.map_or(String::new(), num))
-            });
+            })
+        };
+        let (pd, pd_se) = pair(m.peak_deceleration_track_m_s2);
+        let (pf, pf_se) = pair(m.peak_force_track_n);
         let (speed, angle) = (m.impact_speed(), m.impact_angle());
         let worst_chi2 = e.chi2_red.iter().cloned().fold(f64::NAN, f64::max);
         w.write_record([
@@ -182,6 +192,8 @@ pub fn write_estimates_csv(out: &mut dyn Write, shots: &[ShotData]) -> Result<()
             so_se,
             pd,
             pd_se,
+            pf,
+            pf_se,
             num(e.t_touch.value),
             num(e.t_touch.se),
             num(e.t_sep.value),
@@ -236,10 +248,17 @@ fn safe_name(clip: &str) -> String {
 }
 
 /// Writes `estimates.csv`, `trajectories/`, `fit.json` and returns their paths.
-pub(crate) fn write_all(dir: &Path, shots: &[ShotData], fit: &FitResult) -> Result<Vec<PathBuf>, AnalyzeError> {
+pub(crate) fn write_all(
+    dir: &Path,
+    shots: &[ShotData],
+    fit: &FitResult,
+    spec: &bouncelab_model::ModelSpec,
+) -> Result<Vec<PathBuf>, AnalyzeError> {
     let mut written = Vec::new();
     let path = dir.join("estimates.csv");
-    write_atomic(&path, |w| write_estimates_csv(w, shots).map_err(csv_io))?;
+    write_atomic(&path, |w| {
+        write_estimates_csv(w, shots, spec.ball.mass_kg, spec.gravity).map_err(csv_io)
+    })?;
     written.push(path);
     let traj = dir.join("trajectories");
     std::fs::create_dir_all(&traj).map_err(|source| AnalyzeError::Io {
@@ -311,7 +330,7 @@ pub fn write_comparison_csv(out: &mut dyn Write, comparison: &bouncelab_compare:
 type SurfaceQuantity = (&'static str, &'static str, f64, fn(&r::ShotMeasurement) -> Option<f64>);
 
 /// The quantities of `surfaces.csv`, measured first, then the model's.
-const SURFACE_QUANTITIES: [SurfaceQuantity; 15] = [
+const SURFACE_QUANTITIES: [SurfaceQuantity; 16] = [
     ("impact_speed", "m/s", 1.0, |m| Some(m.impact_speed().value)),
     ("impact_angle", "deg", 1.0, |m| Some(m.impact_angle().value)),
     ("v_in_n", "m/s", 1.0, |m| Some(m.v_in_m_s[1].value.abs())),
@@ -324,6 +343,7 @@ const SURFACE_QUANTITIES: [SurfaceQuantity; 15] = [
     ("peak_decel_track", "m/s2", 1.0, |m| {
         m.peak_deceleration_track_m_s2.map(|v| v.value)
     }),
+    ("peak_force_track", "N", 1.0, |m| m.peak_force_track_n.map(|v| v.value)),
     ("cor_model", "1", 1.0, |m| m.model.map(|p| p.cor)),
     ("contact_model", "ms", 1e3, |m| m.model.map(|p| p.contact_time_s)),
     ("delta_max_model", "mm", 1e3, |m| m.model.map(|p| p.delta_max_m)),

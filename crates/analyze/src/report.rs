@@ -271,9 +271,17 @@ fn measured(m: bouncelab_estimate::Measured) -> r::Measured {
     r::Measured::new(m.value, m.se)
 }
 
-/// Every measured quantity of a shot, with the model's prediction for it.
-pub(crate) fn measurement(s: &ShotData, model: Option<r::ShotPrediction>) -> r::ShotMeasurement {
+/// Every measured quantity of a shot, with the model's prediction for it; `ball_mass_kg` and `gravity`
+/// turn the track's deceleration into a force.
+pub(crate) fn measurement(
+    s: &ShotData,
+    model: Option<r::ShotPrediction>,
+    ball_mass_kg: f64,
+    gravity: f64,
+) -> r::ShotMeasurement {
     let e = &s.estimate;
+    let decel = track_peak_deceleration(&s.measured.frames, e.t_touch.value, e.t_sep.value);
+    let g_n = gravity * s.angle_deg.to_radians().cos();
     r::ShotMeasurement {
         clip: s.clip.clone(),
         surface: s.surface.clone(),
@@ -288,8 +296,8 @@ pub(crate) fn measurement(s: &ShotData, model: Option<r::ShotPrediction>) -> r::
         delta_max_m: measured(e.delta_max_m),
         spin_in_rad_s: e.spin_in.map(measured),
         spin_out_rad_s: e.spin_out.map(measured),
-        peak_deceleration_track_m_s2: track_peak_deceleration(&s.measured.frames, e.t_touch.value, e.t_sep.value)
-            .map(|(a, se)| r::Measured::new(a, se)),
+        peak_deceleration_track_m_s2: decel.map(|(a, se)| r::Measured::new(a, se)),
+        peak_force_track_n: decel.map(|(a, se)| r::Measured::new(ball_mass_kg * (a + g_n), ball_mass_kg * se)),
         model,
     }
 }
@@ -331,7 +339,7 @@ pub(crate) fn build(a: &Analysis, p: &Predictions, description: Option<&str>, wa
             .shots
             .iter()
             .zip(&p.per_shot)
-            .map(|(s, m)| measurement(s, *m))
+            .map(|(s, m)| measurement(s, *m, a.model.ball.mass_kg, a.model.gravity))
             .collect(),
         model_curves: p.curves.clone(),
         contact_force: match &p.force {

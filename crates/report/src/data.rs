@@ -289,6 +289,9 @@ pub struct ShotMeasurement {
     /// Peak normal deceleration of the ball's centre from the track's second difference, m/s², when the
     /// track resolves it.
     pub peak_deceleration_track_m_s2: Option<Measured>,
+    /// Peak normal contact force from the same, N: the mass times (the deceleration + gravity's normal
+    /// component).
+    pub peak_force_track_n: Option<Measured>,
     /// The fitted model hit at this shot's measured incoming velocity, when a model was fitted.
     pub model: Option<ShotPrediction>,
 }

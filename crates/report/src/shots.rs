@@ -210,6 +210,7 @@ fn measured_table(ctx: &Ctx) -> String {
                 opt_pm(m.spin_in_rad_s, 1.0, 3),
                 opt_pm(m.spin_out_rad_s, 1.0, 3),
                 opt_pm(m.peak_deceleration_track_m_s2, 1.0, 4),
+                opt_pm(m.peak_force_track_n, 1.0, 4),
             ]
         })
         .collect();
@@ -229,6 +230,7 @@ fn measured_table(ctx: &Ctx) -> String {
             nc("ω<sub>in</sub> (rad/s)"),
             nc("ω<sub>out</sub> (rad/s)"),
             nc("Peak decel. (m/s²)"),
+            nc("Peak force (N)"),
         ],
         &rows,
     )

@@ -218,6 +218,8 @@ pub fn sample_report_with(per_surface: usize, seed: u64) -> Report {
                 spin_out_rad_s: spin,
                 peak_deceleration_track_m_s2: (v_n > 2.5)
                     .then(|| Measured::new(std::f64::consts::PI * v_n * 1.8 / tc, 60.0)),
+                peak_force_track_n: (v_n > 2.5)
+                    .then(|| Measured::new(0.0567 * (std::f64::consts::PI * v_n * 1.8 / tc + G), 3.4)),
                 model: Some(prediction(e2, k, v_n)),
             });
             errors.push((surface.into(), 100.0 * (e_model - cor).abs() / cor));
@@ -637,6 +639,7 @@ pub fn hostile_report() -> Report {
         spin_in_rad_s: Some(q(nan, None)),
         spin_out_rad_s: None,
         peak_deceleration_track_m_s2: Some(q(inf, Some(nan))),
+        peak_force_track_n: Some(q(-inf, None)),
         model: Some(ShotPrediction {
             cor: nan,
             peak_force_n: inf,

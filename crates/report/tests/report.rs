@@ -114,6 +114,7 @@ fn every_quantity_is_shown_per_surface_and_per_shot() {
         "Spin in ω<sub>in</sub> (rad/s)",
         "Spin out ω<sub>out</sub> (rad/s)",
         "Peak deceleration, track (m/s²)",
+        "Peak contact force, track (N)",
         "Peak contact force, model (N)",
         "Peak deceleration, model (m/s²)",
     ] {
@@ -398,6 +399,7 @@ fn report_from(v: &[f64], n: usize) -> Report {
                 spin_in_rad_s: Some(q()),
                 spin_out_rad_s: Some(q()),
                 peak_deceleration_track_m_s2: Some(q()),
+                peak_force_track_n: Some(q()),
                 model: Some(ShotPrediction {
                     cor: q().value,
                     peak_force_n: q().value,
