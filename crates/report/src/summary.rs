@@ -90,6 +90,13 @@ pub(crate) const QUANTITIES: &[Quantity] = &[
         get: |m| m.peak_deceleration_track_m_s2.map(|s| s.value),
     },
     Quantity {
+        name: "Peak contact force, track",
+        unit: "N",
+        scale: 1.0,
+        sig: 4,
+        get: |m| m.peak_force_track_n.map(|s| s.value),
+    },
+    Quantity {
         name: "COR, model",
         unit: "",
         scale: 1.0,
