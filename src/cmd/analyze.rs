@@ -229,11 +229,17 @@ pub fn print_summary(a: &Analysis) {
         a.fit.reduced_chi2
     );
     for p in &a.fit.parameters {
+        // A length (a surface level) is a fraction of a millimetre: in µm, as residuals are.
+        let (k, unit) = if p.param.ends_with("_m") {
+            (1e6, " µm")
+        } else {
+            (1.0, "")
+        };
         let ci = p
             .interval
-            .map(|[lo, hi]| format!(" [{lo:.4}, {hi:.4}]"))
+            .map(|[lo, hi]| format!(" [{:.4}, {:.4}]", lo * k, hi * k))
             .unwrap_or_default();
-        println!("  {:<28} {:>12.4}{ci}", p.name, p.value);
+        println!("  {:<28} {:>12.4}{unit}{ci}", p.name, p.value * k);
     }
     for sentence in &a.failure.sentences {
         println!("  {}", sentence.replace('`', ""));
