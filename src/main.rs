@@ -32,6 +32,10 @@ enum Command {
     Estimate(cmd::estimate::Args),
     /// Track the ball through one clip folder and write its trajectory (CSV).
     Track(cmd::track::Args),
+    /// Track one clip and draw the tracking on its frames (PNG) and a sheet of its key frames.
+    Overlay(cmd::overlay::Args),
+    /// Start a session from a folder of recordings: write session.toml and clips.csv to complete.
+    Init(cmd::init::Args),
     /// Everything over a session folder: track, estimate, fit, compare, diagnose, stats, report.
     Analyze(cmd::analyze::Args),
     /// The missing-effect verdict over a session folder (runs `analyze`), with its evidence.
@@ -48,7 +52,9 @@ fn main() -> ExitCode {
         Command::Effects(a) => cmd::effects::run(a),
         Command::Render(a) => cmd::render::run(a),
         Command::Track(a) => cmd::track::run(a),
+        Command::Overlay(a) => cmd::overlay::run(a),
         Command::Estimate(a) => cmd::estimate::run(a),
+        Command::Init(a) => cmd::init::run(a),
         Command::Analyze(a) => cmd::analyze::run(a),
         Command::Diagnose(a) => cmd::diagnose::run(a),
         Command::Model(a) => cmd::model::run(a),

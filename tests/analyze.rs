@@ -344,6 +344,41 @@ fn a_clip_without_a_ball_fails_alone_and_the_rest_is_written() {
     );
 }
 
+/// When no shot can be measured, what was measured is still written: the trajectories, an estimates.csv
+/// without rows, and a report giving each shot's reason and how far it got (exit 1).
+#[test]
+fn when_every_shot_fails_the_trajectories_and_a_report_are_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let session = copy_session(dir.path());
+    let out = dir.path().join("out");
+    // Only the first 40 frames of each clip: the ball never reaches the surface.
+    let clips: Vec<PathBuf> = std::fs::read_dir(&session)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_dir())
+        .collect();
+    for clip in &clips {
+        let mut frames: Vec<PathBuf> = std::fs::read_dir(clip).unwrap().map(|e| e.unwrap().path()).collect();
+        frames.sort();
+        for f in frames.iter().skip(40) {
+            std::fs::remove_file(f).unwrap();
+        }
+    }
+    fails_naming(&mut analyze(&session, &out), "none of the 3 shot(s) could be measured");
+    let estimates = std::fs::read_to_string(out.join("estimates.csv")).unwrap();
+    assert_eq!(estimates.lines().count(), 1, "a header only:\n{estimates}");
+    for clip in &clips {
+        let name = clip.file_name().unwrap().to_string_lossy().into_owned();
+        let t = std::fs::read_to_string(out.join("trajectories").join(format!("{name}.csv"))).unwrap();
+        assert_eq!(t.lines().count(), 41, "{name}");
+    }
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(
+        html.contains("no impact in the clip") && html.contains("ball measured in 40 of 40 frames"),
+        "{html}"
+    );
+}
+
 #[test]
 fn text_from_input_files_is_escaped_in_the_report() {
     let dir = tempfile::tempdir().unwrap();

@@ -238,3 +238,73 @@ fn track_bad_inputs_exit_1_naming_the_folder() {
         .code(1)
         .stderr(predicate::str::contains("fps"));
 }
+
+/// The 30 frames of `write_session_with_one_clip` as an 8-bit Photron recording (`.cih` text header +
+/// `.mraw`) named by its conditions, in a folder of its own.
+fn write_camera_recording(root: &std::path::Path) -> std::path::PathBuf {
+    let frames = write_session_with_one_clip(&root.join("pngs"));
+    let mut files: Vec<_> = std::fs::read_dir(&frames).unwrap().map(|e| e.unwrap().path()).collect();
+    files.sort();
+    let mut raw = Vec::new();
+    for f in &files {
+        raw.extend(image::open(f).unwrap().into_luma8().into_raw());
+    }
+    let dir = root.join("recordings");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("clay_15deg_550mm.mraw"), raw).unwrap();
+    std::fs::write(
+        dir.join("clay_15deg_550mm.cih"),
+        "#Camera Information Header\nRecord Rate(fps) : 10000\nShutter Speed(s) : 1/20000\nTotal Frame : 30\n\
+         Start Frame : 0\nImage Width : 256\nImage Height : 256\nColor Type : Mono\nColor Bit : 8\n\
+         File Format : MRaw\nEffectiveBit Depth : 8\nEffectiveBit Side : Lower\n",
+    )
+    .unwrap();
+    dir
+}
+
+#[test]
+fn track_reads_a_camera_file_and_init_writes_a_session_for_it() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(dir.path().join("pngs")).unwrap();
+    let rec = write_camera_recording(dir.path());
+    bouncelab()
+        .args(["track", rec.join("clay_15deg_550mm.cih").to_str().unwrap()])
+        .assert()
+        .success()
+        .stderr(
+            predicate::str::contains("30 frames, ball measured in 30")
+                .and(predicate::str::contains("no ball diameter given"))
+                .and(predicate::str::contains("frame rate").not()),
+        );
+    bouncelab()
+        .args(["init", rec.to_str().unwrap(), "--diameter", "0.067", "--mass", "0.0567"])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("clay_15deg_550mm.cih").and(predicate::str::contains("10000 fps")));
+    let csv = std::fs::read_to_string(rec.join("clips.csv")).unwrap();
+    assert!(csv.contains("clay_15deg_550mm.cih,clay,15,0.55"), "{csv}");
+    let toml = std::fs::read_to_string(rec.join("session.toml")).unwrap();
+    assert!(
+        toml.contains("fps = 10000.0") && toml.contains("diameter_m = 0.067"),
+        "{toml}"
+    );
+    bouncelab()
+        .args(["init", rec.to_str().unwrap()])
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("session.toml").and(predicate::str::contains("--force")));
+    // Inside the session, the diameter comes from session.toml: no default is taken.
+    bouncelab()
+        .args(["track", rec.join("clay_15deg_550mm.mraw").to_str().unwrap()])
+        .assert()
+        .success()
+        .stderr(predicate::str::contains("no ball diameter given").not());
+    let video = rec.join("shot.mp4");
+    std::fs::write(&video, b"x").unwrap();
+    #[cfg(not(feature = "opencv"))]
+    bouncelab()
+        .args(["track", video.to_str().unwrap()])
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("--features opencv").and(predicate::str::contains("ffmpeg")));
+}

@@ -1,4 +1,5 @@
-//! `bouncelab estimate`: one clip folder → its per-shot measurements with standard errors.
+//! `bouncelab estimate`: one clip (a folder of frames or a camera file) → its per-shot measurements with
+//! standard errors.
 
 use anyhow::Context;
 use bouncelab_estimate::{Conditions, Estimate, estimate_with_frames};
@@ -8,14 +9,18 @@ use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Folder of frames (one clip), inside a session folder or on its own.
+    /// One clip (a folder of frames, or a camera file: .cihx/.cih/.mraw, .cine, .tif stack), inside a
+    /// session folder or on its own.
     clip_dir: PathBuf,
     /// Incline of the surface, degrees (default: the clip's angle_deg in the session's clips.csv).
     #[arg(long, allow_negative_numbers = true)]
     angle: Option<f64>,
-    /// Frame rate, frames/s (beats clip.toml and session.toml).
+    /// Frame rate, frames/s (beats clip.toml, the camera header and session.toml).
     #[arg(long)]
     fps: Option<f64>,
+    /// Ball diameter, m (beats clip.toml and session.toml's [ball] diameter_m; else 0.067, with a warning).
+    #[arg(long)]
+    diameter: Option<f64>,
     /// Gravitational acceleration, m/s².
     #[arg(long, default_value_t = 9.81)]
     gravity: f64,
@@ -24,38 +29,44 @@ pub struct Args {
     json: bool,
 }
 
-/// What the session around the clip says: ball diameter, down-slope direction, and the clip's incline.
-fn from_session(clip_dir: &Path) -> (Option<f64>, bool, Option<f64>) {
+/// What the session around the clip says: down-slope direction, and the clip's incline.
+fn from_session(clip_dir: &Path) -> (bool, Option<f64>) {
     let Ok(dir) = clip_dir.canonicalize() else {
-        return (None, false, None);
+        return (false, None);
     };
-    let (Some(parent), Some(name)) = (dir.parent(), dir.file_name().and_then(|n| n.to_str())) else {
-        return (None, false, None);
+    let Some(parent) = dir.parent() else {
+        return (false, None);
     };
     if !parent.join("session.toml").is_file() {
-        return (None, false, None);
+        return (false, None);
     }
     match Session::load(parent) {
         Ok(s) => {
-            let clip = s.clip(name);
+            // The row whose folder or camera file this is (clips.csv may name a file without its extension).
+            let clip = s.clips.iter().find(|c| c.dir.canonicalize().is_ok_and(|p| p == dir));
             let minus_x = clip.map(|c| c.downslope).unwrap_or(s.downslope) == Downslope::MinusX;
-            (Some(s.ball.diameter_m), minus_x, clip.map(|c| c.angle_deg))
+            (minus_x, clip.map(|c| c.angle_deg))
         }
-        Err(_) => (None, false, None),
+        Err(_) => (false, None),
     }
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
-    let options = a.fps.map(ClipOptions::with_fps).unwrap_or_default();
+    let mut options = ClipOptions::default();
+    options.fps = a.fps;
+    options.overrides.ball_diameter_m = a.diameter;
     let clip = Clip::open_with(&a.clip_dir, &options)?;
-    let (diameter, minus_x, session_angle) = from_session(&a.clip_dir);
+    for w in clip.warnings() {
+        eprintln!("warning: {w}");
+    }
+    let (minus_x, session_angle) = from_session(&a.clip_dir);
     let Some(angle) = a.angle.or(session_angle) else {
         anyhow::bail!(
             "{}: no incline known: give --angle, or put the clip in a session folder whose clips.csv lists it",
             a.clip_dir.display()
         );
     };
-    let diameter = diameter.unwrap_or(0.067);
+    let diameter = clip.settings().ball_diameter_m;
     let opts = ClipTracking {
         ball_diameter_m: diameter,
         downslope_negative_x: minus_x,

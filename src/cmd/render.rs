@@ -7,10 +7,11 @@ use std::path::PathBuf;
 #[derive(clap::Args)]
 #[command(group = clap::ArgGroup::new("source").required(true).args(["preset", "scenario"]))]
 pub struct Args {
-    /// Built-in scenario: smoke, paper, none, or effect-<name> for a library effect (names: `bouncelab effects`).
+    /// Built-in scenario: smoke, paper, none, looks (64 shots with drawn looks and physics), looks-smoke,
+    /// effect-<name> (an unknown name lists them all).
     #[arg(long)]
     preset: Option<String>,
-    /// Scenario file (TOML; see docs/renderer.md).
+    /// Scenario file (TOML; see docs/renderer.md; a [look] table draws each shot's appearance).
     #[arg(long)]
     scenario: Option<PathBuf>,
     /// Output folder: the session goes to DIR/session, its ground truth to DIR/truth.

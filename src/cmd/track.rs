@@ -1,25 +1,32 @@
-//! `bouncelab track`: one clip folder → its trajectory CSV (SPEC §5 columns).
+//! `bouncelab track`: one clip (a folder of frames or a camera file) → its trajectory CSV.
 
 use anyhow::Context;
 use bouncelab_frames::{Clip, ClipOptions, Downslope, Session};
-use bouncelab_track::{ClipTracking, track_clip};
+use bouncelab_track::{ClipTracking, Track, track_clip};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Folder of frames (one clip).
+    /// One clip: a folder of frames, or a camera file (.cihx/.cih/.mraw, .cine, .tif stack).
     clip_dir: PathBuf,
     /// Trajectory CSV to write; standard output when omitted.
     #[arg(long)]
     out: Option<PathBuf>,
+    #[command(flatten)]
+    tracking: Tracking,
+}
+
+/// How a clip is tracked: shared by `track` and `overlay`.
+#[derive(clap::Args)]
+pub struct Tracking {
     /// Detector (builds with the `opencv` feature also offer OpenCV's HoughCircles as `opencv`).
     #[arg(long, value_enum, default_value_t = Detector::Hough)]
     detector: Detector,
     /// Frame rate, frames/s (beats clip.toml and session.toml).
     #[arg(long, allow_negative_numbers = true)]
     fps: Option<f64>,
-    /// Ball diameter, m (default: session.toml's [ball] diameter_m, else 0.067).
+    /// Ball diameter, m (beats clip.toml and session.toml's [ball] diameter_m; else 0.067, with a warning).
     #[arg(long)]
     diameter: Option<f64>,
     /// Approximate scale, m/px, if known (otherwise the ball is found by its motion).
@@ -36,48 +43,41 @@ enum Detector {
     Opencv,
 }
 
-/// Ball diameter and down-slope direction from the session folder above the clip, if there is one.
-fn session_settings(clip_dir: &Path) -> (Option<f64>, bool) {
+/// Down-slope direction from the session folder above the clip, if there is one.
+fn session_minus_x(clip_dir: &Path) -> bool {
     let Some(parent) = clip_dir
         .canonicalize()
         .ok()
         .and_then(|p| p.parent().map(Path::to_path_buf))
     else {
-        return (None, false);
+        return false;
     };
     if !parent.join("session.toml").is_file() {
-        return (None, false);
+        return false;
     }
     match Session::load(&parent) {
-        Ok(s) => (Some(s.ball.diameter_m), s.downslope == Downslope::MinusX),
-        Err(_) => (None, false),
+        Ok(s) => s.downslope == Downslope::MinusX,
+        Err(_) => false,
     }
 }
 
-pub fn run(a: Args) -> anyhow::Result<()> {
-    let options = match a.fps {
-        Some(f) => ClipOptions::with_fps(f),
-        None => ClipOptions::default(),
-    };
-    let clip = Clip::open_with(&a.clip_dir, &options)?;
+/// Opens the clip and tracks it as `bouncelab track` does (warnings printed, a progress bar on a terminal).
+pub fn track_clip_dir(clip_dir: &Path, a: &Tracking) -> anyhow::Result<(Clip, Track)> {
+    let mut options = ClipOptions::default();
+    options.fps = a.fps;
+    options.overrides.ball_diameter_m = a.diameter;
+    options.overrides.scale_m_per_px = a.scale;
+    let clip = Clip::open_with(clip_dir, &options)?;
     for w in clip.warnings() {
         eprintln!("warning: {w}");
     }
     if !clip.gaps().is_empty() {
-        eprintln!(
-            "warning: {} dropped frame(s) in {}",
-            clip.dropped(),
-            a.clip_dir.display()
-        );
+        eprintln!("warning: {} dropped frame(s) in {}", clip.dropped(), clip_dir.display());
     }
-    let (session_diameter, minus_x) = session_settings(&a.clip_dir);
-    let diameter = a.diameter.or(session_diameter).unwrap_or(0.067);
-    if !(diameter > 0.0 && diameter.is_finite()) {
-        anyhow::bail!("--diameter {diameter} must be a positive number of metres");
-    }
+    let minus_x = session_minus_x(clip_dir);
     let opts = ClipTracking {
-        ball_diameter_m: diameter,
-        scale_hint_m_per_px: a.scale,
+        ball_diameter_m: clip.settings().ball_diameter_m,
+        scale_hint_m_per_px: clip.settings().scale_m_per_px,
         downslope_negative_x: minus_x,
         ..ClipTracking::default()
     };
@@ -94,11 +94,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             progress,
         ),
     }
-    .with_context(|| format!("tracking {}", a.clip_dir.display()))?;
+    .with_context(|| format!("tracking {}", clip_dir.display()))?;
     bar.finish_and_clear();
     for w in &track.warnings {
         eprintln!("warning: {w}");
     }
+    Ok((clip, track))
+}
+
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let (_, track) = track_clip_dir(&a.clip_dir, &a.tracking)?;
     let mut out: Box<dyn Write> = match &a.out {
         Some(p) => Box::new(std::fs::File::create(p).with_context(|| format!("creating {}", p.display()))?),
         None => Box::new(std::io::stdout().lock()),

@@ -45,7 +45,9 @@ pub enum AnalyzeError {
         source: csv::Error,
     },
     /// No shot of the session could be measured, so nothing can be fitted.
-    #[error("{session}: none of the {total} shot(s) could be measured; first failure: {first}")]
+    #[error(
+        "{session}: none of the {total} shot(s) could be measured; first failure: {first} (the failures, and the trajectories that were measured, are in the files written)"
+    )]
     NothingMeasured {
         /// The session folder.
         session: PathBuf,
@@ -53,6 +55,9 @@ pub enum AnalyzeError {
         total: usize,
         /// The first shot's failure, "clip: reason".
         first: String,
+        /// What was written all the same: `estimates.csv` (no rows), the measured trajectories,
+        /// `report.html` with every shot's failure.
+        written: Vec<PathBuf>,
     },
     /// A stored estimate lacks the detail later stages need (written by an older program).
     #[error(

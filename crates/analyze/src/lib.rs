@@ -20,7 +20,7 @@ pub use outputs::{
     write_comparison_csv, write_estimates_csv,
 };
 pub use report::{track_peak_deceleration, verdict_headline};
-pub use shots::{ShotData, load_shots, measured_shot};
+pub use shots::{ShotData, load_failed_tracks, load_shots, measured_shot};
 
 use bouncelab_compare::{Comparison, FailureReport, ShotExtras, SpinFrame};
 use bouncelab_diagnose::{Diagnosis, SearchOptions, find_missing_effect_with};
@@ -253,7 +253,20 @@ pub fn analyze(
     let measure = measure_session(&session, &mut store, spec.gravity, options.fingerprint, progress)?;
     timings.push((Stage::Track, t.elapsed().as_secs_f64()));
     let shots = load_shots(&store, measure.session_id)?;
+    let failed_tracks = load_failed_tracks(&store, measure.session_id)?;
     if shots.is_empty() {
+        // Nothing to fit, but what was measured is written: the trajectories of the shots that were
+        // tracked, an empty estimates.csv, and a report listing every shot's failure and how far it got.
+        create_dir(&options.out_dir)?;
+        let tracks: Vec<_> = failed_tracks.iter().map(|(c, t, _)| (c.clone(), t.clone())).collect();
+        let mut written = vec![outputs::write_estimates_only(&options.out_dir, &shots, &spec)?];
+        written.extend(outputs::write_failed_trajectories(&options.out_dir, &tracks)?);
+        written.push(report::write_failure(
+            &options.out_dir,
+            &session,
+            &measure,
+            &failed_tracks,
+        )?);
         let first = measure
             .failed
             .first()
@@ -263,12 +276,18 @@ pub fn analyze(
             session: session_dir.to_path_buf(),
             total: session.clips.len(),
             first,
+            written,
         });
     }
 
     let t = std::time::Instant::now();
     progress.start(Stage::Fit, 1);
-    let excluded = suspect_tracks(&shots);
+    let mut excluded = flagged_shots(&shots);
+    for (clip, why) in suspect_tracks(&shots) {
+        if !excluded.iter().any(|(c, _)| *c == clip) {
+            excluded.push((clip, why));
+        }
+    }
     for (clip, why) in &excluded {
         progress.note(&format!("{clip} is left out of the fit: {why}"));
     }
@@ -401,6 +420,8 @@ pub fn analyze(
     let t = std::time::Instant::now();
     create_dir(&options.out_dir)?;
     let mut outputs = outputs::write_all(&options.out_dir, &shots, &fit, &spec)?;
+    let tracks: Vec<_> = failed_tracks.iter().map(|(c, t, _)| (c.clone(), t.clone())).collect();
+    outputs::write_failed_trajectories(&options.out_dir, &tracks)?;
     outputs.push(outputs::write_comparison(&options.out_dir, &comparison)?);
     if let Ok(st) = &stats {
         outputs.push(outputs::write_anova(&options.out_dir, &st.ancova)?);
@@ -511,6 +532,16 @@ fn before_after(
         reduced_chi2: (old.reduced_chi2, fit.reduced_chi2),
         shots,
     }))
+}
+
+/// Shots whose estimate says their numbers are not to be trusted (see `Estimate::flags`: a flight that does not
+/// fall like a ball …), with the reasons.
+pub fn flagged_shots(shots: &[ShotData]) -> Vec<(String, String)> {
+    shots
+        .iter()
+        .filter(|s| !s.estimate.flags.is_empty())
+        .map(|s| (s.clip.clone(), s.estimate.flags.join("; ")))
+        .collect()
 }
 
 /// How far a shot's flight fits may scatter beyond the session's typical shot before its track is suspect.

@@ -67,8 +67,9 @@ pub(crate) fn session_key(session: &Session) -> String {
 }
 
 /// Raised whenever the tracker or the estimator changes what they record for a shot, so that shots
-/// measured by an earlier build are measured again (2: estimates carry the surface line's σ).
-const MEASUREMENT_REVISION: u32 = 2;
+/// measured by an earlier build are measured again (2: estimates carry the surface line's σ; 3: the contact
+/// line's source, the local frame along the measured tilt, the gravity check).
+const MEASUREMENT_REVISION: u32 = 3;
 
 /// Everything besides the frame files that changes a shot's track or estimate.
 fn settings_text(session: &Session, entry: &ClipEntry, gravity: f64) -> String {
@@ -200,21 +201,37 @@ fn measure_clip(session: &Session, entry: &ClipEntry, gravity: f64) -> Measured 
         gravity,
         ball_diameter_m: session.ball.diameter_m,
     };
-    let estimate = estimate_with_frames(&track, &clip, &conditions)
-        .map(|e| estimate_record(&e))
-        .map_err(|e| format!("estimating: {e}"));
-    Ok((track_record(&track, started.elapsed().as_secs_f64()), estimate))
+    let estimate = estimate_with_frames(&track, &clip, &conditions);
+    // The trajectory in the estimate's local frame (on the contact line it chose, along its tilt), else in
+    // the frame of the line the tracker found.
+    let frame = estimate.as_ref().ok().and_then(|e| e.frame);
+    let line = estimate.as_ref().ok().and_then(|e| e.contact_line).or(track.surface);
+    let record = track_record(&track, frame.as_ref(), line.as_ref(), started.elapsed().as_secs_f64());
+    Ok((
+        record,
+        estimate
+            .map(|e| estimate_record(&e))
+            .map_err(|e| format!("estimating: {e}")),
+    ))
 }
 
-fn track_record(track: &Track, seconds: f64) -> TrackRecord {
-    let rows = track.rows();
+fn track_record(
+    track: &Track,
+    frame: Option<&bouncelab_track::SurfaceFrame>,
+    line: Option<&bouncelab_track::SurfaceLine>,
+    seconds: f64,
+) -> TrackRecord {
+    let rows = match frame {
+        Some(f) => track.rows_in(Some(f)),
+        None => track.rows(),
+    };
     TrackRecord {
         frames: track.fixes.len() as u64,
         measured: track.fixes.iter().filter(|f| f.status.measured()).count() as u64,
         scale_m_per_px: track.scale.map(|s| s.m_per_px),
         scale_se: track.scale.map(|s| s.sigma_m_per_px),
-        surface_y_px: track.surface.map(|l| l.y0),
-        surface_tilt_deg: track.surface.map(|l| l.tilt_deg()),
+        surface_y_px: line.map(|l| l.y0),
+        surface_tilt_deg: line.map(|l| l.tilt_deg()),
         warnings: track.warnings.clone(),
         seconds,
         rows: rows

@@ -208,11 +208,49 @@ pub fn write_estimates_csv(
 
 /// `trajectories/<clip>.csv`: the SPEC §5 columns of every frame.
 fn write_trajectory(out: &mut dyn Write, s: &ShotData) -> Result<(), csv::Error> {
+    write_track_rows(out, &s.track)
+}
+
+/// Writes `trajectories/<clip>.csv` for tracks whose shots could not be estimated (what was measured of them
+/// is still a person's to look at).
+pub(crate) fn write_failed_trajectories(
+    dir: &Path,
+    tracks: &[(String, bouncelab_store::TrackRecord)],
+) -> Result<Vec<PathBuf>, AnalyzeError> {
+    let traj = dir.join("trajectories");
+    std::fs::create_dir_all(&traj).map_err(|source| AnalyzeError::Io {
+        path: traj.clone(),
+        source,
+    })?;
+    let mut written = Vec::new();
+    for (clip, track) in tracks {
+        let path = traj.join(format!("{}.csv", safe_name(clip)));
+        write_atomic(&path, |w| write_track_rows(w, track).map_err(csv_io))?;
+        written.push(path);
+    }
+    Ok(written)
+}
+
+/// `estimates.csv` with no fit behind it: the rows of `shots` (possibly none); `spec` gives the ball's mass
+/// and gravity.
+pub(crate) fn write_estimates_only(
+    dir: &Path,
+    shots: &[ShotData],
+    spec: &bouncelab_model::ModelSpec,
+) -> Result<PathBuf, AnalyzeError> {
+    let path = dir.join("estimates.csv");
+    write_atomic(&path, |w| {
+        write_estimates_csv(w, shots, spec.ball.mass_kg, spec.gravity).map_err(csv_io)
+    })?;
+    Ok(path)
+}
+
+fn write_track_rows(out: &mut dyn Write, track: &bouncelab_store::TrackRecord) -> Result<(), csv::Error> {
     let mut w = csv::Writer::from_writer(out);
     w.write_record([
         "frame", "t_s", "x_px", "y_px", "r_px", "sigma_px", "quality", "status", "x_m", "y_m",
     ])?;
-    for r in &s.track.rows {
+    for r in &track.rows {
         w.write_record([
             r.frame.to_string(),
             num(r.t_s),

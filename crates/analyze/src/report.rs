@@ -719,6 +719,56 @@ pub(crate) fn write(
     Ok(written)
 }
 
+/// `report.html` when no shot could be measured: the session, and every shot's failure with how far it got
+/// (tracked in how many frames, or not at all).
+pub(crate) fn write_failure(
+    dir: &std::path::Path,
+    session: &bouncelab_frames::Session,
+    measure: &crate::MeasureSummary,
+    failed_tracks: &[(String, bouncelab_store::TrackRecord, String)],
+) -> Result<std::path::PathBuf, crate::AnalyzeError> {
+    let mut notes: Vec<String> = session.warnings.iter().map(|w| w.to_string()).collect();
+    for (clip, why) in &measure.failed {
+        let got = match failed_tracks.iter().find(|(c, _, _)| c == clip) {
+            Some((_, t, _)) => format!(
+                "tracked: ball measured in {} of {} frames; trajectory written",
+                t.measured, t.frames
+            ),
+            None => "not tracked".to_string(),
+        };
+        notes.push(format!("{clip}: not measured: {why} ({got})"));
+    }
+    let name = session
+        .dir
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| session.dir.display().to_string());
+    let none = "no shot could be measured (see the notes for each shot's reason)";
+    let report = r::Report {
+        title: format!("bouncelab report: {name}"),
+        session: r::SessionInfo {
+            path: session.dir.display().to_string(),
+            description: String::new(),
+            shots: session.clips.len(),
+            surfaces: Vec::new(),
+            generated_by: format!("bouncelab {}", env!("CARGO_PKG_VERSION")),
+            generated_at: None,
+            metadata: vec![("shots measured".into(), "0".into())],
+        },
+        contact_force: r::Section::unavailable(none),
+        ancova: r::Section::unavailable(none),
+        inference: r::Section::unavailable(none),
+        fit: r::Section::unavailable(none),
+        diagnosis: r::Section::unavailable(none),
+        model_change: r::Section::unavailable(none),
+        warnings: notes,
+        ..Default::default()
+    };
+    let path = dir.join("report.html");
+    bouncelab_report::write_report(&path, &report)?;
+    Ok(path)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

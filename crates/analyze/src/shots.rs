@@ -60,6 +60,21 @@ pub fn load_shots(store: &Store, session_id: i64) -> Result<Vec<ShotData>, Analy
     Ok(out)
 }
 
+/// The stored tracks of the session's shots that could not be estimated, with their failure: (clip, track,
+/// reason). Shots that failed before a track was made are left out (see [`crate::MeasureSummary::failed`]).
+pub fn load_failed_tracks(store: &Store, session_id: i64) -> Result<Vec<(String, TrackRecord, String)>, AnalyzeError> {
+    let mut out = Vec::new();
+    for row in store.shots(session_id)? {
+        if row.status != ShotStatus::Failed {
+            continue;
+        }
+        if let Some(track) = store.track(row.id)? {
+            out.push((row.record.clip.clone(), track, row.error.clone().unwrap_or_default()));
+        }
+    }
+    Ok(out)
+}
+
 /// The fit's view of one shot: frames (local frame, m) from the first fitted incoming frame to the last
 /// fitted outgoing one, each weighted by the tracker's σ (floored as the estimator floors it), and the
 /// simulation's start taken from the incoming ballistic arc at the first of those frames.

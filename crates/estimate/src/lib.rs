@@ -9,11 +9,15 @@
 //! impact, and a phase too short to fit is said to be so rather than guessed.
 
 mod ballistic;
+mod contact;
 mod shot;
 mod spin;
 
-pub use ballistic::{BallisticFit, fit_ballistic};
-pub use shot::{Conditions, Estimate, EstimateError, MIN_SIGMA_PX, Measured, PhaseFrames, estimate};
+pub use ballistic::{BallisticFit, fit_ballistic, fit_free_acceleration};
+pub use contact::{HeightPoint, TrajectoryContact, find_impact, trajectory_contact};
+pub use shot::{
+    Conditions, Estimate, EstimateError, GravityCheck, MIN_FLIGHT_FRAMES, MIN_SIGMA_PX, Measured, PhaseFrames, estimate,
+};
 pub use spin::{
     Rotation, Spin, SpinFrame, SpinOptions, estimate_with_frames, measure_spin, rotation_between, spin_from_frames,
 };

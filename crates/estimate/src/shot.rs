@@ -1,7 +1,8 @@
 //! One shot: phases, velocities, restitution, friction, contact time and penetration from a track.
 
-use crate::ballistic::{BallisticFit, fit_ballistic};
-use bouncelab_track::{Status, Track};
+use crate::ballistic::{BallisticFit, fit_ballistic, fit_free_acceleration};
+use crate::contact::{HeightPoint, TrajectoryContact, find_impact, trajectory_contact};
+use bouncelab_track::{LineCue, Status, SurfaceFrame, SurfaceLine, Track};
 use serde::{Deserialize, Serialize};
 
 /// The conditions of a shot that the video does not show.
@@ -93,8 +94,43 @@ pub struct Estimate {
     /// is the prior of each shot's deviation from it). 0 in estimates stored before it existed.
     #[serde(default)]
     pub surface_sigma_m: f64,
+    /// The contact line used, in the image: found (its `cue` says by which cue), given by the user, or taken
+    /// from the ball's trajectory (`LineCue::Trajectory`).
+    #[serde(default)]
+    pub contact_line: Option<SurfaceLine>,
+    /// The local frame the velocities are measured in: on the contact line, its axes along the line (so a
+    /// rolled camera's tilt is taken out) and its normal.
+    #[serde(default)]
+    pub frame: Option<SurfaceFrame>,
+    /// The surface's tilt in the image, degrees counter-clockwise as seen, with its standard error, when a line
+    /// was found (a camera rolled by φ shows the surface tilted by −φ for down-slope +x).
+    #[serde(default)]
+    pub surface_tilt_deg: Option<Measured>,
+    /// Where the ball's own trajectory puts the contact level, px above the contact line used (≈ 0 when the
+    /// two agree), with its standard error; `None` where the trajectory could not tell.
+    #[serde(default)]
+    pub trajectory_level_px: Option<Measured>,
+    /// The flights' acceleration, m/s² in the local frame (free fits of both arcs, weighted), against gravity's.
+    #[serde(default)]
+    pub gravity: Option<GravityCheck>,
+    /// Why the shot's numbers are not to be trusted (it is kept out of the fit); empty when they are.
+    #[serde(default)]
+    pub flags: Vec<String>,
     /// Things a person should know.
     pub notes: Vec<String>,
+}
+
+/// Does the ball fall like a ball? The free-flight arcs fitted with their acceleration free.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct GravityCheck {
+    /// Measured acceleration (along the surface down-slope, along the normal), m/s².
+    pub measured: [Measured; 2],
+    /// What gravity gives on the incline, m/s².
+    pub expected: [f64; 2],
+    /// True if they agree within 4 standard errors plus 10 % of g (drag and the like move it by a few %).
+    pub consistent: bool,
+    /// True if the error is too large for the check to say anything (over half of g).
+    pub inconclusive: bool,
 }
 
 impl Estimate {
@@ -117,12 +153,20 @@ pub enum EstimateError {
     /// The track has no scale (the ball was never measured clear of the surface).
     #[error("no scale: the ball was not measured in free flight in enough frames")]
     NoScale,
-    /// No surface line was found.
-    #[error("no surface line found: cannot tell when the ball touches the surface")]
-    NoSurface,
+    /// No surface line was found and the trajectory could not tell the contact either.
+    #[error("no surface line found and the trajectory cannot tell the contact: {why}")]
+    NoSurface { why: String },
     /// The ball never came within a pixel of the surface.
     #[error("no impact in the clip: the ball comes no closer than {clearance_px:.1} px to the surface")]
     NoContact { clearance_px: f64 },
+    /// The trajectory never comes down and goes up again.
+    #[error(
+        "no impact in the clip: the ball {} through all {frames} measured frames ({:.3} ± {:.3} m/s along the normal at the last)",
+        if *speed_m_s <= 0.0 { "falls" } else { "rises" },
+        speed_m_s.abs(),
+        se_m_s
+    )]
+    NoImpact { frames: usize, speed_m_s: f64, se_m_s: f64 },
     /// A flight phase has too few frames to fit.
     #[error(
         "{phase} flight too short to fit: {frames} usable frame(s), {needed} needed (the clip {which} too close to the impact)"
@@ -156,37 +200,61 @@ struct Point {
 }
 
 /// Measures one shot from its track.
+///
+/// The contact line is the best evidence available, in this order: a line the user gave; the line the
+/// tracker found, if the ball's trajectory agrees that the contact is there (else the other cue's line, if
+/// it agrees); the contact level the trajectory gives (see `contact.rs`). The local frame follows that line's
+/// tilt in the image.
 pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError> {
     let scale = track.scale.ok_or(EstimateError::NoScale)?;
-    let line = track.surface.ok_or(EstimateError::NoSurface)?;
     let s = scale.m_per_px;
-    let rows = track.rows();
-    let points: Vec<Point> = track
+    let measured: Vec<&bouncelab_track::BallFix> = track
         .fixes
         .iter()
-        .zip(&rows)
-        .filter(|(f, r)| matches!(f.status, Status::Ok | Status::Occluded) && r.x_m.is_finite())
-        .map(|(f, r)| Point {
-            frame: f.frame,
-            t: f.t_s,
-            x: r.x_m,
-            y: r.y_m,
-            sigma: f.sigma_px.max(MIN_SIGMA_PX) * s,
-            clearance_px: line.y_at(f.x_px) - f.y_px - scale.radius_px,
+        .filter(|f| matches!(f.status, Status::Ok | Status::Occluded) && f.x_px.is_finite() && f.y_px.is_finite())
+        .collect();
+    if measured.len() < 2 * MIN_FLIGHT_FRAMES {
+        return Err(EstimateError::FlightTooShort {
+            phase: "incoming",
+            frames: measured.len(),
+            needed: 2 * MIN_FLIGHT_FRAMES,
+            which: "holds too few measured frames",
+        });
+    }
+    let beta = c.incline_deg.to_radians();
+    let choice = contact_line(track, &measured, scale.radius_px, -c.gravity * beta.cos() / s)?;
+    let line = choice.line;
+    // The frame's origin: on the line, below the lowest centre.
+    let lowest = measured
+        .iter()
+        .min_by(|a, b| {
+            line.height_of(a.x_px, a.y_px)
+                .total_cmp(&line.height_of(b.x_px, b.y_px))
+        })
+        .expect("measured frames");
+    let frame = SurfaceFrame::on_line(&line, lowest.x_px, lowest.y_px, track.downslope_negative_x, s);
+    let points: Vec<Point> = measured
+        .iter()
+        .map(|f| {
+            let (x, y) = frame.to_local(f.x_px, f.y_px);
+            Point {
+                frame: f.frame,
+                t: f.t_s,
+                x,
+                y,
+                sigma: f.sigma_px.max(MIN_SIGMA_PX) * s,
+                clearance_px: y / s - scale.radius_px,
+            }
         })
         .collect();
-    let Some(low) = points
-        .iter()
-        .enumerate()
-        .min_by(|a, b| a.1.clearance_px.total_cmp(&b.1.clearance_px))
-        .map(|(i, _)| i)
-    else {
-        return Err(EstimateError::NoScale);
-    };
+    let low = (0..points.len())
+        .min_by(|&a, &b| points[a].clearance_px.total_cmp(&points[b].clearance_px))
+        .expect("measured frames");
     if points[low].clearance_px > CLEARANCE_MARGIN_PX {
-        return Err(EstimateError::NoContact {
+        // The trajectory's own account (a fall with its speed) says more than the clearance.
+        return Err(choice.no_impact.unwrap_or(EstimateError::NoContact {
             clearance_px: points[low].clearance_px,
-        });
+        }));
     }
     // The contact: the run of frames around the lowest one within the margin of the surface.
     let near = |p: &Point| p.clearance_px <= CLEARANCE_MARGIN_PX;
@@ -222,13 +290,23 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
     // errors (the line's scatter and its edge's definition as a uniform Type-B term, the scale's at one
     // radius), and for a fit's per-shot level only the shot-to-shot part, without the Type-B terms that a
     // surface's clips share (see `Estimate::surface_sigma_m`).
+    // A level taken from the trajectory is where the centre was at the touch, one radius above a line put
+    // one radius below it: the scale's error in that radius cancels.
+    let radius_scale = if line.cue == LineCue::Trajectory {
+        0.0
+    } else {
+        radius / s
+    };
     let sigma_level = ((line.sigma_y0.powi(2) + line.edge_definition_px.powi(2) / 3.0) * s * s
-        + (radius * scale.sigma_m_per_px / s).powi(2))
+        + (radius_scale * scale.sigma_m_per_px).powi(2))
     .sqrt();
     let scatter_scale = (scale.sigma_m_per_px.powi(2) - scale.sigma_shape_m_per_px.powi(2))
         .max(0.0)
         .sqrt();
-    let sigma_level_scatter = ((line.sigma_y0 * s).powi(2) + (radius * scatter_scale / s).powi(2)).sqrt();
+    let sigma_level_scatter = ((line.sigma_y0 * s).powi(2) + (radius_scale * scatter_scale).powi(2)).sqrt();
+    // The frame's axes follow the line's tilt, measured to σθ: a turn of the axes by dθ moves v_n by v_t·dθ
+    // and v_t by v_n·dθ, in both flights alike.
+    let sigma_theta = line.sigma_tilt_deg.to_radians();
     // The level's error is common to both crossings, so it is carried as a derivative and propagated
     // coherently into the contact time, COR and μ, not added to each crossing separately.
     let touch = crossing(&fin, radius, points[first].t);
@@ -244,7 +322,9 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
             let (_, sv, _) = f.errors_at(k, c.t.value);
             let stat = (sv * sv + (f.a[k] * c.t.se).powi(2)).sqrt();
             let dv_dlevel = f.a[k] * c.dt_dlevel;
-            let total = (stat * stat + (dv_dlevel * sigma_level).powi(2) + (v[k] * rel_scale).powi(2)).sqrt();
+            let tilt = v[1 - k] * sigma_theta;
+            let total =
+                (stat * stat + (dv_dlevel * sigma_level).powi(2) + (v[k] * rel_scale).powi(2) + tilt * tilt).sqrt();
             VelocityPart {
                 value: v[k],
                 stat,
@@ -257,8 +337,10 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
     let vout = velocity(&fout, &sep);
     let cor = (vout[1].value / vin[1].value).abs();
     let cor_level = cor * (vout[1].dv_dlevel / vout[1].value - vin[1].dv_dlevel / vin[1].value) * sigma_level;
+    let cor_tilt = cor * (vout[0].value / vout[1].value - vin[0].value / vin[1].value) * sigma_theta;
     let cor_se = (cor * cor * ((vin[1].stat / vin[1].value).powi(2) + (vout[1].stat / vout[1].value).powi(2))
-        + cor_level * cor_level)
+        + cor_level * cor_level
+        + cor_tilt * cor_tilt)
         .sqrt();
     let (dvt, dvn) = (vout[0].value - vin[0].value, vout[1].value - vin[1].value);
     let mu = -dvt / dvn;
@@ -267,15 +349,38 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
         vout[1].dv_dlevel - vin[1].dv_dlevel,
     );
     let mu_level = (-ddvt / dvn + dvt * ddvn / (dvn * dvn)) * sigma_level;
+    let mu_tilt = (1.0 + mu * mu) * sigma_theta;
     let mu_se = ((vin[0].stat.powi(2) + vout[0].stat.powi(2)) / (dvn * dvn)
         + (dvt / (dvn * dvn)).powi(2) * (vin[1].stat.powi(2) + vout[1].stat.powi(2))
-        + mu_level * mu_level)
+        + mu_level * mu_level
+        + mu_tilt * mu_tilt)
         .sqrt();
     let contact_se =
         (touch.t.se.powi(2) + sep.t.se.powi(2) + ((sep.dt_dlevel - touch.dt_dlevel) * sigma_level).powi(2)).sqrt();
     let contact = &points[first..=last];
     let (t_max, delta_max) = deepest(contact, radius, sigma_level, rel_scale);
-    let mut notes = Vec::new();
+    let mut notes = choice.notes;
+    let mut flags = Vec::new();
+    let gravity = gravity_check(&incoming, &outgoing, a, c.gravity);
+    if let Some(g) = &gravity {
+        if !g.consistent {
+            flags.push(format!(
+                "the ball's flight accelerates at ({:.2} ± {:.2}, {:.2} ± {:.2}) m/s² along and across the surface, not gravity's ({:.2}, {:.2}) on a {}° incline: a wrong frame rate, scale or incline, repeated frames, or not the ball",
+                g.measured[0].value,
+                g.measured[0].se,
+                g.measured[1].value,
+                g.measured[1].se,
+                g.expected[0],
+                g.expected[1],
+                c.incline_deg
+            ));
+        } else if g.inconclusive {
+            notes.push(format!(
+                "the flights are too short to check that the ball falls like a ball (acceleration {:.1} ± {:.1} m/s² across the surface)",
+                g.measured[1].value, g.measured[1].se
+            ));
+        }
+    }
     for (name, f) in [("incoming", &fin), ("outgoing", &fout)] {
         let worst = f.chi2_red[0].max(f.chi2_red[1]);
         if worst > 4.0 {
@@ -307,8 +412,210 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
         flight_in: fin,
         flight_out: fout,
         surface_sigma_m: sigma_level_scatter,
+        contact_line: Some(line),
+        frame: Some(frame),
+        surface_tilt_deg: track
+            .surface
+            .filter(|l| matches!(l.cue, LineCue::Brightness | LineCue::Texture))
+            .map(|l| Measured::new(l.tilt_deg(), l.sigma_tilt_deg)),
+        trajectory_level_px: choice.trajectory_level_px,
+        gravity,
+        flags,
         notes,
     })
+}
+
+/// The flights fitted with their acceleration free, weighted together, against gravity's `expected`
+/// (m/s², local frame); `None` when neither flight has enough frames for a free fit.
+fn gravity_check(incoming: &[&Point], outgoing: &[&Point], expected: [f64; 2], g: f64) -> Option<GravityCheck> {
+    let fits: Vec<[Measured; 2]> = [incoming, outgoing]
+        .iter()
+        .filter_map(|set| {
+            let pts: Vec<_> = set.iter().map(|p| (p.t, p.x, p.y, p.sigma)).collect();
+            fit_free_acceleration(&pts).map(|(a, se)| [0, 1].map(|k| Measured::new(a[k], se[k])))
+        })
+        .collect();
+    if fits.is_empty() {
+        return None;
+    }
+    let measured = [0, 1].map(|k| {
+        let w: f64 = fits.iter().map(|f| 1.0 / f[k].se.powi(2)).sum();
+        let v = fits.iter().map(|f| f[k].value / f[k].se.powi(2)).sum::<f64>() / w;
+        Measured::new(v, (1.0 / w).sqrt())
+    });
+    let consistent = (0..2).all(|k| (measured[k].value - expected[k]).abs() <= 4.0 * measured[k].se + 0.1 * g);
+    let inconclusive = measured[1].se > 0.5 * g;
+    Some(GravityCheck {
+        measured,
+        expected,
+        consistent: consistent || inconclusive,
+        inconclusive,
+    })
+}
+
+/// The contact line chosen, and what the choice rests on.
+struct ContactChoice {
+    line: SurfaceLine,
+    trajectory_level_px: Option<Measured>,
+    notes: Vec<String>,
+    /// The trajectory's [`EstimateError::NoImpact`], when it holds no impact.
+    no_impact: Option<EstimateError>,
+}
+
+/// Chooses the contact line (see [`estimate`]); `a_px` is gravity along the normal, px/s² (negative).
+fn contact_line(
+    track: &Track,
+    measured: &[&bouncelab_track::BallFix],
+    radius_px: f64,
+    a_px: f64,
+) -> Result<ContactChoice, EstimateError> {
+    let given = track.surface.filter(|l| l.cue == LineCue::Given);
+    let found = track.surface.filter(|l| l.cue != LineCue::Given);
+    // The trajectory in a frame along the best line known (image axes without one).
+    let axis = track
+        .surface
+        .unwrap_or_else(|| SurfaceLine::given((track_width(measured) - 1.0) / 2.0, 0.0, 0.0));
+    let heights: Vec<HeightPoint> = measured
+        .iter()
+        .map(|f| HeightPoint {
+            t: f.t_s,
+            h: axis.height_of(f.x_px, f.y_px),
+            sigma: f.sigma_px.max(MIN_SIGMA_PX),
+        })
+        .collect();
+    let m_per_px = track.scale.map_or(f64::NAN, |s| s.m_per_px);
+    let trajectory: Result<TrajectoryContact, EstimateError> =
+        find_impact(&heights, a_px, m_per_px).and_then(|low| trajectory_contact(&heights, low, a_px, radius_px));
+    // The trajectory's level as a line: one radius below the centre at the touch, parallel to `axis`.
+    let level_line = |tc: &TrajectoryContact| SurfaceLine {
+        y0: axis.y0 + (tc.level_px - radius_px) * -(1.0 + axis.slope * axis.slope).sqrt(),
+        sigma_y0: tc.level_se_px,
+        sigma_tilt_deg: axis.sigma_tilt_deg,
+        columns: 0,
+        edge_definition_px: 0.0,
+        roughness_px: 0.0,
+        cue: LineCue::Trajectory,
+        ..axis
+    };
+    // How far the trajectory's level lies above `line`, px, with its standard error.
+    let relative = |tc: &TrajectoryContact, line: &SurfaceLine| {
+        let l = level_line(tc);
+        let offset = (line.y0 - l.y0) / (1.0 + line.slope * line.slope).sqrt();
+        Measured::new(offset, tc.level_se_px)
+    };
+    // A line agrees with the trajectory when their levels differ by less than 3σ of both plus a pixel (or
+    // 3 % of the radius): gross disagreement means the line is not where the ball lands.
+    let agrees = |m: &Measured, line: &SurfaceLine| {
+        let line_se = (line.sigma_y0.powi(2) + line.edge_definition_px.powi(2) / 3.0).sqrt();
+        m.value.abs() <= 3.0 * m.se.hypot(line_se) + (0.03 * radius_px).max(1.0)
+    };
+    let mut notes = Vec::new();
+    let no_impact = match &trajectory {
+        Err(EstimateError::NoImpact {
+            frames,
+            speed_m_s,
+            se_m_s,
+        }) => Some(EstimateError::NoImpact {
+            frames: *frames,
+            speed_m_s: *speed_m_s,
+            se_m_s: *se_m_s,
+        }),
+        _ => None,
+    };
+    if let Some(line) = given {
+        let trajectory_level_px = trajectory.as_ref().ok().map(|tc| relative(tc, &line));
+        if let Some(m) = &trajectory_level_px
+            && !agrees(m, &line)
+        {
+            notes.push(format!(
+                "the given contact line is {:.1} ± {:.1} px from where the ball's trajectory puts the contact",
+                m.value, m.se
+            ));
+        }
+        return Ok(ContactChoice {
+            line,
+            trajectory_level_px,
+            notes,
+            no_impact,
+        });
+    }
+    match (found, &trajectory) {
+        (Some(line), Ok(tc)) => {
+            let m = relative(tc, &line);
+            if agrees(&m, &line) {
+                return Ok(ContactChoice {
+                    line,
+                    trajectory_level_px: Some(m),
+                    notes,
+                    no_impact,
+                });
+            }
+            for alt in track.surface_alternatives.iter().copied() {
+                let ma = relative(tc, &alt);
+                if agrees(&ma, &alt) {
+                    notes.push(format!(
+                        "the first surface line found ({} cue, y = {:.1} px) is {:.1} px from where the ball lands; a lower line ({} cue, y = {:.1} px), which agrees with the ball's trajectory, is used",
+                        line.cue.name(),
+                        line.y0,
+                        m.value,
+                        alt.cue.name(),
+                        alt.y0
+                    ));
+                    return Ok(ContactChoice {
+                        line: alt,
+                        trajectory_level_px: Some(ma),
+                        notes,
+                        no_impact,
+                    });
+                }
+            }
+            notes.push(format!(
+                "the surface line found ({} cue, y = {:.1} px) is {:.1} px from where the ball's trajectory puts the contact: the contact level comes from the trajectory (± {:.2} px)",
+                line.cue.name(),
+                line.y0,
+                m.value,
+                tc.level_se_px
+            ));
+            notes.extend(tc.notes.iter().cloned());
+            Ok(ContactChoice {
+                line: SurfaceLine {
+                    sigma_tilt_deg: line.sigma_tilt_deg,
+                    ..level_line(tc)
+                },
+                trajectory_level_px: Some(Measured::new(0.0, tc.level_se_px)),
+                notes,
+                no_impact,
+            })
+        }
+        (Some(line), Err(_)) => Ok(ContactChoice {
+            line,
+            trajectory_level_px: None,
+            notes,
+            no_impact,
+        }),
+        (None, Ok(tc)) => {
+            notes.push(format!(
+                "no surface line found: the contact level comes from the ball's trajectory (± {:.2} px); the camera's roll is not measured, image axes are taken as the surface's",
+                tc.level_se_px
+            ));
+            notes.extend(tc.notes.iter().cloned());
+            Ok(ContactChoice {
+                line: level_line(tc),
+                trajectory_level_px: Some(Measured::new(0.0, tc.level_se_px)),
+                notes,
+                no_impact,
+            })
+        }
+        (None, Err(e)) => Err(no_impact.unwrap_or_else(|| EstimateError::NoSurface { why: e.to_string() })),
+    }
+}
+
+/// The image width the fixes suggest (for a reference column when no line is known), px.
+fn track_width(measured: &[&bouncelab_track::BallFix]) -> f64 {
+    let (lo, hi) = measured.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), f| {
+        (lo.min(f.x_px), hi.max(f.x_px))
+    });
+    lo + hi + 1.0
 }
 
 /// When a flight arc crosses the contact level.

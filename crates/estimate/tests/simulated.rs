@@ -2,7 +2,7 @@
 
 use bouncelab_estimate::{Conditions, EstimateError, estimate};
 use bouncelab_model::{Ball, Impact, Model, SimOptions, State, simulate};
-use bouncelab_track::{BallFix, Scale, Status, SurfaceLine, Track};
+use bouncelab_track::{BallFix, LineCue, Scale, Status, SurfaceLine, Track};
 
 const SCALE: f64 = 4e-4; // m/px
 const SURFACE_Y: f64 = 420.0; // px
@@ -61,6 +61,7 @@ fn shot(model: &Model, incline_deg: f64, drop_m: f64, after: f64, seed: u64) -> 
         })
         .collect();
     let track = Track {
+        surface_alternatives: Vec::new(),
         fixes,
         surface: Some(SurfaceLine {
             x0: 255.5,
@@ -70,6 +71,8 @@ fn shot(model: &Model, incline_deg: f64, drop_m: f64, after: f64, seed: u64) -> 
             sigma_tilt_deg: 0.001,
             columns: 120,
             edge_definition_px: 0.0,
+            roughness_px: 0.0,
+            cue: Default::default(),
         }),
         scale: Some(Scale {
             m_per_px: SCALE,
@@ -180,6 +183,7 @@ fn a_clip_ending_close_to_the_impact_is_refused_with_a_reason() {
     let (track, truth) = shot(&model, 0.0, 0.3, 0.0, 3);
     let cut = truth.t_separation + 3e-4;
     let track = Track {
+        surface_alternatives: Vec::new(),
         fixes: track.fixes.into_iter().filter(|f| f.t_s <= cut).collect(),
         ..track
     };
@@ -212,4 +216,122 @@ fn a_surface_line_off_by_its_sigma_is_one_standard_error_of_the_contact_time() {
             e.cor
         );
     }
+}
+
+/// A clip whose band shows no line: the contact level comes from where the ball leaves its incoming arc and
+/// rejoins its outgoing one, and the shot is measured as well as its error says.
+#[test]
+fn without_a_surface_line_the_trajectory_tells_the_contact() {
+    let model = Model::paper(25_650.0, 14.0, 0.5);
+    let mut z_level = Vec::new();
+    for (k, (angle, drop)) in [
+        (0.0, 0.2),
+        (7.5, 0.3),
+        (15.0, 0.5),
+        (22.5, 0.9),
+        (0.0, 0.6),
+        (15.0, 0.25),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let (mut track, truth) = shot(&model, angle, drop, 0.02, 50 + k as u64);
+        track.surface = None;
+        let e = estimate(&track, &conditions(angle)).unwrap();
+        let line = e.contact_line.expect("a contact line");
+        assert_eq!(line.cue, LineCue::Trajectory, "{e:?}");
+        // The level against the truth (the plane at SURFACE_Y), px.
+        let err = SURFACE_Y - line.y0;
+        z_level.push(err / line.sigma_y0);
+        assert!(
+            err.abs() < 1.5 && line.sigma_y0 < 1.0,
+            "{angle}°: level {err} px ± {}",
+            line.sigma_y0
+        );
+        assert!(
+            (e.cor.value - truth.restitution).abs() < 0.003,
+            "{angle}°: e {} vs {}",
+            e.cor.value,
+            truth.restitution
+        );
+        assert!(
+            (e.mu.value - truth.effective_friction).abs() < 0.01,
+            "{angle}°: μ {}",
+            e.mu.value
+        );
+        let contact_err = e.contact_ms.value - truth.contact_time() * 1e3;
+        assert!(
+            contact_err.abs() < 3.0 * e.contact_ms.se + 0.05,
+            "{angle}°: contact {contact_err} ms ± {}",
+            e.contact_ms.se
+        );
+        assert!(e.notes.iter().any(|n| n.contains("trajectory")), "{:?}", e.notes);
+        assert!(e.surface_tilt_deg.is_none());
+    }
+    let rms = (z_level.iter().map(|z| z * z).sum::<f64>() / z_level.len() as f64).sqrt();
+    assert!(rms < 2.5, "level RMS(error/σ) {rms} over {z_level:?}");
+}
+
+/// A line far from where the ball lands (a ruler's edge, a shadow) is not taken for the contact.
+#[test]
+fn a_line_the_ball_does_not_land_on_gives_way_to_the_trajectory() {
+    let model = Model::paper(25_650.0, 14.0, 0.5);
+    let (mut track, truth) = shot(&model, 7.5, 0.4, 0.02, 9);
+    let line = track.surface.as_mut().unwrap();
+    line.y0 -= 25.0;
+    let e = estimate(&track, &conditions(7.5)).unwrap();
+    let used = e.contact_line.unwrap();
+    assert_eq!(used.cue, LineCue::Trajectory);
+    assert!((SURFACE_Y - used.y0).abs() < 1.5, "{used:?}");
+    assert!((e.cor.value - truth.restitution).abs() < 0.003);
+    assert!(
+        e.notes
+            .iter()
+            .any(|n| n.contains("from where the ball's trajectory puts the contact")),
+        "{:?}",
+        e.notes
+    );
+}
+
+/// A clip that holds no impact says so, with the speed the ball has at its end.
+#[test]
+fn a_fall_without_an_impact_is_no_impact_with_its_speed() {
+    let model = Model::paper(25_650.0, 14.0, 0.5);
+    let (mut track, truth) = shot(&model, 0.0, 0.3, 0.02, 3);
+    // Keep only the first 10 ms: the ball is still falling.
+    track.fixes.truncate(100);
+    let t_last = track.fixes[99].t_s;
+    let expected = truth.state_in.vy + 9.81 * (0.015 - t_last);
+    match estimate(&track, &conditions(0.0)) {
+        Err(EstimateError::NoImpact {
+            frames,
+            speed_m_s,
+            se_m_s,
+        }) => {
+            assert_eq!(frames, 100);
+            assert!(
+                (speed_m_s - expected).abs() < 3.0 * se_m_s + 1e-3,
+                "{speed_m_s} ± {se_m_s} vs {expected}"
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+/// A flight that does not fall like a ball (the frame rate wrong by 2×) is flagged with what was measured.
+#[test]
+fn a_wrong_frame_rate_is_flagged_by_gravity() {
+    let model = Model::paper(25_650.0, 14.0, 0.5);
+    let (mut track, _) = shot(&model, 0.0, 0.3, 0.02, 4);
+    for f in &mut track.fixes {
+        f.t_s *= 2.0;
+    }
+    let e = estimate(&track, &conditions(0.0)).unwrap();
+    let g = e.gravity.unwrap();
+    assert!(!g.consistent && (g.measured[1].value + 9.81 / 4.0).abs() < 1.0, "{g:?}");
+    assert!(e.flags.iter().any(|f| f.contains("frame rate")), "{:?}", e.flags);
+    // The right frame rate passes.
+    let (track, _) = shot(&model, 0.0, 0.3, 0.02, 4);
+    let e = estimate(&track, &conditions(0.0)).unwrap();
+    assert!(e.gravity.unwrap().consistent && e.flags.is_empty(), "{:?}", e.gravity);
 }

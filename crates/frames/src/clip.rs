@@ -1,26 +1,51 @@
-//! A clip folder: listing, ordering, timing, and streaming its frames.
+//! A clip — a folder of frame files or one camera file: listing, ordering, timing, settings, and streaming
+//! its frames.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use rayon::prelude::*;
 
+use crate::camera::{self, CameraFile, CameraInfo, DEFAULT_MAX_FRAME_PIXELS, Kind, SourceFormat};
 use crate::decode::{FrameFormat, PngDecoder, decode_path};
 use crate::error::{FramesError, Result};
 use crate::pixels::GrayPixels;
-use crate::settings::{FpsSource, Warning, resolve_fps};
+use crate::settings::{
+    ClipSettings, FpsSource, SettingOverrides, Warning, camera_keys_at, check_overrides, choose_fps, choose_settings,
+    clip_toml_path, session_toml_path,
+};
 
 /// How to open a clip.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct ClipOptions {
-    /// Frame rate override (from the command line), in frames/s; beats `clip.toml` and `session.toml`.
+    /// Frame rate override (from the command line), in frames/s; beats `clip.toml`, the camera header and
+    /// `session.toml`.
     pub fps: Option<f64>,
+    /// Geometry overrides (from the command line); each beats `clip.toml` and `session.toml`.
+    pub overrides: SettingOverrides,
+    /// Largest frame accepted from a camera file's header, in pixels (default 2²⁶ = 8192 × 8192): a
+    /// corrupt header is refused before anything is allocated for it.
+    pub max_frame_pixels: u64,
+}
+
+impl Default for ClipOptions {
+    fn default() -> Self {
+        Self {
+            fps: None,
+            overrides: SettingOverrides::default(),
+            max_frame_pixels: DEFAULT_MAX_FRAME_PIXELS,
+        }
+    }
 }
 
 impl ClipOptions {
     /// Options with this frame-rate override, in frames/s.
     pub fn with_fps(fps: f64) -> Self {
-        Self { fps: Some(fps) }
+        Self {
+            fps: Some(fps),
+            ..Self::default()
+        }
     }
 }
 
@@ -47,14 +72,15 @@ impl ReadOptions {
     }
 }
 
-/// One frame file of a clip, before decoding.
+/// One frame of a clip, before decoding: a frame file of a folder, or one frame of a camera file.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct FrameFile {
-    /// The file.
+    /// The file (for a camera file, the camera file itself).
     pub path: PathBuf,
-    /// The last number in its name.
+    /// The last number in its name (for a camera file, the frame's position in the file).
     pub number: u64,
-    /// Its frame index: `number − first number` (0-based; dropped frames counted).
+    /// Its frame index: `number − first number` (0-based; dropped frames counted). For a camera file, the
+    /// position in the file: frame 0 is the first stored frame.
     pub index: u64,
 }
 
@@ -82,9 +108,9 @@ impl Gap {
 /// One decoded frame.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Frame {
-    /// Frame index in the clip: 0 for the first file, dropped frames counted (SPEC §3).
+    /// Frame index in the clip: 0 for the first frame, dropped frames counted (`docs/session.md`).
     pub index: u64,
-    /// The number in the file name.
+    /// The number in the file name (for a camera file, the position in the file).
     pub number: u64,
     /// Time since the first frame, in seconds: `index / fps`.
     pub t_s: f64,
@@ -94,8 +120,103 @@ pub struct Frame {
     pub pixels: GrayPixels,
 }
 
-/// An opened clip folder: its frame files in order, frame rate, dropped frames and size. Nothing is decoded
-/// until frames are read.
+/// What holds a clip's frames, before any setting is applied.
+pub(crate) struct Frames {
+    pub(crate) files: Vec<FrameFile>,
+    pub(crate) size: (u32, u32),
+    pub(crate) camera: Option<Arc<CameraFile>>,
+}
+
+impl Frames {
+    /// Lists a folder (or opens the camera file) at `path`.
+    pub(crate) fn probe(path: &Path, max_pixels: u64) -> Result<Self> {
+        if path.is_dir() {
+            let files = match list_frames(path) {
+                // A folder holding no frame files but one camera file is that camera file.
+                Err(FramesError::NoFrames { dir }) => {
+                    return match lone_camera_file(&dir) {
+                        Some((file, kind)) => Self::camera(&file, kind, max_pixels),
+                        None => Err(FramesError::NoFrames { dir }),
+                    };
+                }
+                other => other?,
+            };
+            // A folder holding one multi-page TIFF is that stack.
+            if let [only] = &files[..] {
+                if FrameFormat::from_path(&only.path) == Some(FrameFormat::Tiff) && tiff_is_stack(&only.path)? {
+                    return Self::camera(&only.path, Kind::Tiff, max_pixels);
+                }
+            }
+            let first = &files[0].path;
+            let size = image::ImageReader::open(first)
+                .and_then(|r| r.with_guessed_format())
+                .map_err(|e| e.to_string())
+                .and_then(|r| r.into_dimensions().map_err(|e| e.to_string()))
+                .map_err(|message| FramesError::Decode {
+                    path: first.clone(),
+                    index: 0,
+                    message,
+                })?;
+            return Ok(Self {
+                files,
+                size,
+                camera: None,
+            });
+        }
+        if !path.exists() {
+            return Err(FramesError::NotAFolder { path: path.into() });
+        }
+        match Kind::of(path) {
+            Some(kind) => Self::camera(path, kind, max_pixels),
+            None => Err(FramesError::NotAClip { path: path.into() }),
+        }
+    }
+
+    fn camera(path: &Path, kind: Kind, max_pixels: u64) -> Result<Self> {
+        let cam = CameraFile::open(path, kind, max_pixels)?;
+        let files = (0..cam.count as u64)
+            .map(|k| FrameFile {
+                path: cam.path.clone(),
+                number: k,
+                index: k,
+            })
+            .collect();
+        Ok(Self {
+            files,
+            size: cam.size,
+            camera: Some(Arc::new(cam)),
+        })
+    }
+}
+
+/// The one camera file (Photron header and data counted once; no video) in a folder, if there is exactly one.
+fn lone_camera_file(dir: &Path) -> Option<(PathBuf, Kind)> {
+    let mut found: Vec<PathBuf> = std::fs::read_dir(dir)
+        .ok()?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.is_file()
+                && p.file_name()
+                    .and_then(|n| n.to_str())
+                    .is_some_and(|n| !n.starts_with('.'))
+                && Kind::of(p).is_some_and(|k| k != Kind::Video)
+        })
+        .collect();
+    found.sort();
+    match &crate::session::photron_grouped(found)[..] {
+        [one] => Kind::of(one).map(|k| (one.clone(), k)),
+        _ => None,
+    }
+}
+
+/// True if the TIFF file at `path` has more than one page (through a memory map: only its header and first
+/// directory are read).
+fn tiff_is_stack(path: &Path) -> Result<bool> {
+    Ok(camera::tiff_has_more_pages(&camera::map(path)?))
+}
+
+/// An opened clip — a folder of frame files or one camera file: its frames in order, frame rate, dropped
+/// frames, size, camera metadata and geometry settings. Nothing is decoded until frames are read.
 #[derive(Clone, Debug)]
 pub struct Clip {
     dir: PathBuf,
@@ -105,53 +226,133 @@ pub struct Clip {
     gaps: Vec<Gap>,
     warnings: Vec<Warning>,
     size: (u32, u32),
+    camera: Option<Arc<CameraFile>>,
+    info: CameraInfo,
+    settings: ClipSettings,
 }
 
 impl Clip {
-    /// Opens a clip folder with default options (fps from `clip.toml`, `session.toml` or the default).
-    pub fn open(dir: impl AsRef<Path>) -> Result<Self> {
-        Self::open_with(dir, &ClipOptions::default())
+    /// Opens a clip with default options (fps from `clip.toml`, the camera header, `session.toml` or the
+    /// default).
+    pub fn open(path: impl AsRef<Path>) -> Result<Self> {
+        Self::open_with(path, &ClipOptions::default())
     }
 
-    /// Opens a clip folder.
+    /// Opens a clip: a folder of frame files, or one camera file (`docs/session.md`).
     ///
-    /// Lists every supported image file (`.png .tif .tiff .bmp .pgm .ppm .pnm .jpg .jpeg`, any case; the
-    /// formats may be mixed) and ignores everything else, including hidden files. Orders them by the last
-    /// number in the file name, finds the dropped frames, resolves the frame rate, and reads the first
-    /// frame's header for the clip's size.
-    pub fn open_with(dir: impl AsRef<Path>, options: &ClipOptions) -> Result<Self> {
-        let dir = dir.as_ref().to_path_buf();
-        let (fps, fps_source, warning) = resolve_fps(&dir, options.fps)?;
-        Self::open_resolved(dir, fps, fps_source, warning.into_iter().collect())
+    /// A folder: lists every supported image file (`.png .tif .tiff .bmp .pgm .ppm .pnm .jpg .jpeg`, any
+    /// case; the formats may be mixed) and ignores everything else, including hidden files. Orders them by
+    /// the last number in the file name, finds the dropped frames and reads the first frame's header for the
+    /// clip's size. A folder whose only frame file is a multi-page TIFF is that stack; a folder with no frame
+    /// files but one camera file is that camera file.
+    ///
+    /// A camera file (`.cihx`/`.cih`/`.mraw`, `.cine`, `.tif`/`.tiff`): reads its header and checks it
+    /// against the data (see [`CameraInfo`]); one frame per stored image, indexed from 0.
+    ///
+    /// Then resolves the frame rate and the geometry settings (command line > `clip.toml` > header (fps) >
+    /// `session.toml` > default) and checks the region of interest and contact line against the size.
+    pub fn open_with(path: impl AsRef<Path>, options: &ClipOptions) -> Result<Self> {
+        let path = path.as_ref().to_path_buf();
+        if let Some(fps) = options.fps {
+            crate::settings::check_fps(fps, "command line", "--fps")?;
+        }
+        check_overrides(&options.overrides)?;
+        let frames = Frames::probe(&path, options.max_frame_pixels)?;
+        let own = camera_keys_at(&clip_toml_path(&path))?;
+        let session = match session_toml_path(&path) {
+            Some(p) => camera_keys_at(&p)?,
+            None => None,
+        };
+        let header = frames
+            .camera
+            .as_ref()
+            .and_then(|c| c.info.fps.map(|f| (f, c.path.as_path())));
+        let session_fps = session.as_ref().and_then(|(p, k)| k.fps.map(|f| (f, p.as_path())));
+        let (fps, fps_source, warning) = choose_fps(&path, options.fps, own.as_ref(), header, session_fps)?;
+        let mut warnings: Vec<Warning> = warning.into_iter().collect();
+        let settings = choose_settings(&path, &options.overrides, own.as_ref(), session.as_ref(), &mut warnings);
+        Self::assemble(path, frames, fps, fps_source, settings, warnings)
     }
 
-    pub(crate) fn open_resolved(dir: PathBuf, fps: f64, fps_source: FpsSource, warnings: Vec<Warning>) -> Result<Self> {
-        let files = list_frames(&dir)?;
-        let gaps = gaps(&files);
-        let first = &files[0].path;
-        let size = image::ImageReader::open(first)
-            .and_then(|r| r.with_guessed_format())
-            .map_err(|e| e.to_string())
-            .and_then(|r| r.into_dimensions().map_err(|e| e.to_string()))
-            .map_err(|message| FramesError::Decode {
-                path: first.clone(),
-                index: 0,
-                message,
-            })?;
+    /// Opens a clip whose frame rate and settings were resolved already (a session's entry).
+    pub(crate) fn open_resolved(
+        path: PathBuf,
+        fps: f64,
+        fps_source: FpsSource,
+        settings: ClipSettings,
+        max_frame_pixels: u64,
+    ) -> Result<Self> {
+        let frames = Frames::probe(&path, max_frame_pixels)?;
+        Self::assemble(path, frames, fps, fps_source, settings, Vec::new())
+    }
+
+    fn assemble(
+        path: PathBuf,
+        frames: Frames,
+        fps: f64,
+        fps_source: FpsSource,
+        settings: ClipSettings,
+        mut warnings: Vec<Warning>,
+    ) -> Result<Self> {
+        settings.check_against(&path, frames.size)?;
+        let info = match &frames.camera {
+            Some(c) => {
+                warnings.extend(c.warnings.iter().cloned());
+                c.info.clone()
+            }
+            None => CameraInfo {
+                format: SourceFormat::Folder,
+                ..CameraInfo::default()
+            },
+        };
+        let gaps = gaps(&frames.files);
         Ok(Self {
-            dir,
-            files,
+            dir: path,
+            files: frames.files,
             fps,
             fps_source,
             gaps,
             warnings,
-            size,
+            size: frames.size,
+            camera: frames.camera,
+            info,
+            settings,
         })
     }
 
-    /// The clip folder.
+    /// The clip as given: its folder, or its camera file. Same as [`Clip::path`].
     pub fn dir(&self) -> &Path {
         &self.dir
+    }
+
+    /// The clip as given: its folder, or its camera file (for Photron, the file named: header or `.mraw`).
+    pub fn path(&self) -> &Path {
+        &self.dir
+    }
+
+    /// True if the clip is one camera file rather than a folder of frame files.
+    pub fn is_camera_file(&self) -> bool {
+        self.camera.is_some()
+    }
+
+    /// Every file the frames come from: the frame files of a folder, or the camera file (for Photron, the
+    /// header and the `.mraw`). Settings files are not included.
+    pub fn source_files(&self) -> Vec<PathBuf> {
+        match &self.camera {
+            Some(c) => c.files(),
+            None => self.files.iter().map(|f| f.path.clone()).collect(),
+        }
+    }
+
+    /// What the camera file's header says (all `None` but the format for a folder of images).
+    pub fn camera(&self) -> &CameraInfo {
+        &self.info
+    }
+
+    /// The clip's geometry settings (scale, ball diameter, region of interest, contact line) with their
+    /// sources.
+    pub fn settings(&self) -> &ClipSettings {
+        &self.settings
     }
 
     /// The frame files in order.
@@ -257,11 +458,19 @@ impl Clip {
     }
 
     fn decode(&self, file: &FrameFile, png: PngDecoder) -> Result<Frame> {
-        let pixels = decode_path(&file.path, png).map_err(|message| FramesError::Decode {
-            path: file.path.clone(),
-            index: file.index,
-            message,
-        })?;
+        let pixels = match &self.camera {
+            Some(cam) => cam.decode(file.index as usize)?,
+            None => decode_path(&file.path, png).map_err(|e| match e {
+                crate::decode::DecodeError::MultiPage => FramesError::MultiPageInFolder {
+                    path: file.path.clone(),
+                },
+                crate::decode::DecodeError::Other(message) => FramesError::Decode {
+                    path: file.path.clone(),
+                    index: file.index,
+                    message,
+                },
+            })?,
+        };
         if pixels.dimensions() != self.size {
             return Err(FramesError::SizeMismatch {
                 path: file.path.clone(),
@@ -394,9 +603,6 @@ pub(crate) fn last_number(stem: &str) -> std::result::Result<Option<u64>, ()> {
 }
 
 fn list_frames(dir: &Path) -> Result<Vec<FrameFile>> {
-    if !dir.is_dir() {
-        return Err(FramesError::NotAFolder { path: dir.into() });
-    }
     let io = |source| FramesError::Io {
         path: dir.into(),
         source,

@@ -66,11 +66,25 @@ impl FrameFormat {
     }
 }
 
-/// Reads and decodes one file to gray pixels. The error is the decoder's (or the OS's) message.
-pub(crate) fn decode_path(path: &Path, png: PngDecoder) -> Result<GrayPixels, String> {
-    let format = FrameFormat::from_path(path).ok_or_else(|| "not a supported image file".to_string())?;
-    let bytes = std::fs::read(path).map_err(|e| e.to_string())?;
-    decode_bytes(&bytes, format, png).map(to_gray)
+/// Why one frame file could not be decoded.
+#[derive(Debug)]
+pub(crate) enum DecodeError {
+    /// A TIFF with more than one page, met among other frame files.
+    MultiPage,
+    /// The decoder's (or the OS's) message.
+    Other(String),
+}
+
+/// Reads and decodes one file to gray pixels.
+pub(crate) fn decode_path(path: &Path, png: PngDecoder) -> Result<GrayPixels, DecodeError> {
+    let other = DecodeError::Other;
+    let format = FrameFormat::from_path(path).ok_or_else(|| other("not a supported image file".to_string()))?;
+    let bytes = std::fs::read(path).map_err(|e| other(e.to_string()))?;
+    // Only a stack's first page would be decoded: refuse rather than lose the others.
+    if format == FrameFormat::Tiff && crate::camera::tiff_has_more_pages(&bytes) {
+        return Err(DecodeError::MultiPage);
+    }
+    decode_bytes(&bytes, format, png).map(to_gray).map_err(other)
 }
 
 /// Decodes encoded bytes to an `image` image, keeping the file's own colour type and depth.

@@ -26,15 +26,144 @@ pub enum FramesError {
         /// Why it is needed.
         what: &'static str,
     },
-    /// The clip path is not a folder (or does not exist).
-    #[error("{}: not a clip folder (no such directory)", path.display())]
+    /// The clip path does not exist.
+    #[error("{}: no such clip folder or camera file", path.display())]
     NotAFolder {
         /// The path given as a clip.
         path: PathBuf,
     },
+    /// The clip path is a file that is not a camera file this crate reads.
+    #[error(
+        "{}: not a clip: a clip is a folder of frames or one camera file (.cihx/.cih/.mraw, .cine, .tif/.tiff stack{})",
+        path.display(),
+        if cfg!(feature = "opencv") { ", .mp4/.avi/.mov" } else { "" }
+    )]
+    NotAClip {
+        /// The path given as a clip.
+        path: PathBuf,
+    },
+    /// A video file, in a build without the `opencv` feature.
+    #[error(
+        "{}: video files are read through OpenCV: build bouncelab with `--features opencv` (needs Debian's \
+         libopencv-dev clang libclang-dev), or export the frames first, e.g. \
+         `ffmpeg -i VIDEO -vsync 0 FOLDER/img_%06d.png` (and give the real frame rate: videos often store a playback rate)",
+        path.display()
+    )]
+    VideoNeedsFeature {
+        /// The video file.
+        path: PathBuf,
+    },
+    /// A camera file's header (or the data it describes) is missing a field, or a field has a value this
+    /// reader does not accept (unknown bit depth, sizes that disagree with the file, an offset outside it).
+    #[error("{}: {field}: {problem}", path.display())]
+    CameraHeader {
+        /// The header file (`.cihx`, `.cih`, `.cine`, `.tif` …) or the data file the field describes.
+        path: PathBuf,
+        /// The header field, e.g. `<colorInfo><bit>`, `Color Bit`, `BITMAPINFOHEADER.biBitCount`.
+        field: String,
+        /// What is wrong with it.
+        problem: String,
+    },
+    /// A Photron header without its `.mraw` data file (or a `.mraw` without a header) beside it.
+    #[error("{}: {what} not found beside it (expected {})", path.display(), expected.display())]
+    MissingCompanion {
+        /// The file that was given.
+        path: PathBuf,
+        /// What is missing, e.g. `the .mraw data file`.
+        what: &'static str,
+        /// Where it was looked for.
+        expected: PathBuf,
+    },
+    /// A frame larger than the configured limit ([`crate::ClipOptions::max_frame_pixels`]): the header is
+    /// probably corrupt, and nothing is allocated for it.
+    #[error(
+        "{}: frame size {width}×{height} px is over the limit of {limit} pixels (a corrupt header? raise ClipOptions::max_frame_pixels if it is real)",
+        path.display()
+    )]
+    FrameTooLarge {
+        /// The camera file.
+        path: PathBuf,
+        /// Width from the header, in pixels.
+        width: u64,
+        /// Height from the header, in pixels.
+        height: u64,
+        /// The limit, in pixels.
+        limit: u64,
+    },
+    /// A multi-page TIFF among other frame files of a folder: each page would be lost but the first.
+    #[error(
+        "{}: a multi-page TIFF stack in a folder of other frames; give the stack itself as the clip (its pages are the frames)",
+        path.display()
+    )]
+    MultiPageInFolder {
+        /// The TIFF file.
+        path: PathBuf,
+    },
+    /// The region of interest does not fit in the clip's frames.
+    #[error(
+        "clip {}: region of interest [{}, {}, {}, {}] (from {}) does not fit in its {}×{} px frames",
+        clip.display(), roi.x, roi.y, roi.width, roi.height, origin, size.0, size.1
+    )]
+    RoiOutsideImage {
+        /// The clip.
+        clip: PathBuf,
+        /// The region, in pixels.
+        roi: crate::settings::Roi,
+        /// Where it was set (a file path, or `command line`).
+        origin: String,
+        /// The frames' width and height, in pixels.
+        size: (u32, u32),
+    },
+    /// The contact line lies outside the clip's frames.
+    #[error(
+        "clip {}: contact line y = {line_y_px} px (from {origin}) is outside its frames (0 ≤ y ≤ {} px)",
+        clip.display(), size.1.saturating_sub(1)
+    )]
+    LineOutsideImage {
+        /// The clip.
+        clip: PathBuf,
+        /// The line's y at the image's centre column, in pixels.
+        line_y_px: f64,
+        /// Where it was set (a file path, or `command line`).
+        origin: String,
+        /// The frames' width and height, in pixels.
+        size: (u32, u32),
+    },
+    /// `clips.csv` rows whose required cells are still empty (as `bouncelab init` leaves them).
+    #[error(
+        "{}: fill these cells before analysing: {}",
+        path.display(),
+        rows.iter()
+            .map(|r| format!("line {} `{}`: {}", r.line, r.clip, r.columns.join(", ")))
+            .collect::<Vec<_>>()
+            .join("; ")
+    )]
+    UnfilledColumns {
+        /// The `clips.csv` file.
+        path: PathBuf,
+        /// Every row with empty cells, in file order.
+        rows: Vec<UnfilledRow>,
+    },
+    /// `bouncelab init` would overwrite an existing file.
+    #[error("{}: exists already; move it away or give --force to overwrite it", path.display())]
+    WouldOverwrite {
+        /// The file.
+        path: PathBuf,
+    },
+    /// A `clips.csv` clip name without extension that matches several camera files.
+    #[error(
+        "clip `{clip}` matches several camera files ({}): write the file name with its extension in clips.csv",
+        candidates.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
+    )]
+    AmbiguousClip {
+        /// The clip name.
+        clip: String,
+        /// The files it could be.
+        candidates: Vec<PathBuf>,
+    },
     /// The clip folder holds no frame files.
     #[error(
-        "{}: no frames in this folder (looked for .png, .tif, .tiff, .bmp, .pgm, .ppm, .pnm, .jpg, .jpeg)",
+        "{}: no frames in this folder (looked for .png, .tif, .tiff, .bmp, .pgm, .ppm, .pnm, .jpg, .jpeg, or one camera file: .cihx/.cih/.mraw, .cine)",
         dir.display()
     )]
     NoFrames {
@@ -168,12 +297,12 @@ pub enum FramesError {
         /// The line of the second listing.
         second_line: u64,
     },
-    /// A clip listed in `clips.csv` has no folder.
-    #[error("clip `{clip}` is listed in clips.csv but its folder {} does not exist", expected.display())]
+    /// A clip listed in `clips.csv` has no folder or camera file.
+    #[error("clip `{clip}` is listed in clips.csv but there is no folder or camera file {}", expected.display())]
     ClipAbsent {
         /// The clip name.
         clip: String,
-        /// The folder it should be in.
+        /// The folder (or file) it should be.
         expected: PathBuf,
     },
     /// The decoding thread pool could not be built.
@@ -194,6 +323,17 @@ pub enum FramesError {
         /// What went wrong.
         message: String,
     },
+}
+
+/// One `clips.csv` row with required cells left empty.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct UnfilledRow {
+    /// The 1-based line in `clips.csv`.
+    pub line: u64,
+    /// The clip name.
+    pub clip: String,
+    /// The empty required columns, in header order.
+    pub columns: Vec<String>,
 }
 
 /// Shorthand for results of this crate.

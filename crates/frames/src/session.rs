@@ -1,11 +1,16 @@
-//! A session folder: `session.toml`, `clips.csv` and one clip folder per row (SPEC §2.7).
+//! A session folder: `session.toml`, `clips.csv` and one clip (a folder of frames or a camera file) per row
+//! (`docs/session.md`).
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
+use crate::camera::{CameraFile, DEFAULT_MAX_FRAME_PIXELS, Kind};
 use crate::clip::Clip;
-use crate::error::{FramesError, Result};
-use crate::settings::{CameraKeys, DEFAULT_FPS, Downslope, FpsSource, Warning, camera_keys, camera_keys_in, read_toml};
+use crate::error::{FramesError, Result, UnfilledRow};
+use crate::settings::{
+    ClipSettings, DIAMETER_RANGE_M, Downslope, FpsSource, SettingOverrides, Warning, camera_keys, camera_keys_at,
+    check_range, choose_fps, choose_settings, clip_toml_path, number, read_toml,
+};
 
 /// The ball, from `session.toml`'s `[ball]` table.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -20,9 +25,10 @@ pub struct BallSpec {
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct ClipEntry {
-    /// Clip name (the `clip` column); also the name of its folder.
+    /// Clip name (the `clip` column): the name of its folder or camera file in the session folder (a camera
+    /// file may be named without its extension when that is unambiguous).
     pub name: String,
-    /// The clip folder: session folder / name.
+    /// The clip: session folder / name — a folder of frames or a camera file.
     pub dir: PathBuf,
     /// Surface name (the `surface` column).
     pub surface: String,
@@ -30,7 +36,7 @@ pub struct ClipEntry {
     pub angle_deg: f64,
     /// Drop height, in metres (the `drop_height_m` column).
     pub drop_height_m: f64,
-    /// Frame rate, in frames/s: `clip.toml` > `session.toml` > 10,000 (with a warning).
+    /// Frame rate, in frames/s: `clip.toml` > camera header > `session.toml` > 10,000 (with a warning).
     pub fps: f64,
     /// Where the frame rate came from.
     pub fps_source: FpsSource,
@@ -40,12 +46,27 @@ pub struct ClipEntry {
     pub metadata: Vec<(String, String)>,
     /// The row's 1-based line in `clips.csv`.
     pub line: u64,
+    /// Scale, ball diameter, region of interest and contact line, each with its source (`clip.toml` >
+    /// `session.toml` > default).
+    pub settings: ClipSettings,
 }
 
 impl ClipEntry {
-    /// Opens this clip's folder with the entry's resolved frame rate.
+    /// The clip: its folder or camera file (same as the `dir` field).
+    pub fn path(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Opens this clip (folder or camera file) with the entry's resolved frame rate and settings; the
+    /// region of interest and the contact line are checked against the frames' size.
     pub fn open(&self) -> Result<Clip> {
-        Clip::open_resolved(self.dir.clone(), self.fps, self.fps_source.clone(), Vec::new())
+        Clip::open_resolved(
+            self.dir.clone(),
+            self.fps,
+            self.fps_source.clone(),
+            self.settings.clone(),
+            DEFAULT_MAX_FRAME_PIXELS,
+        )
     }
 }
 
@@ -73,12 +94,14 @@ pub struct Session {
 const REQUIRED_COLUMNS: [&str; 4] = ["clip", "surface", "angle_deg", "drop_height_m"];
 
 impl Session {
-    /// Loads a session folder.
+    /// Loads a session folder (`docs/session.md`).
     ///
-    /// `session.toml` needs `[ball] diameter_m` and `mass_kg` (positive numbers); `[camera] fps` and
-    /// `downslope` are optional; anything else is kept in [`Session::metadata`]. `clips.csv` needs the
-    /// columns `clip, surface, angle_deg, drop_height_m` in any order; cells are trimmed; other columns are
-    /// kept per row. Lines starting with `#` are comments.
+    /// `session.toml` needs `[ball] diameter_m` and `mass_kg` (positive numbers); `[camera] fps`,
+    /// `downslope`, `scale_m_per_px`, `roi` and `[surface] line_y_px`, `line_tilt_deg` are optional;
+    /// anything else is kept in [`Session::metadata`]. `clips.csv` needs the columns
+    /// `clip, surface, angle_deg, drop_height_m` in any order; cells are trimmed; other columns are kept per
+    /// row. Lines starting with `#` are comments. Rows whose `surface`, `angle_deg` or `drop_height_m` cell
+    /// is empty (as `bouncelab init` leaves them) are all listed in one [`FramesError::UnfilledColumns`].
     pub fn load(dir: impl AsRef<Path>) -> Result<Self> {
         let dir = dir.as_ref().to_path_buf();
         let toml_path = dir.join("session.toml");
@@ -90,11 +113,18 @@ impl Session {
         }
         let metadata = read_toml(&toml_path)?;
         let ball = BallSpec {
-            diameter_m: positive(&toml_path, &metadata, "ball", "diameter_m")?,
+            diameter_m: check_range(
+                positive(&toml_path, &metadata, "ball", "diameter_m")?,
+                DIAMETER_RANGE_M,
+                "m",
+                &toml_path,
+                "[ball] diameter_m",
+            )?,
             mass_kg: positive(&toml_path, &metadata, "ball", "mass_kg")?,
         };
-        let CameraKeys { fps, downslope } = camera_keys(&toml_path, &metadata)?;
-        let downslope = downslope.unwrap_or_default();
+        let session_keys = camera_keys(&toml_path, &metadata)?;
+        let (fps, downslope) = (session_keys.fps, session_keys.downslope.unwrap_or_default());
+        let session_keys = (toml_path.clone(), session_keys);
 
         let csv_path = dir.join("clips.csv");
         if !csv_path.is_file() {
@@ -107,25 +137,29 @@ impl Session {
         let mut clips = Vec::with_capacity(rows.len());
         let mut warnings = Vec::new();
         for row in rows {
-            let clip_dir = dir.join(&row.name);
-            if !clip_dir.is_dir() {
-                return Err(FramesError::ClipAbsent {
-                    clip: row.name,
-                    expected: clip_dir,
-                });
-            }
-            let own = camera_keys_in(&clip_dir, "clip.toml")?;
-            let (fps, fps_source) = match (&own, fps) {
-                (Some((path, CameraKeys { fps: Some(f), .. })), _) => (*f, FpsSource::ClipToml(path.clone())),
-                (_, Some(f)) => (f, FpsSource::SessionToml(toml_path.clone())),
-                _ => {
-                    warnings.push(Warning::DefaultFps {
-                        clip: clip_dir.clone(),
-                        fps: DEFAULT_FPS,
-                    });
-                    (DEFAULT_FPS, FpsSource::Default)
-                }
-            };
+            let clip_dir = resolve_clip(&dir, &row.name)?;
+            let own = camera_keys_at(&clip_toml_path(&clip_dir))?;
+            // The header's record rate, when the clip is a camera file that opens; a file that does not open
+            // fails when the clip is measured, with its own error, rather than the whole session here.
+            let header_fps = Kind::of(&clip_dir)
+                .filter(|_| clip_dir.is_file())
+                .and_then(|kind| CameraFile::open(&clip_dir, kind, DEFAULT_MAX_FRAME_PIXELS).ok())
+                .and_then(|c| c.info.fps.map(|f| (f, c.path)));
+            let (fps, fps_source, warning) = choose_fps(
+                &clip_dir,
+                None,
+                own.as_ref(),
+                header_fps.as_ref().map(|(f, p)| (*f, p.as_path())),
+                fps.map(|f| (f, toml_path.as_path())),
+            )?;
+            warnings.extend(warning);
+            let settings = choose_settings(
+                &clip_dir,
+                &SettingOverrides::default(),
+                own.as_ref(),
+                Some(&session_keys),
+                &mut warnings,
+            );
             let downslope = own.and_then(|(_, k)| k.downslope).unwrap_or(downslope);
             clips.push(ClipEntry {
                 name: row.name,
@@ -138,6 +172,7 @@ impl Session {
                 downslope,
                 metadata: row.metadata,
                 line: row.line,
+                settings,
             });
         }
         Ok(Self {
@@ -157,6 +192,70 @@ impl Session {
     }
 }
 
+/// The folder or camera file a `clips.csv` name stands for: the exact name in the session folder, or else
+/// the one camera file whose name without extension is the clip name (a Photron clip's `.cihx`, `.cih` and
+/// `.mraw` count as one, named by its header).
+pub(crate) fn resolve_clip(session: &Path, name: &str) -> Result<PathBuf> {
+    let exact = session.join(name);
+    if exact.exists() {
+        return Ok(exact);
+    }
+    let mut candidates: Vec<PathBuf> = Vec::new();
+    if let Ok(entries) = std::fs::read_dir(session) {
+        for entry in entries.flatten() {
+            let path = entry.path();
+            if !path.is_file() || path.file_stem().and_then(|s| s.to_str()) != Some(name) || Kind::of(&path).is_none() {
+                continue;
+            }
+            candidates.push(path);
+        }
+    }
+    candidates.sort();
+    candidates = photron_grouped(candidates);
+    match candidates.len() {
+        0 => Err(FramesError::ClipAbsent {
+            clip: name.into(),
+            expected: exact,
+        }),
+        1 => Ok(candidates.remove(0)),
+        _ => Err(FramesError::AmbiguousClip {
+            clip: name.into(),
+            candidates,
+        }),
+    }
+}
+
+/// Camera files with a Photron clip's `.cihx`/`.cih`/`.mraw` reduced to one (its header, `.cihx` first).
+pub(crate) fn photron_grouped(paths: Vec<PathBuf>) -> Vec<PathBuf> {
+    let ext = |p: &Path| {
+        p.extension()
+            .and_then(|e| e.to_str())
+            .unwrap_or_default()
+            .to_ascii_lowercase()
+    };
+    let rank = |p: &Path| match ext(p).as_str() {
+        "cihx" => 0,
+        "cih" => 1,
+        "mraw" => 2,
+        _ => 3,
+    };
+    let mut out: Vec<PathBuf> = Vec::new();
+    for p in paths {
+        let r = rank(&p);
+        if r < 3 {
+            let stem = p.with_extension("");
+            if let Some(i) = out.iter().position(|q| rank(q) < 3 && q.with_extension("") == stem) {
+                if r < rank(&out[i]) {
+                    out[i] = p;
+                }
+                continue;
+            }
+        }
+        out.push(p);
+    }
+    out
+}
+
 fn positive(path: &Path, doc: &toml::Table, table: &str, key: &str) -> Result<f64> {
     let field = format!("[{table}] {key}");
     let missing = || FramesError::MissingKey {
@@ -169,17 +268,7 @@ fn positive(path: &Path, doc: &toml::Table, table: &str, key: &str) -> Result<f6
         .ok_or_else(missing)?
         .get(key)
         .ok_or_else(missing)?;
-    let x = match value {
-        toml::Value::Integer(i) => *i as f64,
-        toml::Value::Float(x) => *x,
-        other => {
-            return Err(FramesError::BadValue {
-                path: path.into(),
-                field,
-                problem: format!("{other} is a {}, not a number", other.type_str()),
-            });
-        }
-    };
+    let x = number(path, &field, value)?;
     if x.is_finite() && x > 0.0 {
         Ok(x)
     } else {
@@ -229,6 +318,7 @@ fn read_clips_csv(path: &Path) -> Result<Vec<Row>> {
     let idx: Vec<usize> = REQUIRED_COLUMNS.iter().map(|c| column(c)).collect::<Result<_>>()?;
     let mut rows: Vec<Row> = Vec::new();
     let mut seen: HashMap<String, u64> = HashMap::new();
+    let mut unfilled = Vec::new();
     for record in reader.records() {
         let record = record.map_err(csv_err)?;
         let line = record.position().map_or(0, csv::Position::line);
@@ -262,6 +352,18 @@ fn read_clips_csv(path: &Path) -> Result<Vec<Row>> {
             });
         }
         seen.insert(name.clone(), line);
+        let empty: Vec<String> = (1..REQUIRED_COLUMNS.len())
+            .filter(|&i| cell(i).is_empty())
+            .map(|i| REQUIRED_COLUMNS[i].to_string())
+            .collect();
+        if !empty.is_empty() {
+            unfilled.push(UnfilledRow {
+                line,
+                clip: name,
+                columns: empty,
+            });
+            continue;
+        }
         let metadata = headers
             .iter()
             .zip(record.iter())
@@ -276,6 +378,12 @@ fn read_clips_csv(path: &Path) -> Result<Vec<Row>> {
             drop_height_m: number(3)?,
             metadata,
             line,
+        });
+    }
+    if !unfilled.is_empty() {
+        return Err(FramesError::UnfilledColumns {
+            path: path.into(),
+            rows: unfilled,
         });
     }
     Ok(rows)

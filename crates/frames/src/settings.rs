@@ -1,6 +1,10 @@
-//! Reading the `[camera]` keys shared by `session.toml` and `clip.toml`, and the fps precedence.
+//! The settings keys shared by `session.toml` and `clip.toml` (`[camera]`, `[ball]`, `[surface]`), their
+//! checks, and how a clip's value is chosen: command line > `clip.toml` > camera header (fps only) >
+//! `session.toml` > default (see `docs/session.md`).
 
 use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
 
 use crate::error::{FramesError, Result};
 
@@ -10,7 +14,19 @@ pub const DEFAULT_FPS: f64 = 10_000.0;
 /// The largest frame rate accepted, in frames/s (anything above is taken as a typo).
 pub const MAX_FPS: f64 = 1e7;
 
-/// Which image direction is down the slope (SPEC §3).
+/// Ball diameter assumed for a clip outside a session when nothing gives one, in metres (a tennis ball).
+pub const DEFAULT_BALL_DIAMETER_M: f64 = 0.067;
+
+/// Accepted range of `[camera] scale_m_per_px`, in metres per pixel.
+pub const SCALE_RANGE_M_PER_PX: (f64, f64) = (1e-7, 1.0);
+
+/// Accepted range of `[ball] diameter_m`, in metres.
+pub const DIAMETER_RANGE_M: (f64, f64) = (1e-4, 1.0);
+
+/// Largest accepted `|[surface] line_tilt_deg|`, in degrees.
+pub const MAX_LINE_TILT_DEG: f64 = 45.0;
+
+/// Which image direction is down the slope (`docs/session.md`, conventions).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Downslope {
     /// Down-slope is +x_px (to the right in the image); the default. Written `"+x"`.
@@ -32,6 +48,8 @@ pub enum FpsSource {
     SessionToml(PathBuf),
     /// The frame rate stored in this video file (feature `opencv`).
     Container(PathBuf),
+    /// The record rate in this camera file's header (`.cihx`, `.cih`, `.cine`).
+    Header(PathBuf),
     /// Nothing gave one: [`DEFAULT_FPS`] (a [`Warning::DefaultFps`] is returned too).
     Default,
 }
@@ -47,6 +65,21 @@ pub enum Warning {
         /// The frame rate assumed, in frames/s.
         fps: f64,
     },
+    /// No ball diameter was given for this clip; [`DEFAULT_BALL_DIAMETER_M`] is assumed.
+    DefaultDiameter {
+        /// The clip.
+        clip: PathBuf,
+        /// The diameter assumed, in metres.
+        diameter_m: f64,
+    },
+    /// The camera stored pixel codes that are not linear in the light (Phantom's 10-bit packed P10
+    /// format is log-encoded); they are passed on as they are, monotonic but not linear.
+    NonLinearPixels {
+        /// The camera file.
+        path: PathBuf,
+        /// What the codes are.
+        detail: String,
+    },
 }
 
 impl std::fmt::Display for Warning {
@@ -57,15 +90,166 @@ impl std::fmt::Display for Warning {
                 "{}: no frame rate given (command line, clip.toml or session.toml [camera] fps); assuming {fps} frames/s",
                 clip.display()
             ),
+            Self::DefaultDiameter { clip, diameter_m } => write!(
+                f,
+                "{}: no ball diameter given (command line, clip.toml or session.toml [ball] diameter_m); assuming {diameter_m} m",
+                clip.display()
+            ),
+            Self::NonLinearPixels { path, detail } => write!(f, "{}: {detail}", path.display()),
         }
     }
 }
 
-/// The `[camera]` keys of one settings file, each optional.
+/// A region of interest: the part of every frame the tracker looks at, in pixels (`x`, `y` of the top-left
+/// corner; written `roi = [x, y, width, height]`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct Roi {
+    /// Left column, in pixels from the image's left edge.
+    pub x: u32,
+    /// Top row, in pixels from the image's top edge.
+    pub y: u32,
+    /// Width, in pixels (≥ 1).
+    pub width: u32,
+    /// Height, in pixels (≥ 1).
+    pub height: u32,
+}
+
+impl Roi {
+    /// True if the region lies inside a `width`×`height` image.
+    pub fn fits(&self, (width, height): (u32, u32)) -> bool {
+        u64::from(self.x) + u64::from(self.width) <= u64::from(width)
+            && u64::from(self.y) + u64::from(self.height) <= u64::from(height)
+    }
+}
+
+/// The contact line given by hand: where the surface the ball touches crosses the image.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ContactLine {
+    /// y of the line at the image's centre column, in pixels (y down, pixel centres at integers).
+    pub y_px: f64,
+    /// The line's tilt, in degrees, counter-clockwise as seen in the image (|tilt| ≤ 45); 0 = level.
+    pub tilt_deg: f64,
+}
+
+/// Where one setting of a clip came from.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[non_exhaustive]
+pub enum SettingSource {
+    /// An explicit override (the command line).
+    CommandLine,
+    /// This clip's `clip.toml`.
+    ClipToml(PathBuf),
+    /// The session's `session.toml`.
+    SessionToml(PathBuf),
+    /// Nothing gave it: the documented default.
+    Default,
+}
+
+impl std::fmt::Display for SettingSource {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::CommandLine => f.write_str("command line"),
+            Self::ClipToml(p) | Self::SessionToml(p) => write!(f, "{}", p.display()),
+            Self::Default => f.write_str("default"),
+        }
+    }
+}
+
+/// Values given on the command line for one clip; each beats `clip.toml` and `session.toml`.
+#[derive(Clone, Debug, Default, PartialEq)]
+#[non_exhaustive]
+pub struct SettingOverrides {
+    /// Image scale, in metres per pixel.
+    pub scale_m_per_px: Option<f64>,
+    /// Ball diameter, in metres.
+    pub ball_diameter_m: Option<f64>,
+    /// Region of interest, in pixels.
+    pub roi: Option<Roi>,
+    /// Contact line, in pixels and degrees.
+    pub contact_line: Option<ContactLine>,
+}
+
+/// A clip's resolved geometry settings, each with where it came from (`docs/session.md`).
+///
+/// Precedence for every key: command line > `clip.toml` > `session.toml` > default. The region of interest
+/// and the contact line are checked against the frames' size when the clip is opened.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
+pub struct ClipSettings {
+    /// Image scale, in metres per pixel (`[camera] scale_m_per_px`); `None`: measured from the ball.
+    pub scale_m_per_px: Option<f64>,
+    /// Where the scale came from, when given.
+    pub scale_source: Option<SettingSource>,
+    /// Ball diameter, in metres (`[ball] diameter_m`).
+    pub ball_diameter_m: f64,
+    /// Where the diameter came from ([`SettingSource::Default`]: [`DEFAULT_BALL_DIAMETER_M`], with a
+    /// [`Warning::DefaultDiameter`]).
+    pub ball_diameter_source: SettingSource,
+    /// Region of interest, in pixels (`[camera] roi`); `None`: the whole frame.
+    pub roi: Option<Roi>,
+    /// Where the region of interest came from, when given.
+    pub roi_source: Option<SettingSource>,
+    /// Contact line (`[surface] line_y_px`, `line_tilt_deg`); `None`: found in the image.
+    pub contact_line: Option<ContactLine>,
+    /// Where the contact line came from, when given.
+    pub contact_line_source: Option<SettingSource>,
+}
+
+impl Default for ClipSettings {
+    fn default() -> Self {
+        Self {
+            scale_m_per_px: None,
+            scale_source: None,
+            ball_diameter_m: DEFAULT_BALL_DIAMETER_M,
+            ball_diameter_source: SettingSource::Default,
+            roi: None,
+            roi_source: None,
+            contact_line: None,
+            contact_line_source: None,
+        }
+    }
+}
+
+impl ClipSettings {
+    /// Checks the region of interest and the contact line against the frames' size.
+    pub fn check_against(&self, clip: &Path, size: (u32, u32)) -> Result<()> {
+        if let Some(roi) = self.roi {
+            if !roi.fits(size) {
+                return Err(FramesError::RoiOutsideImage {
+                    clip: clip.into(),
+                    roi,
+                    origin: origin_of(self.roi_source.as_ref()),
+                    size,
+                });
+            }
+        }
+        if let Some(line) = self.contact_line {
+            if !(line.y_px >= 0.0 && line.y_px <= f64::from(size.1.saturating_sub(1))) {
+                return Err(FramesError::LineOutsideImage {
+                    clip: clip.into(),
+                    line_y_px: line.y_px,
+                    origin: origin_of(self.contact_line_source.as_ref()),
+                    size,
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+fn origin_of(source: Option<&SettingSource>) -> String {
+    source.map_or_else(|| "unknown".to_string(), ToString::to_string)
+}
+
+/// The settings keys of one file, each optional.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub(crate) struct CameraKeys {
     pub fps: Option<f64>,
     pub downslope: Option<Downslope>,
+    pub scale_m_per_px: Option<f64>,
+    pub diameter_m: Option<f64>,
+    pub roi: Option<Roi>,
+    pub contact_line: Option<ContactLine>,
 }
 
 /// Reads and parses a TOML file into a table.
@@ -93,75 +277,316 @@ pub(crate) fn check_fps(fps: f64, origin: &str, field: &str) -> Result<f64> {
     }
 }
 
-/// The `[camera]` keys of a parsed settings file.
-pub(crate) fn camera_keys(path: &Path, doc: &toml::Table) -> Result<CameraKeys> {
-    let Some(camera) = doc.get("camera") else {
-        return Ok(CameraKeys::default());
-    };
-    let camera = camera.as_table().ok_or_else(|| FramesError::BadValue {
-        path: path.into(),
-        field: "[camera]".into(),
-        problem: "must be a table".into(),
-    })?;
-    let origin = path.display().to_string();
-    let fps = match camera.get("fps") {
-        None => None,
-        Some(toml::Value::Integer(i)) => Some(check_fps(*i as f64, &origin, "[camera] fps")?),
-        Some(toml::Value::Float(x)) => Some(check_fps(*x, &origin, "[camera] fps")?),
-        Some(other) => {
-            return Err(FramesError::BadFps {
-                origin,
-                field: "[camera] fps".into(),
-                value: other.to_string(),
-            });
-        }
-    };
-    let downslope = match camera.get("downslope") {
-        None => None,
-        Some(v) => Some(match v.as_str().map(str::trim) {
-            Some("+x") => Downslope::PlusX,
-            Some("-x") => Downslope::MinusX,
-            _ => {
-                return Err(FramesError::BadValue {
-                    path: path.into(),
-                    field: "[camera] downslope".into(),
-                    problem: format!("{v} is not \"+x\" or \"-x\""),
-                });
-            }
-        }),
-    };
-    Ok(CameraKeys { fps, downslope })
+/// Checks a value against a closed range, naming the file, key, unit and range.
+pub(crate) fn check_range(x: f64, (lo, hi): (f64, f64), unit: &str, path: &Path, field: &str) -> Result<f64> {
+    if x.is_finite() && x >= lo && x <= hi {
+        Ok(x)
+    } else {
+        Err(FramesError::BadValue {
+            path: path.into(),
+            field: field.into(),
+            problem: format!("{x} is outside the accepted range {lo:e}–{hi:e} {unit}"),
+        })
+    }
 }
 
-/// `[camera]` keys of `dir/name` if that file exists.
-pub(crate) fn camera_keys_in(dir: &Path, name: &str) -> Result<Option<(PathBuf, CameraKeys)>> {
-    let path = dir.join(name);
+fn table<'a>(path: &Path, doc: &'a toml::Table, name: &str) -> Result<Option<&'a toml::Table>> {
+    match doc.get(name) {
+        None => Ok(None),
+        Some(toml::Value::Table(t)) => Ok(Some(t)),
+        Some(_) => Err(FramesError::BadValue {
+            path: path.into(),
+            field: format!("[{name}]"),
+            problem: "must be a table".into(),
+        }),
+    }
+}
+
+/// A number (integer or float) or a type error naming the file and key.
+pub(crate) fn number(path: &Path, field: &str, value: &toml::Value) -> Result<f64> {
+    match value {
+        toml::Value::Integer(i) => Ok(*i as f64),
+        toml::Value::Float(x) => Ok(*x),
+        other => Err(FramesError::BadValue {
+            path: path.into(),
+            field: field.into(),
+            problem: format!("{other} is a {}, not a number", other.type_str()),
+        }),
+    }
+}
+
+fn roi(path: &Path, value: &toml::Value) -> Result<Roi> {
+    let field = "[camera] roi";
+    let bad = |problem: String| FramesError::BadValue {
+        path: path.into(),
+        field: field.into(),
+        problem,
+    };
+    let items = value.as_array().filter(|a| a.len() == 4).ok_or_else(|| {
+        bad(format!(
+            "{value} is not [x, y, width, height] (four whole numbers of pixels)"
+        ))
+    })?;
+    let mut v = [0u32; 4];
+    for (slot, item) in v.iter_mut().zip(items) {
+        *slot = item
+            .as_integer()
+            .and_then(|i| u32::try_from(i).ok())
+            .ok_or_else(|| bad(format!("{item} is not a whole number of pixels ≥ 0")))?;
+    }
+    if v[2] == 0 || v[3] == 0 {
+        return Err(bad("width and height must be at least 1 pixel".into()));
+    }
+    Ok(Roi {
+        x: v[0],
+        y: v[1],
+        width: v[2],
+        height: v[3],
+    })
+}
+
+/// The settings keys of a parsed settings file (`[camera]`, `[ball] diameter_m`, `[surface]`).
+pub(crate) fn camera_keys(path: &Path, doc: &toml::Table) -> Result<CameraKeys> {
+    let mut keys = CameraKeys::default();
+    if let Some(camera) = table(path, doc, "camera")? {
+        let origin = path.display().to_string();
+        keys.fps = match camera.get("fps") {
+            None => None,
+            Some(toml::Value::Integer(i)) => Some(check_fps(*i as f64, &origin, "[camera] fps")?),
+            Some(toml::Value::Float(x)) => Some(check_fps(*x, &origin, "[camera] fps")?),
+            Some(other) => {
+                return Err(FramesError::BadFps {
+                    origin,
+                    field: "[camera] fps".into(),
+                    value: other.to_string(),
+                });
+            }
+        };
+        keys.downslope = match camera.get("downslope") {
+            None => None,
+            Some(v) => Some(match v.as_str().map(str::trim) {
+                Some("+x") => Downslope::PlusX,
+                Some("-x") => Downslope::MinusX,
+                _ => {
+                    return Err(FramesError::BadValue {
+                        path: path.into(),
+                        field: "[camera] downslope".into(),
+                        problem: format!("{v} is not \"+x\" or \"-x\""),
+                    });
+                }
+            }),
+        };
+        if let Some(v) = camera.get("scale_m_per_px") {
+            let field = "[camera] scale_m_per_px";
+            keys.scale_m_per_px = Some(check_range(
+                number(path, field, v)?,
+                SCALE_RANGE_M_PER_PX,
+                "m/px",
+                path,
+                field,
+            )?);
+        }
+        if let Some(v) = camera.get("roi") {
+            keys.roi = Some(roi(path, v)?);
+        }
+    }
+    if let Some(ball) = table(path, doc, "ball")? {
+        if let Some(v) = ball.get("diameter_m") {
+            let field = "[ball] diameter_m";
+            keys.diameter_m = Some(check_range(
+                number(path, field, v)?,
+                DIAMETER_RANGE_M,
+                "m",
+                path,
+                field,
+            )?);
+        }
+    }
+    if let Some(surface) = table(path, doc, "surface")? {
+        let y = surface
+            .get("line_y_px")
+            .map(|v| number(path, "[surface] line_y_px", v))
+            .transpose()?;
+        let tilt = surface
+            .get("line_tilt_deg")
+            .map(|v| number(path, "[surface] line_tilt_deg", v))
+            .transpose()?;
+        match (y, tilt) {
+            (None, None) => {}
+            (None, Some(_)) => {
+                return Err(FramesError::BadValue {
+                    path: path.into(),
+                    field: "[surface] line_tilt_deg".into(),
+                    problem: "given without [surface] line_y_px (the line's y at the image's centre column)".into(),
+                });
+            }
+            (Some(y), tilt) => {
+                if !(y.is_finite() && y >= 0.0) {
+                    return Err(FramesError::BadValue {
+                        path: path.into(),
+                        field: "[surface] line_y_px".into(),
+                        problem: format!("{y} is not a pixel row (a number ≥ 0)"),
+                    });
+                }
+                let tilt = tilt.unwrap_or(0.0);
+                check_range(
+                    tilt,
+                    (-MAX_LINE_TILT_DEG, MAX_LINE_TILT_DEG),
+                    "degrees",
+                    path,
+                    "[surface] line_tilt_deg",
+                )?;
+                keys.contact_line = Some(ContactLine {
+                    y_px: y,
+                    tilt_deg: tilt,
+                });
+            }
+        }
+    }
+    Ok(keys)
+}
+
+/// The settings keys of the file at `path`, if it exists.
+pub(crate) fn camera_keys_at(path: &Path) -> Result<Option<(PathBuf, CameraKeys)>> {
     if !path.is_file() {
         return Ok(None);
     }
-    let doc = read_toml(&path)?;
-    let keys = camera_keys(&path, &doc)?;
-    Ok(Some((path, keys)))
+    let doc = read_toml(path)?;
+    let keys = camera_keys(path, &doc)?;
+    Ok(Some((path.to_path_buf(), keys)))
 }
 
-/// The fps precedence of SPEC §2.1: override > `clip.toml` > `session.toml` in the parent > default.
-pub(crate) fn resolve_fps(clip_dir: &Path, fps_override: Option<f64>) -> Result<(f64, FpsSource, Option<Warning>)> {
+/// A clip's own settings file: `DIR/clip.toml` for a clip folder, `NAME.clip.toml` beside a camera file
+/// `NAME.EXT` (the last extension dropped: `shot1.cihx` → `shot1.clip.toml`).
+pub fn clip_toml_path(clip: &Path) -> PathBuf {
+    if clip.is_dir() {
+        return clip.join("clip.toml");
+    }
+    let stem = clip
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    clip.with_file_name(format!("{stem}.clip.toml"))
+}
+
+/// The `session.toml` that applies to a clip: the one in the folder holding the clip.
+pub(crate) fn session_toml_path(clip: &Path) -> Option<PathBuf> {
+    clip.parent().map(|p| p.join("session.toml"))
+}
+
+/// The fps precedence (`docs/session.md`): override > `clip.toml` > the camera file's header >
+/// `session.toml` > [`DEFAULT_FPS`] with a warning.
+pub(crate) fn choose_fps(
+    clip: &Path,
+    fps_override: Option<f64>,
+    own: Option<&(PathBuf, CameraKeys)>,
+    header: Option<(f64, &Path)>,
+    session: Option<(f64, &Path)>,
+) -> Result<(f64, FpsSource, Option<Warning>)> {
     if let Some(fps) = fps_override {
         return Ok((check_fps(fps, "command line", "--fps")?, FpsSource::Override, None));
     }
-    if let Some((path, CameraKeys { fps: Some(fps), .. })) = camera_keys_in(clip_dir, "clip.toml")? {
-        return Ok((fps, FpsSource::ClipToml(path), None));
+    if let Some((path, CameraKeys { fps: Some(fps), .. })) = own {
+        return Ok((*fps, FpsSource::ClipToml(path.clone()), None));
     }
-    if let Some(parent) = clip_dir.parent() {
-        if let Some((path, CameraKeys { fps: Some(fps), .. })) = camera_keys_in(parent, "session.toml")? {
-            return Ok((fps, FpsSource::SessionToml(path), None));
-        }
+    if let Some((fps, path)) = header {
+        return Ok((fps, FpsSource::Header(path.into()), None));
+    }
+    if let Some((fps, path)) = session {
+        return Ok((fps, FpsSource::SessionToml(path.into()), None));
     }
     let warning = Warning::DefaultFps {
-        clip: clip_dir.into(),
+        clip: clip.into(),
         fps: DEFAULT_FPS,
     };
     Ok((DEFAULT_FPS, FpsSource::Default, Some(warning)))
+}
+
+/// The geometry settings' precedence: override > `clip.toml` > `session.toml` > default.
+pub(crate) fn choose_settings(
+    clip: &Path,
+    overrides: &SettingOverrides,
+    own: Option<&(PathBuf, CameraKeys)>,
+    session: Option<&(PathBuf, CameraKeys)>,
+    warnings: &mut Vec<Warning>,
+) -> ClipSettings {
+    fn pick<T: Copy>(
+        over: Option<T>,
+        own: Option<&(PathBuf, CameraKeys)>,
+        session: Option<&(PathBuf, CameraKeys)>,
+        get: impl Fn(&CameraKeys) -> Option<T>,
+    ) -> Option<(T, SettingSource)> {
+        if let Some(v) = over {
+            return Some((v, SettingSource::CommandLine));
+        }
+        if let Some((p, k)) = own {
+            if let Some(v) = get(k) {
+                return Some((v, SettingSource::ClipToml(p.clone())));
+            }
+        }
+        session.and_then(|(p, k)| get(k).map(|v| (v, SettingSource::SessionToml(p.clone()))))
+    }
+    let scale = pick(overrides.scale_m_per_px, own, session, |k| k.scale_m_per_px);
+    let diameter = pick(overrides.ball_diameter_m, own, session, |k| k.diameter_m);
+    let roi = pick(overrides.roi, own, session, |k| k.roi);
+    let line = pick(overrides.contact_line, own, session, |k| k.contact_line);
+    let (ball_diameter_m, ball_diameter_source) = diameter.unwrap_or_else(|| {
+        warnings.push(Warning::DefaultDiameter {
+            clip: clip.into(),
+            diameter_m: DEFAULT_BALL_DIAMETER_M,
+        });
+        (DEFAULT_BALL_DIAMETER_M, SettingSource::Default)
+    });
+    fn split<T>(x: Option<(T, SettingSource)>) -> (Option<T>, Option<SettingSource>) {
+        match x {
+            Some((v, s)) => (Some(v), Some(s)),
+            None => (None, None),
+        }
+    }
+    let (scale_m_per_px, scale_source) = split(scale);
+    let (roi, roi_source) = split(roi);
+    let (contact_line, contact_line_source) = split(line);
+    ClipSettings {
+        scale_m_per_px,
+        scale_source,
+        ball_diameter_m,
+        ball_diameter_source,
+        roi,
+        roi_source,
+        contact_line,
+        contact_line_source,
+    }
+}
+
+/// Checks command-line overrides with the same ranges as the files.
+pub(crate) fn check_overrides(o: &SettingOverrides) -> Result<()> {
+    let cl = Path::new("command line");
+    if let Some(s) = o.scale_m_per_px {
+        check_range(s, SCALE_RANGE_M_PER_PX, "m/px", cl, "--scale")?;
+    }
+    if let Some(d) = o.ball_diameter_m {
+        check_range(d, DIAMETER_RANGE_M, "m", cl, "--diameter")?;
+    }
+    if let Some(l) = o.contact_line {
+        check_range(l.y_px, (0.0, f64::MAX), "px", cl, "--line-y")?;
+        check_range(
+            l.tilt_deg,
+            (-MAX_LINE_TILT_DEG, MAX_LINE_TILT_DEG),
+            "degrees",
+            cl,
+            "--line-tilt",
+        )?;
+    }
+    if let Some(r) = o.roi {
+        if r.width == 0 || r.height == 0 {
+            return Err(FramesError::BadValue {
+                path: cl.into(),
+                field: "--roi".into(),
+                problem: "width and height must be at least 1 pixel".into(),
+            });
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -178,7 +603,8 @@ mod tests {
             keys("[camera]\nfps = 5000\ndownslope = \"-x\"").unwrap(),
             CameraKeys {
                 fps: Some(5000.0),
-                downslope: Some(Downslope::MinusX)
+                downslope: Some(Downslope::MinusX),
+                ..CameraKeys::default()
             }
         );
         assert_eq!(keys("[camera]\nfps = 2.5e4").unwrap().fps, Some(25_000.0));

@@ -1,4 +1,4 @@
-//! Reading clip folders: formats, order, gaps, fps precedence, bad input (SPEC §2.1, §6).
+//! Reading clip folders: formats, order, gaps, fps precedence, bad input (`docs/session.md`).
 
 use std::path::Path;
 
@@ -113,7 +113,7 @@ fn mixed_formats_other_files_and_hidden_files() {
     );
     assert_eq!(clip.fps(), 2000.0);
     assert!(matches!(clip.fps_source(), FpsSource::ClipToml(_)));
-    assert!(clip.warnings().is_empty());
+    assert!(!clip.warnings().iter().any(|w| matches!(w, Warning::DefaultFps { .. })));
 }
 
 #[test]
@@ -235,12 +235,16 @@ fn fps_precedence_override_then_clip_then_session_then_default() {
 
     let clip = Clip::open(&clip_dir).unwrap();
     assert_eq!((clip.fps(), clip.fps_source()), (10_000.0, &FpsSource::Default));
-    assert!(matches!(clip.warnings(), [Warning::DefaultFps { .. }]));
+    assert!(matches!(
+        clip.warnings(),
+        [Warning::DefaultFps { .. }, Warning::DefaultDiameter { .. }]
+    ));
     assert!(clip.warnings()[0].to_string().contains("10000"));
 
     std::fs::write(tmp.path().join("session.toml"), SESSION_TOML.replace("10000", "4000")).unwrap();
     let clip = Clip::open(&clip_dir).unwrap();
     assert_eq!(clip.fps(), 4000.0);
+    // session.toml gives the fps and the ball: no default is taken.
     assert!(matches!(clip.fps_source(), FpsSource::SessionToml(_)) && clip.warnings().is_empty());
 
     std::fs::write(clip_dir.join("clip.toml"), "[camera]\nfps = 5000.0\n").unwrap();

@@ -1,4 +1,4 @@
-//! Streaming a long clip keeps memory bounded (SPEC §2.1): peak RSS of a 20,000-frame clip stays < 200 MB.
+//! Streaming a long clip keeps memory bounded (`docs/session.md`): peak RSS of a 20,000-frame clip stays < 200 MB.
 //!
 //! Its own test binary so that no other test inflates the process's peak. Run with
 //! `cargo test -p bouncelab-frames --release --test peak_rss -- --ignored --nocapture`.

@@ -1,4 +1,4 @@
-//! Loading session folders: session.toml, clips.csv, clip.toml overrides and their errors (SPEC §2.7, §6).
+//! Loading session folders: session.toml, clips.csv, clip.toml overrides and their errors (`docs/session.md`).
 
 use bouncelab_frames::testutil::{ClipSpec, SESSION_TOML, write_session};
 use bouncelab_frames::{Downslope, FpsSource, FramesError, Session, Warning};
@@ -187,4 +187,221 @@ fn a_bad_clip_toml_is_named() {
     let err = Session::load(tmp.path()).unwrap_err();
     assert!(matches!(err, FramesError::BadFps { .. }));
     assert_names(&err, &["shot_02", "clip.toml", "[camera] fps"]);
+}
+
+// ---- camera files, settings keys, unfilled rows, init ------------------------------------------------------
+
+mod common;
+
+use bouncelab_frames::init::{InitOptions, scan};
+use bouncelab_frames::{ContactLine, Roi, SettingSource};
+use common::camera::{Cine, CinePacking, Mraw, TiffCompression, moving_disc, write_tiff_stack};
+
+const BALL: &str = "[ball]\ndiameter_m = 0.067\nmass_kg = 0.0567\n";
+
+#[test]
+fn camera_files_are_clips_by_exact_name_or_by_name_without_extension() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    std::fs::write(d.join("session.toml"), BALL).unwrap();
+    Mraw::new(16, 8, 12).write(d, "p1", &moving_disc(16, 8, 3, 4095, 1));
+    Cine::new(16, 8, CinePacking::U8).write(&d.join("c1.cine"), &moving_disc(16, 8, 4, 255, 1));
+    write_tiff_stack(
+        &d.join("t1.tif"),
+        16,
+        8,
+        8,
+        &moving_disc(16, 8, 5, 255, 1),
+        TiffCompression::None,
+    );
+    ClipSpec::new(2).write(&d.join("folder1"));
+    std::fs::write(
+        d.join("clips.csv"),
+        "clip,surface,angle_deg,drop_height_m\np1,clay,0,1\nc1.cine,clay,10,1\nt1,tape,0,0.5\nfolder1,tape,0,1\n",
+    )
+    .unwrap();
+    let s = Session::load(d).unwrap();
+    let by = |n: &str| s.clip(n).unwrap();
+    assert_eq!(by("p1").dir, d.join("p1.cihx"));
+    assert_eq!((by("p1").fps, by("c1.cine").fps), (30_000.0, 25_000.0));
+    assert!(matches!(by("p1").fps_source, FpsSource::Header(_)));
+    assert_eq!(by("t1").dir, d.join("t1.tif"));
+    // Neither the stack nor the folder has a header; nothing else gives an fps.
+    assert_eq!(s.warnings.len(), 2, "{:?}", s.warnings);
+    for (name, frames) in [("p1", 3), ("c1.cine", 4), ("t1", 5), ("folder1", 2)] {
+        assert_eq!(by(name).open().unwrap().len(), frames, "{name}");
+    }
+
+    Cine::new(16, 8, CinePacking::U8).write(&d.join("t1.cine"), &moving_disc(16, 8, 4, 255, 1));
+    let err = Session::load(d).unwrap_err();
+    assert!(matches!(err, FramesError::AmbiguousClip { .. }), "{err:?}");
+    assert_names(&err, &["t1", "t1.cine", "t1.tif"]);
+}
+
+#[test]
+fn settings_keys_resolve_clip_over_session_with_their_sources() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let toml = format!(
+        "{BALL}[camera]\nfps = 1000\nscale_m_per_px = 2.5e-4\nroi = [0, 2, 30, 20]\n[surface]\nline_y_px = 20\nline_tilt_deg = -1.5\n"
+    );
+    write_session(d, &toml, CSV, &["shot_01", "shot_02"]);
+    std::fs::write(
+        d.join("shot_02/clip.toml"),
+        "[ball]\ndiameter_m = 0.04\n[surface]\nline_y_px = 12.5\n",
+    )
+    .unwrap();
+    let s = Session::load(d).unwrap();
+    let (a, b) = (&s.clips[0].settings, &s.clips[1].settings);
+    let session_src = SettingSource::SessionToml(d.join("session.toml"));
+    let clip_src = SettingSource::ClipToml(d.join("shot_02/clip.toml"));
+    assert_eq!((a.ball_diameter_m, &a.ball_diameter_source), (0.067, &session_src));
+    assert_eq!((b.ball_diameter_m, &b.ball_diameter_source), (0.04, &clip_src));
+    assert_eq!((a.scale_m_per_px, b.scale_m_per_px), (Some(2.5e-4), Some(2.5e-4)));
+    let roi = Roi {
+        x: 0,
+        y: 2,
+        width: 30,
+        height: 20,
+    };
+    assert_eq!((a.roi, &a.roi_source), (Some(roi), &Some(session_src.clone())));
+    assert_eq!(
+        a.contact_line,
+        Some(ContactLine {
+            y_px: 20.0,
+            tilt_deg: -1.5
+        })
+    );
+    // The clip's line is a unit: its tilt defaults to 0, not the session's.
+    assert_eq!(
+        b.contact_line,
+        Some(ContactLine {
+            y_px: 12.5,
+            tilt_deg: 0.0
+        })
+    );
+    assert_eq!(b.contact_line_source, Some(clip_src));
+    let clip = s.clips[1].open().unwrap();
+    assert_eq!(clip.settings().ball_diameter_m, 0.04);
+
+    // Checked against the frames (32×24) when the clip is opened, naming the clip and the file.
+    std::fs::write(d.join("shot_01/clip.toml"), "[camera]\nroi = [10, 0, 30, 10]\n").unwrap();
+    std::fs::write(d.join("shot_02/clip.toml"), "[surface]\nline_y_px = 24\n").unwrap();
+    let s = Session::load(d).unwrap();
+    let err = s.clips[0].open().unwrap_err();
+    assert!(matches!(err, FramesError::RoiOutsideImage { .. }), "{err:?}");
+    assert_names(&err, &["shot_01", "[10, 0, 30, 10]", "clip.toml", "32×24"]);
+    let err = s.clips[1].open().unwrap_err();
+    assert!(matches!(err, FramesError::LineOutsideImage { .. }), "{err:?}");
+    assert_names(&err, &["shot_02", "y = 24", "0 ≤ y ≤ 23"]);
+}
+
+#[test]
+fn settings_values_out_of_range_name_the_file_key_and_range() {
+    let cases = [
+        ("[camera]\nscale_m_per_px = 0\n", "[camera] scale_m_per_px", "1e-7"),
+        ("[camera]\nscale_m_per_px = 3\n", "[camera] scale_m_per_px", "1e0"),
+        ("[ball]\ndiameter_m = 5\n", "[ball] diameter_m", "1e-4"),
+        ("[camera]\nroi = [1, 2, 3]\n", "[camera] roi", "[x, y, width, height]"),
+        ("[camera]\nroi = [1, 2, 0, 4]\n", "[camera] roi", "at least 1 pixel"),
+        ("[camera]\nroi = [-1, 2, 3, 4]\n", "[camera] roi", "≥ 0"),
+        (
+            "[surface]\nline_y_px = 10\nline_tilt_deg = 60\n",
+            "[surface] line_tilt_deg",
+            "4.5e1",
+        ),
+        ("[surface]\nline_tilt_deg = 2\n", "[surface] line_tilt_deg", "without"),
+        ("[surface]\nline_y_px = -3\n", "[surface] line_y_px", "≥ 0"),
+        (
+            "[surface]\nline_y_px = \"top\"\n",
+            "[surface] line_y_px",
+            "not a number",
+        ),
+    ];
+    for (clip_toml, key, range) in cases {
+        let tmp = tempfile::tempdir().unwrap();
+        write_session(tmp.path(), SESSION_TOML, CSV, &["shot_01", "shot_02"]);
+        std::fs::write(tmp.path().join("shot_02/clip.toml"), clip_toml).unwrap();
+        let err = Session::load(tmp.path()).unwrap_err();
+        assert!(matches!(err, FramesError::BadValue { .. }), "{clip_toml}: {err:?}");
+        assert_names(&err, &["shot_02", "clip.toml", key, range]);
+    }
+}
+
+#[test]
+fn unfilled_cells_are_all_named_at_once() {
+    let csv = "clip,surface,angle_deg,drop_height_m\nshot_01,,,1.2\nshot_02,tape,20,\n";
+    let (_t, s) = session_with(SESSION_TOML, csv, &["shot_01", "shot_02"]);
+    let err = s.unwrap_err();
+    let FramesError::UnfilledColumns { rows, .. } = &err else {
+        panic!("{err:?}")
+    };
+    assert_eq!(rows.len(), 2);
+    assert_eq!(
+        (rows[0].line, rows[0].columns.clone()),
+        (2, vec!["surface".to_string(), "angle_deg".into()])
+    );
+    assert_names(
+        &err,
+        &[
+            "clips.csv",
+            "line 2 `shot_01`: surface, angle_deg",
+            "line 3 `shot_02`: drop_height_m",
+        ],
+    );
+}
+
+#[test]
+fn init_then_load_on_a_folder_of_camera_files() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    Mraw::new(16, 8, 12).write(d, "clay_15deg_550mm", &moving_disc(16, 8, 3, 4095, 1));
+    Cine::new(16, 8, CinePacking::P12).write(&d.join("tape_0deg_1.2m.cine"), &moving_disc(16, 8, 4, 4095, 1));
+    ClipSpec::new(2).write(&d.join("shot_03"));
+    std::fs::create_dir(d.join("notes")).unwrap();
+    std::fs::write(d.join("broken.cine"), b"CI but not really").unwrap();
+    let draft = scan(d).unwrap();
+    let names: Vec<&str> = draft.clips.iter().map(|c| c.name.as_str()).collect();
+    assert_eq!(
+        names,
+        ["broken.cine", "clay_15deg_550mm.cihx", "shot_03", "tape_0deg_1.2m.cine"]
+    );
+    assert!(draft.clips[0].problem.as_deref().unwrap().contains("broken.cine"));
+    assert_eq!(draft.skipped.len(), 1);
+    assert_eq!((draft.clips[1].frames, draft.clips[1].fps), (Some(3), Some(30_000.0)));
+    // Headers disagree (30,000 and 25,000): no session-wide fps is written.
+    assert_eq!(draft.common_fps(), None);
+    let mut o = InitOptions::default();
+    o.diameter_m = Some(0.067);
+    o.mass_kg = Some(0.0567);
+    draft.write(&o).unwrap();
+    let err = draft.write(&o).unwrap_err();
+    assert!(matches!(err, FramesError::WouldOverwrite { .. }), "{err:?}");
+    let csv = std::fs::read_to_string(d.join("clips.csv")).unwrap();
+    assert!(csv.contains("clay_15deg_550mm.cihx,clay,15,0.55"), "{csv}");
+    assert!(csv.contains("tape_0deg_1.2m.cine,tape,0,1.2"), "{csv}");
+    let err = Session::load(d).unwrap_err();
+    assert_names(
+        &err,
+        &[
+            "line 2 `broken.cine`",
+            "line 4 `shot_03`: surface, angle_deg, drop_height_m",
+        ],
+    );
+    let filled = csv
+        .replace("broken.cine,,,\n", "")
+        .replace("shot_03,,,", "shot_03,clay,0,1");
+    std::fs::write(d.join("clips.csv"), filled).unwrap();
+    let s = Session::load(d).unwrap();
+    assert_eq!(s.clips.len(), 3);
+    assert_eq!(s.clip("tape_0deg_1.2m.cine").unwrap().open().unwrap().len(), 4);
+    assert_eq!(s.clip("clay_15deg_550mm.cihx").unwrap().fps, 30_000.0);
+    let mut forced = o.clone();
+    forced.force = true;
+    draft.write(&forced).unwrap();
+    // Without a ball, the keys are left for a person to fill and loading names them.
+    let mut bare = InitOptions::default();
+    bare.force = true;
+    draft.write(&bare).unwrap();
+    assert_names(&Session::load(d).unwrap_err(), &["[ball] diameter_m missing"]);
 }

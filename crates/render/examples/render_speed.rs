@@ -26,15 +26,15 @@ fn main() {
         let f = r.frame(i);
         t_render += t.elapsed().as_secs_f64();
         let t = Instant::now();
-        bytes += encode(&f, scenario.camera.format).expect("encode").len();
+        bytes += encode(&f, plan.camera().format).expect("encode").len();
         t_encode += t.elapsed().as_secs_f64();
     }
     println!(
         "{preset} shot {} ({}): {n} frames {}x{}; physics {:.1} ms, background {:.1} ms per clip",
         shot,
         plan.truth.clip,
-        scenario.camera.width,
-        scenario.camera.height,
+        plan.camera().width,
+        plan.camera().height,
         t_plan.as_secs_f64() * 1e3,
         t_bg.as_secs_f64() * 1e3
     );
@@ -51,7 +51,7 @@ fn main() {
             .iter()
             .position(|f| f.t_s >= plan.truth.t_max_s)
             .unwrap_or(0);
-        std::fs::write(out, encode(&r.frame(i), scenario.camera.format).unwrap()).unwrap();
+        std::fs::write(out, encode(&r.frame(i), plan.camera().format).unwrap()).unwrap();
         println!("frame {i} (maximum compression) written to {out}");
     }
 }

@@ -7,9 +7,13 @@
 //! times (motion blur), so the truth is the model's own output. The main design choice is that the
 //! expensive image work is split into a static background made once per shot and a per-frame pass that
 //! only shades the ball's bounding box, with every random stream derived from (seed, shot, frame): frames
-//! can be rendered in any order, in parallel, and come out byte-identical.
+//! can be rendered in any order, in parallel, and come out byte-identical. A scenario's `[look]` draws each
+//! shot's appearance and camera from wide ranges (`docs/renderer.md`, "Looks"), so the pipeline is tested
+//! on many looks, not on this renderer's one.
 
+mod appearance;
 mod error;
+mod look;
 pub mod presets;
 mod progress;
 mod rng;
@@ -19,9 +23,10 @@ mod session;
 mod shot;
 
 pub use error::RenderError;
+pub use look::{BallLook, HotSpot, Item, ItemKind, LOOK_COLUMNS, LOOK_FAMILIES, Look, LookSpec, Range, SurfaceLook};
 pub use presets::{EFFECT_MAGNITUDES, preset_names, preset_toml};
 pub use progress::ProgressBarObserver;
-pub use scenario::{BallSpec, Camera, Downslope, Format, Scenario, Shot, Surface, Texture};
+pub use scenario::{BallSpec, Camera, Downslope, Format, RandomPhysics, Scenario, Shot, Surface, Texture};
 pub use scene::{Frame, Pixels, ShotRenderer};
 pub use session::{
     FRAME_COLUMNS, Observer, RenderOptions, Rendered, SHOTS_COLUMNS, Silent, encode, render, render_with,

@@ -1,5 +1,6 @@
 //! Built-in scenarios: `smoke` (regression tests), `paper` (the paper's 144-shot session), `none` and one
-//! `effect-<name>` session per non-base effect of the model crate (for the missing-effect diagnosis).
+//! `effect-<name>` session per non-base effect of the model crate (for the missing-effect diagnosis),
+//! `looks` (64 shots, each with its own look and physics) and `looks-smoke` (6 small ones for tests).
 
 use bouncelab_model::{ModelSpec, builtin_effects};
 
@@ -18,7 +19,10 @@ pub const EFFECT_MAGNITUDES: &[(&str, &str)] = &[
 
 /// The names of every preset.
 pub fn preset_names() -> Vec<String> {
-    let mut v: Vec<String> = ["smoke", "paper", "none"].iter().map(|s| s.to_string()).collect();
+    let mut v: Vec<String> = ["smoke", "paper", "none", "looks", "looks-smoke"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
     for e in builtin_effects().iter().filter(|e| !e.base) {
         v.push(format!("effect-{}", e.name));
     }
@@ -75,6 +79,8 @@ pub fn preset_toml(name: &str) -> Option<String> {
             paper_model_tables()
         )),
         "none" => Some(effect_session("none", None)),
+        "looks" => Some(looks()),
+        "looks-smoke" => Some(looks_smoke()),
         _ => {
             let effect = name.strip_prefix("effect-")?;
             let info = builtin_effects().iter().find(|e| e.name == effect && !e.base)?;
@@ -114,5 +120,87 @@ fn effect_session(name: &str, effect: Option<&str>) -> String {
     let flight_ms = if effect == Some("drag") { 35 } else { 10 };
     format!(
         "name = \"{name}\"\ndescription = \"Diagnosis session: clay, {what}\"\nseed = {seed}\npre_contact_ms = {flight_ms}\npost_separation_ms = {flight_ms}\n\n[ball]\ndiameter_m = 0.067\nmass_kg = 0.0567\ninertia_factor = 0.6666666666666666\n\n{CAMERA_512}\n[model]\ngravity_m_s2 = 9.81\n[model.effects.spring]\nk = 25650\n[model.effects.damping]\nb = 14\n[model.effects.coulomb]\nmu = 0.5\n\n[surfaces.clay]\ntexture = \"clay\"\n\n{extra}\n[grid]\nsurfaces = [\"clay\"]\ndrop_heights_m = [0.2, 0.55, 0.9]\nangles_deg = [0, 7.5, 15, 22.5]\nrepeats = 1\neffects = {list}\n"
+    )
+}
+
+/// A session of `repeats` shots on clay and as many on tape (`white_tape` physics) whose look and physics
+/// are drawn per shot from `[random_physics]` (`physics`) and `[look]` (`look`) lines, filmed `flight_ms`
+/// before the touch and after separation.
+fn looks_session(
+    name: &str,
+    description: &str,
+    seed: u64,
+    flight_ms: f64,
+    repeats: u32,
+    physics: &str,
+    look: &str,
+) -> String {
+    format!(
+        r#"name = "{name}"
+description = "{description}"
+seed = {seed}
+pre_contact_ms = {flight_ms}
+post_separation_ms = {flight_ms}
+
+[ball]
+diameter_m = 0.067
+mass_kg = 0.0567
+inertia_factor = 0.6666666666666666
+
+[camera]
+fps = 10000
+exposure_s = 5e-5
+
+[model]
+gravity_m_s2 = 9.81
+[model.effects.spring]
+k = 25650
+[model.effects.damping]
+b = 14
+[model.effects.coulomb]
+mu = 0.5
+
+[surfaces.clay]
+texture = "clay"
+[surfaces.tape]
+texture = "white_tape"
+
+[random_physics]
+{physics}
+[look]
+{look}
+[grid]
+surfaces = ["clay", "tape"]
+drop_heights_m = [0.3]
+angles_deg = [0]
+repeats = {repeats}
+"#
+    )
+}
+
+/// `looks`: 64 shots (32 on clay, 32 on tape), every look family of `docs/renderer.md`, at 320–512 px.
+fn looks() -> String {
+    looks_session(
+        "looks",
+        "64 shots, each with its own look (surface, contrast, lighting, clutter, ball, sensor, geometry) and physics",
+        15,
+        8.0,
+        32,
+        "drop_height_m = [0.15, 0.6]\nangle_deg = [0, 25]\nk = [20000, 36000]\nb = [8, 20]\nmu = [0.3, 0.7]\n",
+        "width_px = [320, 512]\nheight_px = [320, 512]\n",
+    )
+}
+
+/// `looks-smoke`: 6 small shots (3 on clay, 3 on tape) with drawn looks and physics, 256 × 256, a 4-ms
+/// flight either side; renders in a few seconds, for tests of other crates.
+fn looks_smoke() -> String {
+    looks_session(
+        "looks-smoke",
+        "6 small shots with drawn looks and physics, for tests",
+        3,
+        4.0,
+        3,
+        "drop_height_m = [0.15, 0.35]\nangle_deg = [0, 20]\n",
+        "width_px = 256\nheight_px = 256\nball_radius_px = [20, 40]\n",
     )
 }

@@ -2,6 +2,8 @@
 //! is read and checked.
 
 use crate::RenderError;
+use crate::look::{LookSpec, Range};
+use crate::rng::{Rng, derive};
 use bouncelab_model::ModelSpec;
 use serde::Deserialize;
 use std::path::Path;
@@ -94,7 +96,8 @@ pub struct Camera {
     /// Camera roll, degrees counter-clockwise with respect to the surface: the whole scene turns in the
     /// image and the surface line is tilted (default 0). Adds to a shot's `camera_roll` effect.
     pub roll_deg: f64,
-    /// Bits per pixel of the frame files: 8 or 16 (default 8).
+    /// Bits of the frame data: 8 (8-bit files), 12 (12-bit data in 16-bit files, shifted left by 4: values
+    /// × 16, as 12-bit cameras write them) or 16 (default 8).
     pub bit_depth: u8,
     /// Frame file format (default png).
     pub format: Format,
@@ -156,7 +159,7 @@ impl Camera {
 }
 
 /// (prefix, zero-padding width, suffix) of a naming pattern.
-fn parse_naming(pattern: &str) -> Result<(String, usize, String), String> {
+pub(crate) fn parse_naming(pattern: &str) -> Result<(String, usize, String), String> {
     let open = pattern
         .find('{')
         .ok_or("needs a `{}` or `{:06}` placeholder for the frame number")?;
@@ -214,6 +217,54 @@ pub struct Surface {
     pub texture: Texture,
     /// Its per-surface model values, in `model.toml`'s `[surfaces.NAME]` syntax (`spring.k = 25650`).
     pub model_values: Table,
+}
+
+/// The `[random_physics]` table: physics drawn per shot from the shot's seed, replacing the shot's drop
+/// height and incline and its surface's k, b and μ. Draws are rounded to 1 mm, 0.1°, 10 N/m, 0.1 N·s/m and
+/// 0.01 (so clip names and `clips.csv` show them exactly).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RandomPhysics {
+    /// Drop height, m.
+    pub drop_height_m: Option<Range>,
+    /// Incline β, degrees.
+    pub angle_deg: Option<Range>,
+    /// Spring stiffness k (`spring.k`), N/m.
+    pub k: Option<Range>,
+    /// Compression damping b (`damping.b`), N·s/m.
+    pub b: Option<Range>,
+    /// Coulomb friction μ (`coulomb.mu`).
+    pub mu: Option<Range>,
+}
+
+/// Stream of a shot's random physics, derived from the shot's seed.
+const PHYSICS_STREAM: u64 = 0x5048_5953_5354_524D;
+
+/// A model value replaced for one shot: (effect, parameter, value).
+pub(crate) type Override = (&'static str, &'static str, f64);
+
+impl RandomPhysics {
+    /// The model parameters it draws: (key, effect, parameter, range, rounding step).
+    fn model_keys(&self) -> [(&'static str, &'static str, &'static str, Option<Range>, f64); 3] {
+        [
+            ("k", "spring", "k", self.k, 10.0),
+            ("b", "damping", "b", self.b, 0.1),
+            ("mu", "coulomb", "mu", self.mu, 0.01),
+        ]
+    }
+}
+
+/// The value at `u` ∈ [0, 1) of range `r`, rounded to a multiple of `step` (dividing by a whole number for
+/// decimal steps, so 0.287 is printed as 0.287) and kept within `r`.
+fn rounded(r: Range, u: f64, step: f64) -> f64 {
+    let x = r.lo + (r.hi - r.lo) * u;
+    let q = if step >= 1.0 {
+        (x / step).round() * step
+    } else {
+        let per_unit = (1.0 / step).round();
+        (x * per_unit).round() / per_unit
+    };
+    q.clamp(r.lo, r.hi)
 }
 
 /// One drop shot.
@@ -277,6 +328,10 @@ struct Raw {
     grid: Option<Grid>,
     #[serde(default)]
     extra_effects: Table,
+    #[serde(default)]
+    look: Option<LookSpec>,
+    #[serde(default)]
+    random_physics: Option<RandomPhysics>,
 }
 
 fn default_pre() -> f64 {
@@ -311,8 +366,13 @@ pub struct Scenario {
     /// The surfaces, in file order.
     pub surfaces: Vec<Surface>,
     /// The shots, in order (`[[shots]]` first, then the `[grid]` expanded surface × angle × height ×
-    /// repeat).
+    /// repeat), as written: with `[random_physics]`, [`Scenario::shot`] gives the values each shot is
+    /// rendered with.
     pub shots: Vec<Shot>,
+    /// The `[look]` table: when present each shot's appearance and camera are drawn from its ranges.
+    pub look: Option<LookSpec>,
+    /// The `[random_physics]` table: when present each shot's physics is drawn from its ranges.
+    pub random_physics: Option<RandomPhysics>,
     model: Table,
     extra_effects: Table,
 }
@@ -427,8 +487,12 @@ impl Scenario {
             (0.0..=0.01).contains(&c.hot_pixel_fraction),
             "must be 0 to 0.01",
         )?;
-        if c.bit_depth != 8 && c.bit_depth != 16 {
-            return Err(invalid("camera.bit_depth", c.bit_depth.to_string(), "must be 8 or 16"));
+        if ![8, 12, 16].contains(&c.bit_depth) {
+            return Err(invalid(
+                "camera.bit_depth",
+                c.bit_depth.to_string(),
+                "must be 8, 12 (12-bit data in 16-bit files) or 16",
+            ));
         }
         if !(1..=64).contains(&c.blur_samples) {
             return Err(invalid(
@@ -613,9 +677,14 @@ impl Scenario {
             camera: raw.camera,
             surfaces,
             shots,
+            look: raw.look,
+            random_physics: raw.random_physics,
             model,
             extra_effects: raw.extra_effects,
         };
+        if let Some(l) = &scenario.look {
+            l.check(origin)?;
+        }
         // Surface values may only name effects of the model or of [extra_effects].
         let model_effects = scenario.model.get("effects").and_then(Value::as_table);
         for s in &scenario.surfaces {
@@ -645,12 +714,149 @@ impl Scenario {
             })?;
             seen.push(key);
         }
+        if let Some(rp) = scenario.random_physics {
+            scenario.check_random_physics(&rp)?;
+        }
         Ok(scenario)
+    }
+
+    /// Checks `[random_physics]`: finite ranges, inclines and heights in range, and every drawn model value
+    /// accepted by the model crate at both ends of its range, for every surface and effect set shots use.
+    fn check_random_physics(&self, rp: &RandomPhysics) -> Result<(), RenderError> {
+        let invalid = |field: &str, r: Range, reason: &str| RenderError::InvalidValue {
+            origin: self.origin.clone(),
+            field: format!("random_physics.{field}"),
+            value: r.to_string(),
+            reason: reason.to_string(),
+        };
+        let finite = |r: Range| r.lo.is_finite() && r.hi.is_finite() && r.lo <= r.hi;
+        if let Some(r) = rp.drop_height_m
+            && !(finite(r) && r.lo > 0.0 && r.hi <= 10.0)
+        {
+            return Err(invalid("drop_height_m", r, "must lie within (0, 10] m, low ≤ high"));
+        }
+        if let Some(r) = rp.angle_deg
+            && !(finite(r) && r.lo >= -60.0 && r.hi <= 60.0)
+        {
+            return Err(invalid("angle_deg", r, "must lie within ±60°, low ≤ high"));
+        }
+        let base = self.model_spec(&[])?;
+        for (key, effect, _, range, _) in rp.model_keys() {
+            let Some(r) = range else { continue };
+            if !finite(r) {
+                return Err(invalid(key, r, "must be finite with low ≤ high"));
+            }
+            if !base.has_effect(effect) {
+                return Err(invalid(
+                    key,
+                    r,
+                    &format!("the scenario's [model] has no `{effect}` effect to set it on"),
+                ));
+            }
+        }
+        let mut seen: Vec<(Vec<String>, String)> = Vec::new();
+        for s in &self.shots {
+            let key = (s.effects.clone(), s.surface.clone());
+            if seen.contains(&key) {
+                continue;
+            }
+            for end in [0.0, 1.0] {
+                let over: Vec<Override> = rp
+                    .model_keys()
+                    .iter()
+                    .filter_map(|&(_, e, p, r, _)| r.map(|r| (e, p, r.lo + (r.hi - r.lo) * end)))
+                    .collect();
+                let context = || {
+                    format!(
+                        "random_physics at the {} end of its ranges, surface `{}`",
+                        if end == 0.0 { "low" } else { "high" },
+                        s.surface
+                    )
+                };
+                let spec = self
+                    .model_spec_with(&s.effects, &s.surface, &over)
+                    .map_err(|e| match e {
+                        RenderError::Model { origin, source, .. } => RenderError::Model {
+                            origin,
+                            context: context(),
+                            source,
+                        },
+                        other => other,
+                    })?;
+                spec.build(Some(&s.surface)).map_err(|source| RenderError::Model {
+                    origin: self.origin.clone(),
+                    context: context(),
+                    source: Box::new(source),
+                })?;
+            }
+            seen.push(key);
+        }
+        Ok(())
+    }
+
+    /// Shot `index` as rendered: with `[random_physics]`, its drop height and incline drawn from the shot's
+    /// seed.
+    ///
+    /// # Panics
+    /// If `index` is not a shot of the scenario.
+    pub fn shot(&self, index: usize) -> Shot {
+        self.shot_physics(index).0
+    }
+
+    /// Shot `index` as rendered and the model values its random physics replaces.
+    pub(crate) fn shot_physics(&self, index: usize) -> (Shot, Vec<Override>) {
+        let mut shot = self.shots[index].clone();
+        let Some(rp) = &self.random_physics else {
+            return (shot, Vec::new());
+        };
+        let mut rng = Rng::new(derive(derive(self.seed, index as u64), PHYSICS_STREAM));
+        // One draw per key whether or not it is given, so adding a key does not change the others.
+        let (uh, ua) = (rng.uniform(), rng.uniform());
+        if let Some(r) = rp.drop_height_m {
+            shot.drop_height_m = rounded(r, uh, 0.001);
+        }
+        if let Some(r) = rp.angle_deg {
+            shot.angle_deg = rounded(r, ua, 0.1);
+        }
+        let mut over = Vec::new();
+        for (_, effect, param, range, step) in rp.model_keys() {
+            let u = rng.uniform();
+            if let Some(r) = range {
+                over.push((effect, param, rounded(r, u, step)));
+            }
+        }
+        (shot, over)
+    }
+
+    /// The parsed model for a shot on `surface` with the extra effects `effects` switched on and the
+    /// model values `overrides` set for that surface.
+    pub(crate) fn model_spec_with(
+        &self,
+        effects: &[String],
+        surface: &str,
+        overrides: &[Override],
+    ) -> Result<ModelSpec, RenderError> {
+        if overrides.is_empty() {
+            return self.model_spec(effects);
+        }
+        let text = self.model_toml_with(effects, Some((surface, overrides)));
+        ModelSpec::parse(&text, &format!("{} [model]", self.origin)).map_err(|source| RenderError::Model {
+            origin: self.origin.clone(),
+            context: format!(
+                "the model with effects [{}] and random physics on surface `{surface}`",
+                effects.join(", ")
+            ),
+            source: Box::new(source),
+        })
     }
 
     /// The model file (model.toml text) for shots with the extra effects `effects` switched on: `[model]`,
     /// the ball, the chosen `[extra_effects]` and every surface's values for the effects present.
     pub fn model_toml(&self, effects: &[String]) -> String {
+        self.model_toml_with(effects, None)
+    }
+
+    fn model_toml_with(&self, effects: &[String], overrides: Option<(&str, &[Override])>) -> String {
         let mut t = Table::new();
         if let Some(g) = self.model.get("gravity_m_s2") {
             t.insert("gravity_m_s2".into(), g.clone());
@@ -686,6 +892,18 @@ impl Scenario {
                     vals.insert(k.clone(), v.clone());
                 }
             }
+            if let Some((surface, over)) = overrides
+                && surface == s.name
+            {
+                for &(effect, param, value) in over {
+                    let e = vals
+                        .entry(effect.to_string())
+                        .or_insert_with(|| Value::Table(Table::new()));
+                    if let Value::Table(e) = e {
+                        e.insert(param.to_string(), Value::Float(value));
+                    }
+                }
+            }
             surfaces.insert(s.name.clone(), Value::Table(vals));
         }
         t.insert("effects".into(), Value::Table(fx));
@@ -715,7 +933,7 @@ impl Scenario {
 
     /// The clip (folder) name of shot `index` (0-based), e.g. `S001_clay_7.5deg_300mm_r1`.
     pub fn clip_name(&self, index: usize) -> String {
-        let s = &self.shots[index];
+        let s = &self.shot(index);
         format!(
             "S{:03}_{}_{}deg_{}mm_r{}",
             index + 1,

@@ -22,12 +22,13 @@ pub struct Frame {
 pub enum Pixels {
     /// 8-bit (0–255).
     Gray8(Vec<u8>),
-    /// 16-bit (0–65535; the 8-bit scale × 257).
+    /// 16-bit: the 8-bit scale × 257 (0–65535), or for 12-bit data the 12-bit value × 16 (low 4 bits zero).
     Gray16(Vec<u16>),
 }
 
 impl Frame {
-    /// The gray level at (x, y) on the 8-bit scale (16-bit frames divided by 257).
+    /// The gray level at (x, y) on the 8-bit scale (16-bit frames divided by 257; 12-bit data in 16-bit
+    /// frames comes out within 0.4 % of it).
     pub fn get(&self, x: u32, y: u32) -> f64 {
         let i = (y * self.width + x) as usize;
         match &self.pixels {
@@ -50,6 +51,44 @@ const RIM: f64 = 0.28;
 /// Brightest albedo of the felt, DN.
 const BALL_ALBEDO: f64 = 228.0;
 
+/// How a sphere is shaded: `ambient + diffuse·max(n·l, 0) + rim·(1 − n_z)²`, times its albedo.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Shading {
+    /// Light reaching every point.
+    pub ambient: f64,
+    /// Lambertian share.
+    pub diffuse: f64,
+    /// Brightening toward the silhouette (felt fibres catching the light, backlight wrapping round).
+    pub rim: f64,
+}
+
+impl Shading {
+    /// The felt ball of scenarios without a look.
+    const CLASSIC: Shading = Shading {
+        ambient: AMBIENT,
+        diffuse: DIFFUSE,
+        rim: RIM,
+    };
+    /// Pure Lambert (metal domes).
+    pub(crate) const LAMBERT: Shading = Shading {
+        ambient: 0.0,
+        diffuse: 1.0,
+        rim: 0.0,
+    };
+}
+
+/// The static layers of a shot: backdrop and band radiance (DN, lighting applied), the band's coverage
+/// (0–1, in front of the ball), the illumination map (vignetting and gradient) and the ball's light and
+/// shading.
+pub(crate) struct Layers {
+    pub back: Vec<f32>,
+    pub band: Vec<f32>,
+    pub front: Vec<f32>,
+    pub vig: Vec<f32>,
+    pub light: [f64; 3],
+    pub shading: Shading,
+}
+
 /// Makes the frames of one shot.
 #[derive(Debug)]
 pub struct ShotRenderer<'a> {
@@ -70,14 +109,17 @@ pub struct ShotRenderer<'a> {
     /// The sensor's fixed pattern (column and row offsets, hot pixels), DN, added after the light.
     fpn: Vec<f32>,
     light: [f64; 3],
+    shading: Shading,
 }
 
-fn hash01(seed: u64, i: i64, j: i64) -> f64 {
+/// A uniform value in [0, 1) from a seed and two lattice indices.
+pub(crate) fn hash01(seed: u64, i: i64, j: i64) -> f64 {
     let h = mix(seed ^ (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ (j as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F));
     (h >> 11) as f64 / (1u64 << 53) as f64
 }
 
-fn ramp(x: f64) -> f64 {
+/// x clamped to [0, 1].
+pub(crate) fn ramp(x: f64) -> f64 {
     x.clamp(0.0, 1.0)
 }
 
@@ -192,6 +234,9 @@ impl<'a> ShotRenderer<'a> {
         let g: Geometry = plan.geom;
         let seed = derive(plan.truth.seed, 0xB4C6);
         let mut rng = Rng::new(seed);
+        if let Some(look) = &plan.look {
+            return ShotRenderer::with_look(plan, look, rng);
+        }
         let tex = SurfaceTex {
             seed: rng.next_u64(),
             kind: plan.texture,
@@ -228,15 +273,47 @@ impl<'a> ShotRenderer<'a> {
                 }
             }
         }
-        let mut r = ShotRenderer {
+        let light = {
+            let l = LIGHT;
+            let n = (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt();
+            [l[0] / n, l[1] / n, l[2] / n]
+        };
+        let mut r = ShotRenderer::assemble(
             plan,
-            w,
-            h,
-            back,
-            band,
-            front,
+            Layers {
+                back,
+                band,
+                front,
+                vig,
+                light,
+                shading: Shading::CLASSIC,
+            },
+        );
+        r.distractors(&mut rng);
+        r.finish(&mut rng, BALL_ALBEDO, true);
+        r
+    }
+
+    /// The static images of a shot with a look (`appearance.rs`).
+    fn with_look(plan: &'a ShotPlan, look: &crate::Look, mut rng: Rng) -> ShotRenderer<'a> {
+        let mut r = ShotRenderer::assemble(plan, crate::appearance::build(plan, look));
+        r.finish(&mut rng, look.ball_dn, look.ball == crate::BallLook::FeltSeam);
+        r
+    }
+
+    /// A renderer over the static layers, with the session's fixed pattern; the ball's texture and the
+    /// noise table come from [`ShotRenderer::finish`].
+    fn assemble(plan: &'a ShotPlan, l: Layers) -> ShotRenderer<'a> {
+        let cam = &plan.camera;
+        ShotRenderer {
+            plan,
+            w: cam.width as usize,
+            h: cam.height as usize,
+            back: l.back,
+            band: l.band,
+            front: l.front,
             stat: Vec::new(),
-            vig,
+            vig: l.vig,
             albedo: Vec::new(),
             amap: 0,
             acen: 0.0,
@@ -244,22 +321,24 @@ impl<'a> ShotRenderer<'a> {
             fuzz_max: 0.0,
             sigma: Vec::new(),
             fpn: fixed_pattern(cam, plan.session_seed),
-            light: {
-                let l = LIGHT;
-                let n = (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt();
-                [l[0] / n, l[1] / n, l[2] / n]
-            },
-        };
-        r.distractors(&mut rng);
-        r.stat = (0..n)
-            .map(|i| r.front[i] * r.band[i] + (1.0 - r.front[i]) * r.back[i])
+            light: l.light,
+            shading: l.shading,
+        }
+    }
+
+    /// The composited static frame, the ball's texture (albedo `albedo` DN, with or without its seam) and
+    /// the noise table.
+    fn finish(&mut self, rng: &mut Rng, albedo: f64, seam: bool) {
+        let n = self.w * self.h;
+        self.stat = (0..n)
+            .map(|i| self.front[i] * self.band[i] + (1.0 - self.front[i]) * self.back[i])
             .collect();
-        r.ball_texture(&mut rng);
+        self.ball_texture(rng, albedo, seam);
+        let cam = &self.plan.camera;
         let (rn, gain) = (cam.read_noise, cam.shot_noise_gain);
-        r.sigma = (0..1400)
+        self.sigma = (0..1400)
             .map(|k| (rn * rn + gain * (k as f64 / 4.0)).sqrt() as f32)
             .collect();
-        r
     }
 
     /// Paints a disc of radius `rad` at (cx, cy) with colour `f(dx, dy)` (DN before vignetting) into the
@@ -362,8 +441,8 @@ impl<'a> ShotRenderer<'a> {
     }
 
     /// The felt's albedo over the visible hemisphere (fixed to the ball: the spin axis is the camera's axis)
-    /// with the seam, and the fuzz of the silhouette.
-    fn ball_texture(&mut self, rng: &mut Rng) {
+    /// with the seam (if `with_seam`), brightest albedo `albedo_dn`, and the fuzz of the silhouette.
+    fn ball_texture(&mut self, rng: &mut Rng, albedo_dn: f64, with_seam: bool) {
         let r = self.plan.truth.r_px;
         let m = 2 * (r + 3.0).ceil() as usize + 1;
         let c = (m / 2) as f64;
@@ -395,7 +474,7 @@ impl<'a> ShotRenderer<'a> {
         let mut dist = vec![f32::INFINITY; m * m];
         let seam_w = 0.035 * r;
         let reach = (2.5 * seam_w).ceil() as i64 + 1;
-        let steps = (24.0 * r).ceil() as usize;
+        let steps = if with_seam { (24.0 * r).ceil() as usize } else { 0 };
         for s in 0..steps {
             let t = TAU * s as f64 / steps as f64;
             let p = rot([
@@ -426,7 +505,7 @@ impl<'a> ShotRenderer<'a> {
                     + 0.07 * (hash01(fseed, i as i64, j as i64) - 0.5);
                 let d = dist[j * m + i] as f64;
                 let seam = 1.0 - 0.4 * (-(d / seam_w).powi(2)).exp();
-                albedo[j * m + i] = (BALL_ALBEDO * felt * seam) as f32;
+                albedo[j * m + i] = (albedo_dn * felt * seam) as f32;
             }
         }
         // Fuzz of the silhouette: harmonics 6–60 (no first harmonic, so no shift of the centre) plus fibres.
@@ -479,7 +558,8 @@ impl<'a> ShotRenderer<'a> {
         let nz = (1.0 - u * u - v * v).max(0.0).sqrt();
         let l = self.light;
         let lam = (u * l[0] + v * l[1] + nz * l[2]).max(0.0);
-        let s = AMBIENT + DIFFUSE * lam + RIM * (1.0 - nz) * (1.0 - nz);
+        let sh = self.shading;
+        let s = sh.ambient + sh.diffuse * lam + sh.rim * (1.0 - nz) * (1.0 - nz);
         let bx = dx * ca - dy * sa;
         let by = dx * sa + dy * ca;
         self.albedo_at(bx + self.acen, by + self.acen) * s
@@ -518,7 +598,8 @@ impl<'a> ShotRenderer<'a> {
         let by1 = ((sy1 + r_out).ceil() + 1.0).clamp(0.0, h as f64) as usize;
         let gauss = gauss_table();
         let mut rng = Rng::new(plan.frame_seed(i));
-        let sixteen = cam.bit_depth == 16;
+        let sixteen = cam.bit_depth != 8;
+        let twelve = cam.bit_depth == 12;
         let mut out8 = if sixteen { Vec::new() } else { vec![0u8; w * h] };
         let mut out16 = if sixteen { vec![0u16; w * h] } else { Vec::new() };
         let mut row = vec![0f32; w];
@@ -571,7 +652,10 @@ impl<'a> ShotRenderer<'a> {
                 let n = gauss[(bits & 0xFFFF) as usize];
                 bits >>= 16;
                 let q = v + self.sigma[li] * n;
-                if sixteen {
+                if twelve {
+                    // 12-bit data shifted into 16-bit words, as 12-bit cameras write them.
+                    out16[base + x] = ((q * (4095.0 / 255.0) + 0.5).clamp(0.0, 4095.0) as u16) << 4;
+                } else if sixteen {
                     out16[base + x] = (q * 257.0 + 0.5).clamp(0.0, 65535.0) as u16;
                 } else {
                     out8[base + x] = (q + 0.5).clamp(0.0, 255.0) as u8;

@@ -103,9 +103,10 @@ pub fn render_with(
         let dir = session_dir.join(&p.truth.clip);
         std::fs::create_dir_all(&dir).map_err(|e| RenderError::write(&dir, e))?;
         let r = p.renderer();
+        let cam = p.camera();
         let write = |i: usize| -> Result<(), RenderError> {
-            let path = dir.join(scenario.camera.frame_name(i));
-            let bytes = encode(&r.frame(i), scenario.camera.format).map_err(|e| RenderError::write(&path, e))?;
+            let path = dir.join(cam.frame_name(i));
+            let bytes = encode(&r.frame(i), cam.format).map_err(|e| RenderError::write(&path, e))?;
             std::fs::write(&path, bytes).map_err(|e| RenderError::write(&path, e))?;
             observer.frame_written();
             Ok(())
@@ -172,6 +173,18 @@ fn num(x: f64) -> String {
     (x + 0.0).to_string()
 }
 
+fn format_name(f: Format) -> &'static str {
+    match f {
+        Format::Png => "png",
+        Format::Tiff => "tiff",
+    }
+}
+
+/// The bits of the files a camera writes (12-bit data comes in 16-bit files).
+fn file_bits(c: &crate::Camera) -> u8 {
+    if c.bit_depth == 8 { 8 } else { 16 }
+}
+
 fn write_session_files(scenario: &Scenario, dir: &Path, plans: &[ShotPlan]) -> Result<(), RenderError> {
     let c = &scenario.camera;
     let desc = if scenario.description.is_empty() {
@@ -179,6 +192,9 @@ fn write_session_files(scenario: &Scenario, dir: &Path, plans: &[ShotPlan]) -> R
     } else {
         scenario.description.clone()
     };
+    if scenario.look.is_some() {
+        return write_look_session_files(scenario, dir, plans, &desc);
+    }
     let text = format!(
         "# Rendered by bouncelab-render {}: a synthetic session. Its ground truth is beside it (../truth), never here.\n\n[session]\ndescription = {}\nsynthetic = true\n\n[ball]\ndiameter_m = {}\nmass_kg = {}\n\n[camera]\nfps = {}\ndownslope = \"{}\"\nexposure_s = {}\nbit_depth = {}\nwidth_px = {}\nheight_px = {}\nformat = \"{}\"\n",
         env!("CARGO_PKG_VERSION"),
@@ -188,7 +204,7 @@ fn write_session_files(scenario: &Scenario, dir: &Path, plans: &[ShotPlan]) -> R
         c.fps,
         c.downslope.as_str(),
         c.exposure_s,
-        c.bit_depth,
+        file_bits(c),
         c.width,
         c.height,
         match c.format {
@@ -198,6 +214,10 @@ fn write_session_files(scenario: &Scenario, dir: &Path, plans: &[ShotPlan]) -> R
     );
     let p = dir.join("session.toml");
     std::fs::write(&p, text).map_err(|e| RenderError::write(&p, e))?;
+    write_clips_csv(dir, plans)
+}
+
+fn write_clips_csv(dir: &Path, plans: &[ShotPlan]) -> Result<(), RenderError> {
     write_csv(
         &dir.join("clips.csv"),
         &["clip", "surface", "angle_deg", "drop_height_m", "repeat"],
@@ -266,6 +286,44 @@ pub const FRAME_COLUMNS: &[&str] = &[
     "delta_m",
 ];
 
+/// `session.toml` with what all clips share, and each clip's own camera in its `clip.toml` (as a lab writes
+/// one per camera set-up): frame size, file bits and format, and the down-slope direction the pipeline needs.
+fn write_look_session_files(
+    scenario: &Scenario,
+    dir: &Path,
+    plans: &[ShotPlan],
+    desc: &str,
+) -> Result<(), RenderError> {
+    let c = &scenario.camera;
+    let text = format!(
+        "# Rendered by bouncelab-render {}: a synthetic session. Its ground truth is beside it (../truth), never here.\n# Each clip's camera (frame size, bits, format, down-slope) is in its clip.toml.\n\n[session]\ndescription = {}\nsynthetic = true\n\n[ball]\ndiameter_m = {}\nmass_kg = {}\n\n[camera]\nfps = {}\nexposure_s = {}\n",
+        env!("CARGO_PKG_VERSION"),
+        toml::Value::String(desc.to_string()),
+        scenario.ball.diameter_m,
+        scenario.ball.mass_kg,
+        c.fps,
+        c.exposure_s,
+    );
+    let p = dir.join("session.toml");
+    std::fs::write(&p, text).map_err(|e| RenderError::write(&p, e))?;
+    for plan in plans {
+        let c = plan.camera();
+        let clip_dir = dir.join(&plan.truth.clip);
+        std::fs::create_dir_all(&clip_dir).map_err(|e| RenderError::write(&clip_dir, e))?;
+        let text = format!(
+            "[camera]\ndownslope = \"{}\"\nbit_depth = {}\nwidth_px = {}\nheight_px = {}\nformat = \"{}\"\n",
+            c.downslope.as_str(),
+            file_bits(c),
+            c.width,
+            c.height,
+            format_name(c.format),
+        );
+        let p = clip_dir.join("clip.toml");
+        std::fs::write(&p, text).map_err(|e| RenderError::write(&p, e))?;
+    }
+    write_clips_csv(dir, plans)
+}
+
 fn write_truth_files(scenario: &Scenario, dir: &Path, plans: &[ShotPlan]) -> Result<(), RenderError> {
     let opt = |v: Option<f64>| v.map(num).unwrap_or_default();
     write_csv(&dir.join("shots.csv"), SHOTS_COLUMNS, plans.iter(), |p| {
@@ -329,6 +387,14 @@ fn write_truth_files(scenario: &Scenario, dir: &Path, plans: &[ShotPlan]) -> Res
                     num(f.delta_m),
                 ]
             },
+        )?;
+    }
+    if scenario.look.is_some() {
+        write_csv(
+            &dir.join("looks.csv"),
+            crate::LOOK_COLUMNS,
+            plans.iter().filter_map(|p| p.look.as_ref().map(|l| (p, l))),
+            |(p, l)| l.row(&p.truth.clip),
         )?;
     }
     let p = dir.join("scenario.toml");

@@ -1,6 +1,7 @@
 //! One shot: its physics (the model simulated at the frame and sub-exposure times), the camera placement,
 //! and the exact truth per frame and per shot.
 
+use crate::look::{Look, PathExtent, Placement};
 use crate::rng::{Rng, derive};
 use crate::{RenderError, Scenario};
 use bouncelab_model::{Phase, SimOptions, simulate_drop};
@@ -152,6 +153,14 @@ impl Geometry {
         let yc = self.ty - py;
         (self.cos * xc - self.sin * yc, self.sin * xc + self.cos * yc)
     }
+
+    /// The image point of local pixel coordinates (along the surface, height above it): the inverse of
+    /// [`Geometry::to_local_px`].
+    pub fn local_px_to_image(self, s: f64, up: f64) -> (f64, f64) {
+        let xc = self.cos * s + self.sin * up;
+        let yc = -self.sin * s + self.cos * up;
+        (self.tx + self.dir * xc, self.ty - yc)
+    }
 }
 
 /// A planned shot: physics done, camera placed, truth known; images not yet made
@@ -164,6 +173,8 @@ pub struct ShotPlan {
     pub truth: ShotTruth,
     /// The truth of every frame.
     pub frames: Vec<FrameTruth>,
+    /// The shot's drawn look, if the scenario has a `[look]` (its truth, written to `truth/looks.csv`).
+    pub look: Option<Look>,
     pub(crate) camera: crate::Camera,
     pub(crate) texture: crate::Texture,
     pub(crate) geom: Geometry,
@@ -181,36 +192,55 @@ pub struct ShotPlan {
 /// Shots at most this far (s) from the release cannot start earlier.
 const MIN_T0: f64 = 1e-4;
 
+/// Stream of a shot's look, derived from the shot's seed (far from the frames' streams 1, 2, …).
+const LOOK_STREAM: u64 = 0x4C4F_4F4B_5354_524D;
+
 impl ShotPlan {
     /// Simulates shot `index` of `scenario` and places the camera.
     ///
     /// Placement (per shot): the ball's whole path over the clip is centred horizontally (plus a random
     /// shift of up to ±30 px where there is room) and the surface line's origin sits at 78 % of the frame
-    /// height, moved down (to at most 94 %) when the path would otherwise leave the top of the frame.
+    /// height (a look draws it from 62–85 %), moved down (to at most 94 %) when the path would otherwise
+    /// leave the top of the frame. A look's frame grows (then its ball shrinks) within the `[look]` ranges
+    /// until the path fits.
     pub fn new(scenario: &Scenario, index: usize) -> Result<ShotPlan, RenderError> {
-        let shot = scenario.shots.get(index).ok_or_else(|| RenderError::InvalidValue {
-            origin: scenario.origin.clone(),
-            field: "shots".into(),
-            value: index.to_string(),
-            reason: format!("no shot with that index (there are {})", scenario.shots.len()),
-        })?;
+        if index >= scenario.shots.len() {
+            return Err(RenderError::InvalidValue {
+                origin: scenario.origin.clone(),
+                field: "shots".into(),
+                value: index.to_string(),
+                reason: format!("no shot with that index (there are {})", scenario.shots.len()),
+            });
+        }
+        let (shot, overrides) = scenario.shot_physics(index);
+        let shot = &shot;
         let clip = scenario.clip_name(index);
         let model_err = |source: bouncelab_model::ModelError| RenderError::Model {
             origin: scenario.origin.clone(),
             context: format!("shot {clip}"),
             source: Box::new(source),
         };
-        let spec = scenario.model_spec(&shot.effects)?;
+        let spec = scenario.model_spec_with(&shot.effects, &shot.surface, &overrides)?;
         let model = spec.build(Some(&shot.surface)).map_err(model_err)?;
         let settings = spec.settings(Some(&shot.surface)).map_err(model_err)?;
-        let cam = scenario.camera.clone();
+        let texture = scenario
+            .surface(&shot.surface)
+            .map(|s| s.texture)
+            .unwrap_or(crate::Texture::Clay);
+        let seed = derive(scenario.seed, index as u64);
+        let r_m = scenario.ball.diameter_m / 2.0;
+        let mut look_rng = Rng::new(derive(seed, LOOK_STREAM));
+        let mut look = scenario.look.as_ref().map(|l| l.draw(&mut look_rng, texture));
+        let mut cam = scenario.camera.clone();
+        if let Some(l) = &look {
+            l.apply_to(&mut cam, r_m);
+        }
         let beta = shot.angle_deg.to_radians();
         let opts = SimOptions::default();
         let impact = simulate_drop(&model, beta, shot.drop_height_m, &[], &opts)
             .map_err(model_err)?
             .impact;
 
-        let seed = derive(scenario.seed, index as u64);
         let mut rng = Rng::new(seed);
         let dt = 1.0 / cam.fps;
         let half = cam.exposure_s / 2.0;
@@ -230,9 +260,31 @@ impl ShotPlan {
         let roll_deg = cam.roll_deg + roll_effect;
         let phi = roll_deg.to_radians();
         let dir = cam.downslope.sign();
+        if let (Some(l), Some(spec)) = (&mut look, &scenario.look) {
+            // The path's extent in the rolled frame, metres: the frame must hold it at the look's scale.
+            let (c, s) = (phi.cos(), phi.sin());
+            let (mut xmin, mut xmax, mut top) = (f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY);
+            for smp in sim_sub.samples.iter().chain(&sim_mid.samples) {
+                let xc = c * smp.state.x + s * smp.state.y;
+                let yc = -s * smp.state.x + c * smp.state.y;
+                xmin = xmin.min(xc);
+                xmax = xmax.max(xc);
+                top = top.max(yc + r_m);
+            }
+            l.fit_frame(
+                spec,
+                PathExtent {
+                    width_m: xmax - xmin,
+                    top_m: top,
+                },
+                r_m,
+            );
+            cam.width = l.width_px;
+            cam.height = l.height_px;
+            cam.scale_m_per_px = r_m / l.ball_radius_px;
+        }
         let theta0 = rng.range(0.0, std::f64::consts::TAU);
         let scale = cam.scale_m_per_px;
-        let r_m = scenario.ball.diameter_m / 2.0;
         let r_px = r_m / scale;
         let mut geom = Geometry {
             scale,
@@ -261,7 +313,7 @@ impl ShotPlan {
         }
         let room = ((w - (xmax - xmin)) / 2.0 - 8.0).clamp(0.0, 30.0);
         geom.tx = (w - 1.0) / 2.0 - (xmin + xmax) / 2.0 + rng.range(-room, room);
-        geom.ty = 0.78 * h;
+        geom.ty = look.as_ref().map_or(0.78, |l| l.draft.line_frac) * h;
         if ymin + geom.ty < 6.0 {
             geom.ty = (6.0 - ymin).min(0.94 * h);
         }
@@ -355,14 +407,39 @@ impl ShotPlan {
             effects_json: serde_json::Value::Object(effects).to_string(),
             extra_effects: shot.effects.clone(),
         };
-        let texture = scenario
-            .surface(&shot.surface)
-            .map(|s| s.texture)
-            .unwrap_or(crate::Texture::Clay);
+        if let Some(l) = &mut look {
+            let mut contact: Vec<(f64, f64)> = frames
+                .iter()
+                .filter(|f| f.phase != Phase::Flight)
+                .map(|f| (f.x_px, f.y_px))
+                .collect();
+            if contact.is_empty() {
+                // Contact shorter than a frame: the frame nearest the touch.
+                let t = impact.t_touch - t0;
+                if let Some(f) = frames
+                    .iter()
+                    .min_by(|a, b| (a.t_s - t).abs().total_cmp(&(b.t_s - t).abs()))
+                {
+                    contact.push((f.x_px, f.y_px));
+                }
+            }
+            l.place(
+                &mut look_rng,
+                &Placement {
+                    geom,
+                    width: w,
+                    height: h,
+                    r_px,
+                    path: &subs,
+                    contact: &contact,
+                },
+            );
+        }
         Ok(ShotPlan {
             index,
             truth,
             frames,
+            look,
             camera: cam,
             texture,
             geom,
@@ -372,6 +449,12 @@ impl ShotPlan {
             flicker_phase: rng.range(0.0, std::f64::consts::TAU),
             session_seed: scenario.seed,
         })
+    }
+
+    /// The camera of this shot: the scenario's, with a look's frame size, scale, roll, down-slope, noise,
+    /// vignetting, bits, format and naming.
+    pub fn camera(&self) -> &crate::Camera {
+        &self.camera
     }
 
     /// The seed of frame `frame`'s noise.

@@ -6,44 +6,11 @@ use bouncelab_model::{Phase, SimOptions, simulate_drop};
 use bouncelab_render::*;
 use testutil::*;
 
-fn render_to(s: &Scenario, dir: &std::path::Path, parallel: bool) -> Rendered {
-    let opts = RenderOptions {
-        parallel,
-        overwrite: false,
-    };
-    render_with(s, dir, &opts, &Silent).unwrap()
-}
-
 #[test]
 fn same_seed_is_byte_identical_and_parallel_equals_sequential() {
     let s = Scenario::parse(&tiny(7), "tiny").unwrap();
-    let (a, b, c) = (
-        tempfile::tempdir().unwrap(),
-        tempfile::tempdir().unwrap(),
-        tempfile::tempdir().unwrap(),
-    );
-    render_to(&s, a.path(), false);
-    render_to(&s, b.path(), false);
-    render_to(&s, c.path(), true);
-    let fa = files(a.path());
-    assert_eq!(fa, files(b.path()));
-    assert_eq!(fa, files(c.path()));
-    assert!(fa.len() > 50);
-    for f in &fa {
-        let x = std::fs::read(a.path().join(f)).unwrap();
-        assert_eq!(
-            x,
-            std::fs::read(b.path().join(f)).unwrap(),
-            "{} differs between runs",
-            f.display()
-        );
-        assert_eq!(
-            x,
-            std::fs::read(c.path().join(f)).unwrap(),
-            "{} differs sequential vs parallel",
-            f.display()
-        );
-    }
+    let n = assert_renders_identically(&s);
+    assert!(n > 50, "{n} files");
 }
 
 #[test]
@@ -62,92 +29,6 @@ fn different_seeds_give_different_noise() {
     assert!(differing > a.len() / 2, "only {differing} pixels differ");
     // The physics does not depend on the seed.
     assert_eq!(p1.truth.cor, p2.truth.cor);
-}
-
-/// Bilinear sample of the frame.
-fn sample(f: &Frame, x: f64, y: f64) -> f64 {
-    let (x0, y0) = (x.floor(), y.floor());
-    let (fx, fy) = (x - x0, y - y0);
-    let (i, j) = (x0 as u32, y0 as u32);
-    let g = |a, b| f.get(a, b);
-    (g(i, j) * (1.0 - fx) + g(i + 1, j) * fx) * (1.0 - fy) + (g(i, j + 1) * (1.0 - fx) + g(i + 1, j + 1) * fx) * fy
-}
-
-/// Brute-force circle fit: along 360 rays from a start centre, the strongest edge (largest gradient of a
-/// lightly smoothed profile) near the start radius, refined by a parabola; then an algebraic least-squares
-/// circle fit with one round of outlier rejection.
-#[allow(clippy::needless_range_loop)] // a small dense Gauss–Jordan solve
-fn fit_circle(f: &Frame, cx: f64, cy: f64, r: f64) -> (f64, f64, f64) {
-    let mut pts = Vec::new();
-    for a in 0..360 {
-        let t = (a as f64).to_radians();
-        let (c, s) = (t.cos(), t.sin());
-        let prof: Vec<f64> = (0..=64)
-            .map(|k| {
-                let rr = r - 4.0 + k as f64 * 0.125;
-                let mut acc = 0.0;
-                for o in [-0.5, 0.0, 0.5] {
-                    acc += sample(f, cx + rr * c - o * s, cy + rr * s + o * c);
-                }
-                acc / 3.0
-            })
-            .collect();
-        let grad: Vec<f64> = (0..prof.len())
-            .map(|k| {
-                if k < 4 || k + 4 >= prof.len() {
-                    0.0
-                } else {
-                    (prof[k + 4] - prof[k - 4]).abs()
-                }
-            })
-            .collect();
-        let (kmax, _) = grad
-            .iter()
-            .enumerate()
-            .fold((0, 0.0), |b, (k, &g)| if g > b.1 { (k, g) } else { b });
-        if kmax < 5 || kmax + 5 > grad.len() {
-            continue;
-        }
-        let (gm, g0, gp) = (grad[kmax - 1], grad[kmax], grad[kmax + 1]);
-        let off = 0.5 * (gm - gp) / (gm - 2.0 * g0 + gp);
-        let rr = r - 4.0 + (kmax as f64 + off.clamp(-1.0, 1.0)) * 0.125;
-        pts.push((cx + rr * c, cy + rr * s));
-    }
-    let kasa = |p: &[(f64, f64)]| {
-        // Solve for x² + y² + D x + E y + F = 0.
-        let mut m = [[0.0f64; 4]; 3];
-        for &(x, y) in p {
-            let row = [x, y, 1.0, -(x * x + y * y)];
-            for i in 0..3 {
-                for j in 0..4 {
-                    m[i][j] += row[i] * row[j];
-                }
-            }
-        }
-        for i in 0..3 {
-            let piv = m[i][i];
-            for j in 0..4 {
-                m[i][j] /= piv;
-            }
-            for k in 0..3 {
-                if k != i {
-                    let fct = m[k][i];
-                    for j in 0..4 {
-                        m[k][j] -= fct * m[i][j];
-                    }
-                }
-            }
-        }
-        let (d, e, ff) = (m[0][3], m[1][3], m[2][3]);
-        let (x0, y0) = (-d / 2.0, -e / 2.0);
-        (x0, y0, (x0 * x0 + y0 * y0 - ff).sqrt())
-    };
-    let first = kasa(&pts);
-    let kept: Vec<_> = pts
-        .into_iter()
-        .filter(|&(x, y)| ((x - first.0).hypot(y - first.1) - first.2).abs() < 1.0)
-        .collect();
-    kasa(&kept)
 }
 
 #[test]
@@ -310,8 +191,8 @@ fn scenario_errors_are_clear() {
     assert!(e.contains("unknown effect `hurtz`"), "{e}");
     let e = err(&base.replace("[camera]\n", "[camera]\nfps = -5\n"));
     assert!(e.contains("camera.fps = -5"), "{e}");
-    let e = err(&base.replace("[camera]\n", "[camera]\nbit_depth = 12\n"));
-    assert!(e.contains("camera.bit_depth = 12"), "{e}");
+    let e = err(&base.replace("[camera]\n", "[camera]\nbit_depth = 10\n"));
+    assert!(e.contains("camera.bit_depth = 10") && e.contains("8, 12"), "{e}");
     let e = err(&base.replace("[camera]\n", "[camera]\nfsp = 10\n"));
     assert!(e.contains("fsp"), "{e}");
     let e = err(&base.replace("spring.k = 25650", "spring.k = -3"));
@@ -337,6 +218,8 @@ fn presets_parse_with_the_promised_shots() {
         match name.as_str() {
             "smoke" => assert_eq!(n, 3),
             "paper" => assert_eq!(n, 144),
+            "looks" => assert_eq!(n, 64),
+            "looks-smoke" => assert_eq!(n, 6),
             _ => assert!((12..=24).contains(&n), "{name}: {n} shots"),
         }
     }

@@ -84,21 +84,43 @@ pub enum ClipFingerprint {
     Content,
 }
 
-/// The fingerprint of a clip folder and the settings that shape its analysis.
+/// The fingerprint of a clip (a folder of frames or one camera file) and the settings that shape its
+/// analysis.
 ///
-/// Definition: for every regular file directly inside `dir` (frames and `clip.toml` alike), in byte order of
-/// the file names: the name, the length and either the modification time in nanoseconds since the Unix epoch
-/// ([`ClipFingerprint::Metadata`]) or the file's bytes ([`ClipFingerprint::Content`]); then `settings`, a text
-/// the caller builds from everything else that changes the track (fps, downslope, ball diameter, tracker
-/// options, program version …). Subfolders are ignored.
+/// Definition: the clip's files are every regular file directly inside `dir` (frames and `clip.toml` alike)
+/// or, when `dir` is a camera file `NAME.EXT`, every regular file beside it whose name starts with `NAME.`
+/// (`shot1.cihx` with its `shot1.mraw` and `shot1.clip.toml`). For each, in byte order of the file names: the
+/// name, the length and either the modification time in nanoseconds since the Unix epoch
+/// ([`ClipFingerprint::Metadata`]) or the file's bytes, read in chunks ([`ClipFingerprint::Content`]); then
+/// `settings`, a text the caller builds from everything else that changes the track (fps, downslope, ball
+/// diameter, tracker options, program version …). Subfolders are ignored.
 pub fn fingerprint_clip_dir(dir: &Path, settings: &str, mode: ClipFingerprint) -> Result<String> {
     let io = |path: &Path| {
         let path = path.to_path_buf();
         move |source| StoreError::Io { path, source }
     };
+    let (folder, prefix) = if dir.is_file() {
+        let stem = dir
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        (dir.parent().unwrap_or(Path::new(".")), Some(format!("{stem}.")))
+    } else {
+        (dir, None)
+    };
+    let folder = if folder.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        folder
+    };
     let mut files = Vec::new();
-    for entry in fs::read_dir(dir).map_err(io(dir))? {
+    for entry in fs::read_dir(folder).map_err(io(dir))? {
         let entry = entry.map_err(io(dir))?;
+        if let Some(prefix) = &prefix {
+            if !entry.file_name().as_encoded_bytes().starts_with(prefix.as_bytes()) {
+                continue;
+            }
+        }
         let meta = entry.metadata().map_err(io(&entry.path()))?;
         if meta.is_file() {
             files.push((entry.file_name(), entry.path(), meta));
@@ -123,8 +145,19 @@ pub fn fingerprint_clip_dir(dir: &Path, settings: &str, mode: ClipFingerprint) -
                 fp.bytes(&nanos.to_le_bytes());
             }
             ClipFingerprint::Content => {
-                let bytes = fs::read(path).map_err(io(path))?;
-                fp.bytes(&bytes);
+                // In chunks: a camera file may be many gigabytes.
+                use std::io::Read;
+                let mut file = fs::File::open(path).map_err(io(path))?;
+                let mut buf = vec![0u8; 1 << 20];
+                fp.raw(b"b");
+                fp.raw(&meta.len().to_le_bytes());
+                loop {
+                    let n = file.read(&mut buf).map_err(io(path))?;
+                    if n == 0 {
+                        break;
+                    }
+                    fp.raw(&buf[..n]);
+                }
             }
         }
     }
@@ -143,6 +176,30 @@ mod tests {
         assert_ne!(a, b);
         assert_eq!(a.len(), 32);
         assert_eq!(a, Fingerprint::new().str("ab").str("c").finish());
+    }
+
+    #[test]
+    fn a_camera_file_clip_covers_its_same_named_siblings_only() {
+        let dir = std::env::temp_dir().join(format!("bouncelab-fp-{}", std::process::id()));
+        fs::create_dir_all(&dir).unwrap();
+        let write = |name: &str, bytes: &[u8]| fs::write(dir.join(name), bytes).unwrap();
+        write("shot1.cihx", b"<cih/>");
+        write("shot1.mraw", &[1, 2, 3, 4]);
+        write("shot2.cine", b"CI");
+        for mode in [ClipFingerprint::Metadata, ClipFingerprint::Content] {
+            let fp = || fingerprint_clip_dir(&dir.join("shot1.cihx"), "s", mode).unwrap();
+            let before = fp();
+            write("shot2.cine", b"CI..");
+            assert_eq!(before, fp(), "another clip's file does not count");
+            write("shot1.mraw", &[1, 2, 3, 4, 5]);
+            assert_ne!(before, fp(), "the data file counts");
+            let with_data = fp();
+            write("shot1.clip.toml", b"[camera]\nfps = 1000\n");
+            assert_ne!(with_data, fp(), "the clip's settings file counts");
+            fs::remove_file(dir.join("shot1.clip.toml")).unwrap();
+            write("shot1.mraw", &[1, 2, 3, 4]);
+        }
+        fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

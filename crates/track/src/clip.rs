@@ -7,6 +7,7 @@
 //! between two frames.
 
 use crate::hough::CircleDetection;
+use crate::local::SurfaceFrame;
 use crate::plane::{Pixel, Plane};
 use crate::refine::refined_candidates;
 use crate::surface::SurfaceLine;
@@ -29,6 +30,11 @@ pub enum TrackError {
         min_radius: f64,
         max_radius: f64,
     },
+    /// Round things were seen but none moved: static objects are never taken for the ball.
+    #[error(
+        "{clip}: no moving ball: the circles seen ({circles}) stay where they are between frames, so none is a ball in flight (give the scale if the ball is in view but not found)"
+    )]
+    NothingMoves { clip: String, circles: String },
 }
 
 /// Options of [`track_clip`].
@@ -105,8 +111,11 @@ pub struct TrajectoryRow {
 pub struct Track {
     /// One fix per decoded frame, in order.
     pub fixes: Vec<BallFix>,
-    /// The surface line, if found.
+    /// The surface line: found by one of its cues, or given by the user; `None` when neither.
     pub surface: Option<SurfaceLine>,
+    /// The other candidate lines below the ball, topmost first (the estimator chooses by the ball's
+    /// trajectory).
+    pub surface_alternatives: Vec<SurfaceLine>,
     /// The scale, if the ball was measured in free flight.
     pub scale: Option<Scale>,
     /// Things a person should know, each naming its frame.
@@ -120,29 +129,36 @@ pub struct Track {
 }
 
 impl Track {
-    /// The rows of `trajectories/<clip>.csv`: pixels, and the local frame where the scale is known. The
-    /// local frame's axes follow the image (the camera is taken as aligned with the surface, as in the
-    /// paper; the surface line's tilt, reported separately, says how far that holds); its origin is on the
-    /// surface line below the lowest measured centre.
+    /// The local frame on the surface line (origin at the foot of the perpendicular from the lowest measured
+    /// centre, axes along the line and its normal), when both the line and the scale are known.
+    pub fn surface_frame(&self) -> Option<SurfaceFrame> {
+        let (line, scale) = (self.surface.as_ref()?, self.scale.as_ref()?);
+        let lowest = self.fixes.iter().filter(|f| f.status.measured()).min_by(|a, b| {
+            line.height_of(a.x_px, a.y_px)
+                .total_cmp(&line.height_of(b.x_px, b.y_px))
+        })?;
+        Some(SurfaceFrame::on_line(
+            line,
+            lowest.x_px,
+            lowest.y_px,
+            self.downslope_negative_x,
+            scale.m_per_px,
+        ))
+    }
+
+    /// The rows of `trajectories/<clip>.csv` in the frame on the surface line ([`Track::surface_frame`]).
     pub fn rows(&self) -> Vec<TrajectoryRow> {
-        let lowest = self
-            .fixes
-            .iter()
-            .filter(|f| f.status.measured())
-            .max_by(|a, b| a.y_px.total_cmp(&b.y_px))
-            .map(|f| f.x_px);
-        let origin = match (lowest, &self.surface) {
-            (Some(x), Some(line)) => Some((x, line.y_at(x))),
-            _ => None,
-        };
-        let sign = if self.downslope_negative_x { -1.0 } else { 1.0 };
+        self.rows_in(self.surface_frame().as_ref())
+    }
+
+    /// The rows of `trajectories/<clip>.csv`: pixels, and the local frame `frame` where given (NaN metres
+    /// otherwise and in frames where the ball was not measured).
+    pub fn rows_in(&self, frame: Option<&SurfaceFrame>) -> Vec<TrajectoryRow> {
         self.fixes
             .iter()
             .map(|f| {
-                let (x_m, y_m) = match (origin, &self.scale) {
-                    (Some((x0, y0)), Some(s)) if f.status.measured() => {
-                        (sign * (f.x_px - x0) * s.m_per_px, (y0 - f.y_px) * s.m_per_px)
-                    }
+                let (x_m, y_m) = match frame {
+                    Some(fr) if f.status.measured() => fr.to_local(f.x_px, f.y_px),
                     _ => (f64::NAN, f64::NAN),
                 };
                 TrajectoryRow {
@@ -162,11 +178,11 @@ impl Track {
     }
 }
 
-fn with_plane<R>(px: &GrayPixels, f: impl FnOnce(PlaneRef<'_>) -> R) -> R {
+fn with_plane<R>(px: &GrayPixels, gain: f32, f: impl FnOnce(PlaneRef<'_>) -> R) -> R {
     let (w, h) = (px.width() as usize, px.height() as usize);
     match px {
-        GrayPixels::U8(img) => f(PlaneRef::U8(Plane::new(img.as_raw(), w, h))),
-        GrayPixels::U16(img) => f(PlaneRef::U16(Plane::new(img.as_raw(), w, h))),
+        GrayPixels::U8(img) => f(PlaneRef::U8(Plane::new(img.as_raw(), w, h).with_gain(gain))),
+        GrayPixels::U16(img) => f(PlaneRef::U16(Plane::new(img.as_raw(), w, h).with_gain(gain))),
     }
 }
 
@@ -188,32 +204,38 @@ macro_rules! on_plane {
 /// The ball seen at (t, x, y): s, px, px.
 type Sighting = (f64, f64, f64);
 
-/// What acquisition learnt: the ball's radius range in px, and two positions (t, x, y) if it moved.
+/// What acquisition learnt: the ball's radius range in px, and two positions (t, x, y).
 struct Acquired {
     radius: (f64, f64),
-    seed: Option<(Sighting, Sighting)>,
+    seed: (Sighting, Sighting),
 }
 
-/// The least quality of a circle that acquisition considers (the clearest such circle is tracked when none
-/// is seen to move); a ball in free flight refines to near 1.
-const FALLBACK_QUALITY: f64 = 0.6;
+/// The smallest ball radius searched without a scale, px: below it a ball's rim has too few pixels for a
+/// sub-pixel circle.
+pub const MIN_BALL_RADIUS_PX: f64 = 8.0;
 
-/// The ball's radius range in px, told from other circles by its motion between two frames.
-fn acquire(clip: &Clip, opts: &ClipTracking, warnings: &mut Vec<String>) -> Result<Option<Acquired>, TrackError> {
-    if let Some(scale) = opts.scale_hint_m_per_px {
-        let r = opts.ball_diameter_m / (2.0 * scale);
-        return Ok(Some(Acquired {
-            radius: (0.8 * r, 1.2 * r),
-            seed: None,
-        }));
-    }
+/// The least quality of a circle that acquisition considers.
+const CANDIDATE_QUALITY: f64 = 0.6;
+
+/// The ball's radius range in px and two sightings, told from other circles by its motion between two
+/// frames: the clean circle that moved. A circle that does not move (a screw head, a mark, a fixture, a ball
+/// at rest) is never taken for the ball; when nothing moves, the error lists the static circles seen. With a
+/// scale hint only radii within ±20 % of the ball's are searched.
+fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32) -> Result<Acquired, TrackError> {
     let n = clip.len();
     let (w, h) = clip.dimensions();
-    let (min_radius, max_radius) = (8.0, w.min(h) as f64 / 2.0);
+    let (min_radius, max_radius) = match opts.scale_hint_m_per_px {
+        Some(scale) => {
+            let r = opts.ball_diameter_m / (2.0 * scale);
+            (0.8 * r, 1.2 * r)
+        }
+        None => (MIN_BALL_RADIUS_PX, w.min(h) as f64 / 2.0),
+    };
     let read = |k: usize| clip.read(k, opts.read.png_decoder).expect("index in range");
     let gap = 10.min(n.saturating_sub(1)).max(1);
     let mut k = 0;
-    let mut fallback = None;
+    // The clearest circles that did not move, for the error: (x, y, r).
+    let mut still: Vec<(f64, f64, f64, f64)> = Vec::new();
     while k + gap < n && k <= n / 2 {
         let (frame_a, frame_b) = (read(k)?, read(k + gap)?);
         // An octave of radii at a time, largest first: the large bands are searched on coarse images and
@@ -231,7 +253,8 @@ fn acquire(clip: &Clip, opts: &ClipTracking, warnings: &mut Vec<String>) -> Resu
             let circles_in = |frame: &bouncelab_frames::Frame| -> Vec<crate::Circle> {
                 let found = with_plane(
                     &frame.pixels,
-                    |p| on_plane!(p, p => refined_candidates(&p, &det, &opts.tracker.search, None, FALLBACK_QUALITY)),
+                    gain,
+                    |p| on_plane!(p, p => refined_candidates(&p, &det, &opts.tracker.search, None, CANDIDATE_QUALITY)),
                 );
                 found.into_iter().map(|(c, _)| c).collect()
             };
@@ -259,31 +282,37 @@ fn acquire(clip: &Clip, opts: &ClipTracking, warnings: &mut Vec<String>) -> Resu
                 // `k` counts files; time follows frame indices, which count dropped frames too.
                 let t = |pos: usize| clip.time_of(clip.files()[pos].index);
                 let seed = ((t(k), ca.x, ca.y), (t(k + gap), cb.x, cb.y));
-                return Ok(Some(Acquired {
+                return Ok(Acquired {
                     radius: (0.85 * r, 1.15 * r),
-                    seed: Some(seed),
-                }));
+                    seed,
+                });
             }
-            // The clearest circle seen in any band, should none move.
-            if let Some(c) = a.iter().max_by(|p, q| p.support.total_cmp(&q.support))
-                && c.support > FALLBACK_QUALITY
-                && fallback.is_none_or(|f: crate::Circle| c.support > f.support)
-            {
-                fallback = Some(*c);
+            for c in a.iter().filter(good) {
+                if !still.iter().any(|s| (s.0 - c.x).hypot(s.1 - c.y) < 0.5 * c.r) {
+                    still.push((c.x, c.y, c.r, c.support));
+                }
             }
         }
         k += gap;
     }
-    if let Some(r) = fallback.map(|c| c.r) {
-        warnings.push(format!(
-            "could not tell the ball by its motion; tracking the clearest circle (radius {r:.1} px) — give the scale to be sure"
-        ));
-        return Ok(Some(Acquired {
-            radius: (0.85 * r, 1.15 * r),
-            seed: None,
-        }));
+    still.sort_by(|p, q| q.3.total_cmp(&p.3));
+    let clip_name = clip.dir().display().to_string();
+    if still.is_empty() {
+        return Err(TrackError::NoBall {
+            clip: clip_name,
+            min_radius,
+            max_radius,
+        });
     }
-    Ok(None)
+    Err(TrackError::NothingMoves {
+        clip: clip_name,
+        circles: still
+            .iter()
+            .take(3)
+            .map(|c| format!("radius {:.1} px at ({:.0}, {:.0})", c.2, c.0, c.1))
+            .collect::<Vec<_>>()
+            .join(", "),
+    })
 }
 
 /// Tracks the ball through `clip`. `progress` is called with (frames done, frames total).
@@ -295,25 +324,25 @@ pub fn track_clip(
     let mut warnings = Vec::new();
     // The stream starts decoding at once, so its first frames are ready when acquisition is done.
     let frames = clip.frames_with(&opts.read)?;
-    let acquired = acquire(clip, opts, &mut warnings)?;
-    let Some(Acquired { radius, seed }) = acquired else {
-        let (w, h) = clip.dimensions();
-        return Err(TrackError::NoBall {
-            clip: clip.dir().display().to_string(),
-            min_radius: 8.0,
-            max_radius: w.min(h) as f64 / 2.0,
-        });
+    let gain = match clip.read(0, opts.read.png_decoder) {
+        Some(first) => with_plane(&first?.pixels, 1.0, |p| on_plane!(p, p => crate::plane::level_gain(&p))),
+        None => 1.0,
     };
+    if gain >= 2.0 {
+        warnings.push(format!(
+            "the frames use little of their gray scale: levels stretched {gain:.1}× for the ball and line searches"
+        ));
+    }
+    let Acquired { radius, seed } = acquire(clip, opts, gain)?;
     let mut tracker = Tracker::new(TrackOptions {
         radius_px: Some(radius),
         ..opts.tracker.clone()
     });
-    if let Some((a, b)) = seed {
-        tracker.seed(a, b);
-    }
+    tracker.seed(seed.0, seed.1);
     let (fixes, waiting, tracking) = stream_fixes(frames, clip.len(), &mut progress, |frame| {
         with_plane(
             &frame.pixels,
+            gain,
             |p| on_plane!(p, p => observe(&mut tracker, frame.index as usize, frame.t_s, &p)),
         )
     })?;
@@ -330,6 +359,7 @@ pub fn track_clip(
         let image = clip.read(k, opts.read.png_decoder).expect("index in range")?;
         Ok(with_plane(
             &image.pixels,
+            gain,
             |p| on_plane!(p, p => observe(tr, frame, t_back, &p)),
         ))
     })?;
@@ -371,6 +401,7 @@ pub fn track_clip(
     Ok(Track {
         fixes,
         surface: tracker.surface().copied(),
+        surface_alternatives: tracker.surface_alternatives().to_vec(),
         scale,
         warnings,
         seconds_waiting: waiting,

@@ -13,19 +13,23 @@
 mod clip;
 mod fit;
 mod hough;
+mod local;
 #[cfg(feature = "opencv")]
 pub mod opencv;
 mod plane;
 mod refine;
 mod surface;
+mod texture;
 mod tracker;
 
 pub use clip::{ClipTracking, Scale, Track, TrackError, TrajectoryRow, track_clip};
 pub use fit::{CircleFit, fit_circle};
 pub use hough::{Circle, CircleDetection, detect_circles, outermost, radius_bands};
+pub use local::SurfaceFrame;
 pub use plane::{Pixel, Plane};
 pub use refine::{EdgeSearch, Refined, RimShape, RimShapeLearner, refine_circle, refined_candidates, rim_residuals};
-pub use surface::{SurfaceLine, find_surface_line};
+pub use surface::{LineCue, SurfaceLine, SurfaceLines, find_surface_line, find_surface_lines};
+pub use texture::{horizontal_gradient_energy, texture_line, texture_lines};
 pub use tracker::{BallFix, Status, TrackOptions, Tracker};
 
 #[doc(hidden)]

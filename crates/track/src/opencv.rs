@@ -397,6 +397,7 @@ pub fn track_clip_opencv(
     Ok(Track {
         fixes,
         surface,
+        surface_alternatives: Vec::new(),
         scale,
         warnings,
         seconds_waiting: waiting,

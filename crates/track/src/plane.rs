@@ -1,7 +1,8 @@
 //! A borrowed grayscale image of 8- or 16-bit pixels.
 
 /// A pixel type the tracker reads. Values are scaled to 0–255 whatever the bit depth, so thresholds and
-/// contrasts mean the same for 8- and 16-bit clips.
+/// contrasts mean the same for 8- and 16-bit clips (a plane's [`Plane::gain`] then stretches a clip that
+/// uses little of that range).
 pub trait Pixel: Copy + Send + Sync + 'static {
     /// The value on a 0–255 scale.
     fn level(self) -> f32;
@@ -30,6 +31,8 @@ pub struct Plane<'a, P> {
     pub width: usize,
     /// Height, px.
     pub height: usize,
+    /// Factor every level is multiplied by (1 unless set with [`Plane::with_gain`]).
+    pub gain: f32,
 }
 
 impl<'a, P: Pixel> Plane<'a, P> {
@@ -39,13 +42,23 @@ impl<'a, P: Pixel> Plane<'a, P> {
     /// If `data.len() != width * height`.
     pub fn new(data: &'a [P], width: usize, height: usize) -> Self {
         assert_eq!(data.len(), width * height, "plane size");
-        Plane { data, width, height }
+        Plane {
+            data,
+            width,
+            height,
+            gain: 1.0,
+        }
+    }
+
+    /// The same pixels with every level multiplied by `gain` (see [`level_gain`]).
+    pub fn with_gain(self, gain: f32) -> Self {
+        Plane { gain, ..self }
     }
 
     /// The pixel at integer coordinates (no bounds check beyond the slice's).
     #[inline(always)]
     pub fn at(&self, x: usize, y: usize) -> f32 {
-        self.data[y * self.width + x].level()
+        self.data[y * self.width + x].level() * self.gain
     }
 
     /// Bilinear interpolation at (x, y); `None` outside the image (the last row/column excluded).
@@ -63,7 +76,7 @@ impl<'a, P: Pixel> Plane<'a, P> {
         let d = self.data;
         let top = d[i].level() + fx * (d[i + 1].level() - d[i].level());
         let bottom = d[i + self.width].level() + fx * (d[i + self.width + 1].level() - d[i + self.width].level());
-        Some(top + fy * (bottom - top))
+        Some((top + fy * (bottom - top)) * self.gain)
     }
 
     /// Bilinear interpolation at (x, y) known to lie in [0, width − 1) × [0, height − 1).
@@ -77,7 +90,31 @@ impl<'a, P: Pixel> Plane<'a, P> {
         let (c, e) = (d[self.width].level(), d[self.width + 1].level());
         let top = a + fx * (b - a);
         let bottom = c + fx * (e - c);
-        top + fy * (bottom - top)
+        (top + fy * (bottom - top)) * self.gain
+    }
+}
+
+/// Levels below this spread (0–255 scale, between the 0.5th and 99.5th percentiles of a frame) are stretched
+/// to it: the tracker's contrast thresholds are meant for a frame that uses at least half its scale, and a
+/// 12-bit camera's values stored unshifted in 16-bit files use 1/16 of it.
+pub const MIN_LEVEL_SPREAD: f32 = 128.0;
+
+/// The gain that stretches `img`'s levels to at least [`MIN_LEVEL_SPREAD`] (1 for a frame that already
+/// spans that much; at most 4096). Measured on every 7th pixel. Bit depth alone never changes it: an 8-bit
+/// frame and its 12-in-16-bit copy get the same gain.
+pub fn level_gain<P: Pixel>(img: &Plane<P>) -> f32 {
+    let mut levels: Vec<f32> = img.data.iter().step_by(7).map(|p| p.level()).collect();
+    if levels.len() < 16 {
+        return 1.0;
+    }
+    let n = levels.len();
+    let lo = *levels.select_nth_unstable_by(n / 200, f32::total_cmp).1;
+    let hi = *levels.select_nth_unstable_by(n - 1 - n / 200, f32::total_cmp).1;
+    let spread = hi - lo;
+    if spread >= MIN_LEVEL_SPREAD {
+        1.0
+    } else {
+        (MIN_LEVEL_SPREAD / spread.max(MIN_LEVEL_SPREAD / 4096.0)).min(4096.0)
     }
 }
 

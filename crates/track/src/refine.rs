@@ -21,7 +21,8 @@ pub struct EdgeSearch {
     pub step: f64,
     /// Smallest brightness step that counts as an edge, on the 0–255 scale per px (default 2).
     pub min_contrast: f32,
-    /// Rays whose rim point lies less than this above the surface line are skipped, px (default 2).
+    /// Rays whose rim point lies less than this above the surface line are skipped, px (default 2; a
+    /// ragged band's [`SurfaceLine::ragged_reach_px`] is added).
     pub surface_margin: f64,
     /// Also measure [`Refined::edge_definition_px`] (default false: it costs ≈ 3 µs a frame and the scale
     /// needs it in a few dozen frames only).
@@ -323,18 +324,19 @@ fn refine_once<P: Pixel>(
         (c, s) = (c0 * dc - s0 * ds, s0 * dc + c0 * ds);
         let (c, s) = (c0, s0);
         let start = r - half_width;
-        // The search stops short of the surface line: below it is the band, whose own edge must not be
-        // taken for the ball's rim.
+        // The search stops short of the surface line: below it is the band, whose own edge (and, on a
+        // ragged band, its highest grains) must not be taken for the ball's rim.
         let mut len = samples;
         if let Some(line) = surface {
+            let margin = search.surface_margin + line.ragged_reach_px();
             let (rx, ry) = (x + r * c, y + r * s);
-            if ry > line.y_at(rx) - search.surface_margin {
+            if ry > line.y_at(rx) - margin {
                 hidden += 1;
                 continue;
             }
             let towards = s - line.slope * c;
             if towards > 1e-9 {
-                let reach = (line.y_at(x) - search.surface_margin - y) / towards;
+                let reach = (line.y_at(x) - margin - y) / towards;
                 len = len.min(((reach - start) / search.step).floor().max(0.0) as usize + 1);
                 if len < samples / 2 + 3 {
                     hidden += 1;
@@ -638,6 +640,8 @@ mod tests {
             sigma_tilt_deg: 0.0,
             columns: SIZE,
             edge_definition_px: 0.0,
+            roughness_px: 0.0,
+            cue: Default::default(),
         }
     }
 

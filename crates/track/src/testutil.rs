@@ -22,6 +22,8 @@ pub struct Scene {
     pub noise: f64,
     /// Noise seed.
     pub seed: u64,
+    /// Raggedness of the band's top edge: its largest distance from the line, px (grains 2–16 px wide).
+    pub roughness: f64,
 }
 
 impl Default for Scene {
@@ -36,6 +38,7 @@ impl Default for Scene {
             distractors: Vec::new(),
             noise: 2.0,
             seed: 1,
+            roughness: 0.0,
         }
     }
 }
@@ -86,6 +89,16 @@ pub fn render(scene: &Scene) -> Vec<u8> {
     let tex: Vec<f64> = (0..w * h).map(|_| rng.gauss()).collect();
     let (cx, cy, r) = scene.ball;
     let xc = (w as f64 - 1.0) / 2.0;
+    // The ragged edge: a few incommensurate waves, scaled to reach ±roughness.
+    let mut phases = Rng(scene.seed ^ 0x9E37_79B9_7F4A_7C15);
+    let waves: Vec<(f64, f64)> = [2.3, 4.1, 7.9, 15.7]
+        .iter()
+        .map(|&l| (l, phases.uniform() * std::f64::consts::TAU))
+        .collect();
+    let ragged: Vec<f64> = (0..w)
+        .map(|x| waves.iter().map(|(l, p)| (x as f64 / l + p).sin()).sum::<f64>() / waves.len() as f64)
+        .collect();
+    let peak = ragged.iter().fold(0.0f64, |a, v| a.max(v.abs())).max(1e-9);
     let mut out = vec![0u8; w * h];
     for y in 0..h {
         for x in 0..w {
@@ -103,7 +116,7 @@ pub fn render(scene: &Scene) -> Vec<u8> {
                 v = v * (1.0 - c) + scene.ball_level * shade * c;
             }
             if let Some((y0, slope)) = scene.surface {
-                let edge = y0 + slope * (x as f64 - xc);
+                let edge = y0 + slope * (x as f64 - xc) + scene.roughness * ragged[x] / peak;
                 // Anti-aliased top edge of the band, which hides whatever is behind it.
                 let cov = (y as f64 + 0.5 - edge).clamp(0.0, 1.0);
                 if cov > 0.0 {

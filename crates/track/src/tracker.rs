@@ -6,7 +6,7 @@ use crate::plane::{Pixel, Plane};
 use crate::refine::{
     EdgeSearch, Refined, RimShapeLearner, refine_circle_with_rays, refined_candidates, residuals_about, rim_residuals,
 };
-use crate::surface::{SurfaceLine, find_surface_line};
+use crate::surface::{SurfaceLine, find_surface_lines};
 use serde::{Deserialize, Serialize};
 
 /// What the tracker could say about the ball in a frame.
@@ -122,6 +122,8 @@ pub struct Tracker {
     /// is being learned (its residuals teach the shape without a second search); empty otherwise.
     rim_rays: Vec<(usize, [f64; 2])>,
     surface: Option<SurfaceLine>,
+    /// The other candidate lines below the ball (see [`crate::SurfaceLines`]).
+    surface_alternatives: Vec<SurfaceLine>,
     surface_tries: usize,
     warnings: Vec<String>,
     /// Distance between the last prediction and its measurement, px.
@@ -159,6 +161,7 @@ impl Tracker {
             rim_frozen: false,
             rim_rays: Vec::new(),
             surface: None,
+            surface_alternatives: Vec::new(),
             surface_tries: 0,
             warnings: Vec::new(),
             last_innovation: 0.0,
@@ -180,6 +183,11 @@ impl Tracker {
     /// The surface line, once found.
     pub fn surface(&self) -> Option<&SurfaceLine> {
         self.surface.as_ref()
+    }
+
+    /// The other candidate lines below the ball, topmost first.
+    pub fn surface_alternatives(&self) -> &[SurfaceLine] {
+        &self.surface_alternatives
     }
 
     /// Things a person should know (a second ball, a lost track), each naming its frame.
@@ -242,7 +250,15 @@ impl Tracker {
     pub fn observe<P: Pixel>(&mut self, frame: usize, t_s: f64, img: &Plane<P>) -> BallFix {
         if self.surface.is_none() && self.surface_tries < 5 {
             self.surface_tries += 1;
-            self.surface = find_surface_line(img);
+            // Where the ball is expected, a line above it is not the surface.
+            let ball = self
+                .predict(t_s)
+                .zip(self.expected_radius())
+                .map(|((x, y), r)| (x, y, r));
+            if let Some(lines) = find_surface_lines(img, ball) {
+                self.surface = Some(lines.line);
+                self.surface_alternatives = lines.alternatives;
+            }
         }
         // 1. Around the prediction.
         // A confident track needs one narrow pass; the window widens when the last prediction missed (a

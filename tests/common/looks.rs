@@ -1,0 +1,242 @@
+//! The tracker and estimator against the renderer's truth on sessions of many looks (`[look]` scenarios):
+//! per clip the frames found, the centre error in flight and in contact, the contact level's error, COR and μ
+//! errors; per look family the same summarised. Shared by `examples/looks_accuracy.rs` (the full sweep) and
+//! `tests/looks.rs` (the small set `cargo test` runs). Nothing inside the pipeline sees the truth.
+
+#![allow(dead_code)]
+
+use bouncelab_estimate::{Conditions, estimate_with_frames};
+use bouncelab_frames::Session;
+use bouncelab_track::{ClipTracking, Status, track_clip};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// What one clip gave against its truth.
+#[derive(Debug, Clone)]
+pub struct ClipResult {
+    pub clip: String,
+    /// Look family tags of the clip (`truth/looks.csv`).
+    pub families: Vec<String>,
+    /// Frames with the ball measured `ok`/`occluded` and visible in truth, and frames visible in truth.
+    pub frames_found: (usize, usize),
+    /// Measured frames further than 1 px from the truth (another object taken for the ball).
+    pub frames_wrong: usize,
+    /// Centre RMS error in flight and in contact, px (the clip's constant offset included).
+    pub centre_rms_px: (f64, f64),
+    /// Why the shot could not be measured, if it could not.
+    pub failure: Option<String>,
+    /// Contact line used (its cue) and its level error at the truth's column, px (measured − truth, + down).
+    pub level: Option<(String, f64, f64)>,
+    /// COR and μ: (estimate, SE, truth).
+    pub cor: Option<(f64, f64, f64)>,
+    pub mu: Option<(f64, f64, f64)>,
+    /// Surface tilt error, degrees (measured − truth), when a line was found.
+    pub tilt_err_deg: Option<f64>,
+}
+
+fn rms(v: &[f64]) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    (v.iter().map(|e| e * e).sum::<f64>() / v.len() as f64).sqrt()
+}
+
+/// Reads a CSV into rows of (header → value).
+fn read_csv(path: &Path) -> Vec<BTreeMap<String, String>> {
+    let mut r = csv::Reader::from_path(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let h = r.headers().unwrap().clone();
+    r.records()
+        .map(|rec| {
+            let rec = rec.unwrap();
+            h.iter()
+                .zip(rec.iter())
+                .map(|(a, b)| (a.to_string(), b.to_string()))
+                .collect()
+        })
+        .collect()
+}
+
+fn num(row: &BTreeMap<String, String>, key: &str) -> f64 {
+    row.get(key)
+        .unwrap_or_else(|| panic!("column {key}"))
+        .parse()
+        .unwrap_or(f64::NAN)
+}
+
+/// Tracks and estimates every clip of the session at `session_dir` against `truth_dir`.
+pub fn evaluate(session_dir: &Path, truth_dir: &Path) -> Vec<ClipResult> {
+    let session = Session::load(session_dir).expect("session");
+    let shots = read_csv(&truth_dir.join("shots.csv"));
+    let looks = read_csv(&truth_dir.join("looks.csv"));
+    let mut out = Vec::new();
+    for truth in &shots {
+        let name = &truth["clip"];
+        let families = looks
+            .iter()
+            .find(|l| &l["clip"] == name)
+            .map(|l| {
+                l["families"]
+                    .split('+')
+                    .filter(|s| !s.is_empty())
+                    .map(str::to_string)
+                    .collect()
+            })
+            .unwrap_or_default();
+        out.push(evaluate_clip(&session, truth, truth_dir, families));
+    }
+    out
+}
+
+fn evaluate_clip(
+    session: &Session,
+    truth: &BTreeMap<String, String>,
+    truth_dir: &Path,
+    families: Vec<String>,
+) -> ClipResult {
+    let name = truth["clip"].clone();
+    let mut result = ClipResult {
+        clip: name.clone(),
+        families,
+        frames_found: (0, 0),
+        frames_wrong: 0,
+        centre_rms_px: (f64::NAN, f64::NAN),
+        failure: None,
+        level: None,
+        cor: None,
+        mu: None,
+        tilt_err_deg: None,
+    };
+    let entry = session.clip(&name).expect("clip listed");
+    let clip = match entry.open() {
+        Ok(c) => c,
+        Err(e) => {
+            result.failure = Some(format!("opening: {e}"));
+            return result;
+        }
+    };
+    let opts = ClipTracking {
+        ball_diameter_m: session.ball.diameter_m,
+        downslope_negative_x: entry.downslope == bouncelab_frames::Downslope::MinusX,
+        ..ClipTracking::default()
+    };
+    let track = match track_clip(&clip, &opts, |_, _| {}) {
+        Ok(t) => t,
+        Err(e) => {
+            result.failure = Some(format!("tracking: {e}"));
+            return result;
+        }
+    };
+    let frames = read_csv(&truth_dir.join(format!("{name}.csv")));
+    let (mut flight, mut contact) = (Vec::new(), Vec::new());
+    let mut visible = 0;
+    for (f, t) in track.fixes.iter().zip(&frames) {
+        if t["visible"] != "full" {
+            continue;
+        }
+        visible += 1;
+        if !matches!(f.status, Status::Ok | Status::Occluded) {
+            continue;
+        }
+        let e = (f.x_px - num(t, "x_px")).hypot(f.y_px - num(t, "y_px"));
+        if e > 1.0 {
+            result.frames_wrong += 1;
+        }
+        if t["phase"] == "flight" {
+            flight.push(e);
+        } else {
+            contact.push(e);
+        }
+    }
+    result.frames_found = (flight.len() + contact.len(), visible);
+    result.centre_rms_px = (rms(&flight), rms(&contact));
+    let conditions = Conditions {
+        incline_deg: entry.angle_deg,
+        gravity: 9.81,
+        ball_diameter_m: session.ball.diameter_m,
+    };
+    match estimate_with_frames(&track, &clip, &conditions) {
+        Ok(e) => {
+            if let Some(line) = e.contact_line {
+                // The truth's surface line is given at the image's centre column.
+                let xc = (clip.dimensions().0 as f64 - 1.0) / 2.0;
+                let err = line.y_at(xc) - num(truth, "surface_y_px");
+                result.level = Some((line.cue.name().to_string(), err, line.sigma_y0));
+            }
+            result.cor = Some((e.cor.value, e.cor.se, num(truth, "cor")));
+            result.mu = Some((e.mu.value, e.mu.se, num(truth, "mu_eff")));
+            result.tilt_err_deg = e.surface_tilt_deg.map(|t| t.value - num(truth, "surface_tilt_deg"));
+            if !e.flags.is_empty() {
+                result.failure = Some(format!("flagged: {}", e.flags.join("; ")));
+            }
+        }
+        Err(e) => result.failure = Some(format!("estimating: {e}")),
+    }
+    result
+}
+
+/// One Markdown table row per clip.
+pub fn clip_table(results: &[ClipResult]) -> String {
+    let mut s = String::from(
+        "| clip | frames found | wrong | flight RMS px | contact RMS px | line | level err px | COR err | μ err | tilt err ° | failure |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in results {
+        let f = |v: Option<f64>, d: usize| v.map_or("–".to_string(), |v| format!("{v:+.d$}"));
+        s += &format!(
+            "| {} | {}/{} | {} | {:.3} | {:.3} | {} | {} | {} | {} | {} | {} |\n",
+            r.clip,
+            r.frames_found.0,
+            r.frames_found.1,
+            r.frames_wrong,
+            r.centre_rms_px.0,
+            r.centre_rms_px.1,
+            r.level.as_ref().map_or("–".into(), |l| l.0.clone()),
+            f(r.level.as_ref().map(|l| l.1), 2),
+            f(r.cor.map(|c| c.0 - c.2), 4),
+            f(r.mu.map(|c| c.0 - c.2), 4),
+            f(r.tilt_err_deg, 3),
+            r.failure.as_deref().unwrap_or("")
+        );
+    }
+    s
+}
+
+/// One Markdown table row per look family: clips, shots lost, frames found, the worst frame count on
+/// another object, centre RMS in flight and contact, contact level RMS error, COR and μ RMS and worst error.
+pub fn family_table(results: &[ClipResult]) -> String {
+    let mut fams: BTreeMap<String, Vec<&ClipResult>> = BTreeMap::new();
+    for r in results {
+        for f in &r.families {
+            fams.entry(f.clone()).or_default().push(r);
+        }
+        fams.entry("(all)".into()).or_default().push(r);
+    }
+    let mut s = String::from(
+        "| family | clips | lost | frames found | on another object | flight RMS px | contact RMS px | level RMS px | COR RMS / worst | μ RMS / worst |\n|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for (fam, rs) in &fams {
+        let lost = rs.iter().filter(|r| r.failure.is_some()).count();
+        let found: usize = rs.iter().map(|r| r.frames_found.0).sum();
+        let vis: usize = rs.iter().map(|r| r.frames_found.1).sum();
+        let wrong: usize = rs.iter().map(|r| r.frames_wrong).sum();
+        let all =
+            |k: fn(&ClipResult) -> f64| -> Vec<f64> { rs.iter().map(|r| k(r)).filter(|v| v.is_finite()).collect() };
+        let cor: Vec<f64> = rs.iter().filter_map(|r| r.cor.map(|c| c.0 - c.2)).collect();
+        let mu: Vec<f64> = rs.iter().filter_map(|r| r.mu.map(|c| c.0 - c.2)).collect();
+        let worst = |v: &[f64]| v.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+        s += &format!(
+            "| {fam} | {} | {lost} | {found}/{vis} | {wrong} | {:.3} | {:.3} | {:.2} | {:.4} / {:.4} | {:.4} / {:.4} |\n",
+            rs.len(),
+            rms(&all(|r| r.centre_rms_px.0)),
+            rms(&all(|r| r.centre_rms_px.1)),
+            rms(&rs
+                .iter()
+                .filter_map(|r| r.level.as_ref().map(|l| l.1))
+                .collect::<Vec<_>>()),
+            rms(&cor),
+            worst(&cor),
+            rms(&mu),
+            worst(&mu),
+        );
+    }
+    s
+}
