@@ -73,34 +73,33 @@ fn writes_every_output_and_reuses_unchanged_shots() {
     );
     let header = std::fs::read_to_string(out.join("estimates.csv")).unwrap();
     let columns: Vec<&str> = header.lines().next().unwrap().split(',').collect();
-    for c in [
-        "clip",
-        "surface",
-        "angle_deg",
-        "drop_height_m",
-        "v_in_t",
-        "v_in_n",
-        "v_out_t",
-        "v_out_n",
-        "cor",
-        "mu",
-        "contact_ms",
-        "spin_in",
-        "spin_out",
-        "cor_se",
-        "mu_se",
-        "v_in_n_se",
-        "contact_ms_se",
-    ] {
-        assert!(columns.contains(&c), "estimates.csv lacks {c}: {columns:?}");
-    }
+    assert_eq!(
+        columns,
+        bouncelab_analyze::ESTIMATE_COLUMNS,
+        "estimates.csv's header is the documented one"
+    );
     assert_eq!(header.lines().count(), 4);
     let traj = std::fs::read_dir(out.join("trajectories")).unwrap().count();
     assert_eq!(traj, 3);
     let fit: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("fit.json")).unwrap()).unwrap();
     assert!(fit["parameters"].as_array().unwrap().len() >= 2);
     let comparison = std::fs::read_to_string(out.join("comparison.csv")).unwrap();
-    assert!(comparison.starts_with("clip,surface,angle_deg,phase"));
+    assert!(comparison.starts_with(&bouncelab_analyze::COMPARISON_COLUMNS.join(",")));
+    // Spin rows say rad/s, position rows µm, in the unit column.
+    for line in comparison.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        let unit = if f[4] == "spin" { "rad/s" } else { "um" };
+        assert_eq!(f[5], unit, "{line}");
+    }
+    for file in [
+        "model_predictions.csv",
+        "model_curves.csv",
+        "surfaces.csv",
+        "contact_force.csv",
+    ] {
+        assert!(out.join(file).is_file(), "{file} written");
+    }
+    report_figures_hold_the_csv_numbers(&out);
 
     // Nothing changed: nothing tracked.
     let second = stdout(&mut analyze(&session, &out));
@@ -123,6 +122,75 @@ fn writes_every_output_and_reuses_unchanged_shots() {
     std::fs::write(&frame, bytes).unwrap();
     let third = stdout(&mut analyze(&session, &out));
     assert!(third.contains("1 measured now, 2 reused"), "{third}");
+}
+
+/// A CSV as rows of named fields.
+fn read_csv(path: &Path) -> Vec<std::collections::HashMap<String, String>> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let head: Vec<String> = lines.next().unwrap().split(',').map(str::to_string).collect();
+    lines
+        .map(|l| head.iter().cloned().zip(l.split(',').map(str::to_string)).collect())
+        .collect()
+}
+
+/// The numbers the report draws are the CSVs': each COR point's tooltip against estimates.csv, the model
+/// curves' table against model_curves.csv, the contact force's peak against contact_force.csv.
+fn report_figures_hold_the_csv_numbers(out: &Path) {
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    let num = |s: &str| s.replace('\u{2212}', "-").parse::<f64>().unwrap();
+    for row in read_csv(&out.join("estimates.csv")) {
+        let tip = format!("<title>{} ({}, ", row["clip"], row["surface"]);
+        let text = html
+            .match_indices(&tip)
+            .map(|(at, _)| &html[at..at + html[at..].find("</title>").unwrap()])
+            .find(|t| t.contains("Coefficient of restitution "))
+            .unwrap_or_else(|| panic!("no COR point for {}", row["clip"]));
+        // "…: Coefficient of restitution 0.7160 ± 0.0012 at |v_n,in| = 2.345 ± 0.012 m/s"
+        let after = &text[text.find("restitution ").unwrap() + "restitution ".len()..];
+        let shown_cor = after.split_whitespace().next().unwrap();
+        let shown_speed = text.split("= ").nth(1).unwrap().split_whitespace().next().unwrap();
+        // Equal to the last digit shown.
+        let half_digit = |s: &str| 0.5 * 10f64.powi(-(s.split('.').nth(1).map_or(0, str::len) as i32)) + 1e-12;
+        let (c, v) = (num(&row["cor"]), num(&row["v_in_n_m_s"]).abs());
+        assert!(
+            (num(shown_cor) - c).abs() <= half_digit(shown_cor),
+            "COR {shown_cor} vs {c}"
+        );
+        assert!(
+            (num(shown_speed) - v).abs() <= half_digit(shown_speed),
+            "speed {shown_speed} vs {v}"
+        );
+    }
+    // The curve table lists points of model_curves.csv (four significant digits).
+    let curves = read_csv(&out.join("model_curves.csv"));
+    assert!(!curves.is_empty());
+    let table = &html[html
+        .find("Values of the model&#39;s curves")
+        .or_else(|| html.find("Values of the model's curves"))
+        .unwrap()..];
+    let table = &table[..table.find("</table>").unwrap()];
+    for row in [&curves[0], curves.last().unwrap()] {
+        let v = num(&row["v_in_n_m_s"]);
+        let cor = num(&row["cor"]);
+        let cell = |x: f64| {
+            let mag = x.abs().log10().floor() as i32;
+            let d = (3 - mag).max(0) as usize;
+            format!("<td class=\"n\">{x:.d$}</td>")
+        };
+        assert!(
+            table.contains(&cell(v)) && table.contains(&cell(cor)),
+            "curve point {v} {cor} not in the table"
+        );
+    }
+    let force = read_csv(&out.join("contact_force.csv"));
+    let peak = force.iter().map(|r| num(&r["force_n"])).fold(f64::MIN, f64::max);
+    let mag = peak.log10().floor() as i32;
+    let d = (3 - mag).max(0) as usize;
+    assert!(
+        html.contains(&format!("peak {peak:.d$} N")),
+        "contact force peak {peak} not in the caption"
+    );
 }
 
 #[test]
@@ -305,7 +373,10 @@ fn when_every_shot_fails_the_trajectories_and_a_report_are_written() {
         assert_eq!(t.lines().count(), 41, "{name}");
     }
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
-    assert!(html.contains("no impact in the clip") && html.contains("ball measured in 40 of 40 frames"), "{html}");
+    assert!(
+        html.contains("no impact in the clip") && html.contains("ball measured in 40 of 40 frames"),
+        "{html}"
+    );
 }
 
 #[test]

@@ -31,7 +31,13 @@ fn demo_names_the_hidden_effect_and_the_error_falls() {
         let cor: f64 = row.split_whitespace().nth(2).unwrap().parse().unwrap();
         assert!((0.5..0.9).contains(&cor), "{row}");
     }
-    assert!(text.contains("Verdict: The model is missing `hunt_crossley`"), "{text}");
+    assert!(text.contains("Verdict: hunt_crossley is missing"), "{text}");
+    // The verdict once, in short form: its long sentence is for `diagnose` and the report.
+    assert!(!text.contains("The model is missing"), "{text}");
+    assert!(
+        !text.contains("ConvergedCost") && !text.contains("StartsSticking"),
+        "{text}"
+    );
     let total = text
         .lines()
         .find(|l| l.trim_start().starts_with("all shots"))
@@ -44,6 +50,25 @@ fn demo_names_the_hidden_effect_and_the_error_falls() {
     assert!(report.contains("hunt_crossley"));
     assert!(report.contains("Fit error per shot, before and after"));
     assert!(report.contains("before: built-in paper model (version 1)"));
+    // The model change names the effect added and keeps the earlier verdict and residual signature.
+    let change = &report[report.find("<section id=\"model-change\">").unwrap()..];
+    let change = &change[..change.find("</section>").unwrap()];
+    assert!(
+        change.contains("<th>Effects added</th><td><code>hunt_crossley</code></td>"),
+        "{change}"
+    );
+    assert!(
+        change.contains("The earlier verdict") && change.contains("Missing effect found"),
+        "{change}"
+    );
+    assert!(
+        change.contains("Systematic residual per phase and component"),
+        "{change}"
+    );
+    assert!(
+        !report.contains("not available: the earlier model"),
+        "the earlier verdict was kept"
+    );
 }
 
 #[test]

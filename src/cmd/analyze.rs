@@ -52,7 +52,8 @@ impl Args {
     }
 }
 
-/// A bar per stage on a terminal; one plain line per stage otherwise.
+/// A bar per stage on a terminal (a live line of iterations and reduced χ² for the fit); one plain line per
+/// stage otherwise.
 pub struct StageBars {
     terminal: bool,
     bar: Mutex<Option<indicatif::ProgressBar>>,
@@ -67,16 +68,51 @@ impl StageBars {
     }
 }
 
+/// What a stage counts.
+fn unit(stage: Stage) -> &'static str {
+    match stage {
+        Stage::Track => "shots",
+        Stage::Diagnose => "models",
+        _ => "steps",
+    }
+}
+
 impl Progress for StageBars {
     fn start(&self, stage: Stage, total: u64) {
-        if self.terminal && total > 0 {
-            let bar = super::progress_bar(total, stage.name());
-            *self.bar.lock().expect("progress lock") = Some(bar);
+        if !self.terminal {
+            return;
         }
+        let bar = if stage == Stage::Fit {
+            // The solver's iterations are not known in advance: a spinner with the latest iteration.
+            let bar = indicatif::ProgressBar::new_spinner();
+            bar.set_style(
+                indicatif::ProgressStyle::with_template("{prefix:>9} {spinner} {msg} [{elapsed}]")
+                    .expect("valid template"),
+            );
+            bar.set_prefix(stage.name());
+            bar.set_message("starting");
+            bar.enable_steady_tick(std::time::Duration::from_millis(120));
+            bar
+        } else if total > 0 {
+            super::progress_bar(total, stage.name(), unit(stage))
+        } else {
+            return;
+        };
+        *self.bar.lock().expect("progress lock") = Some(bar);
     }
     fn advance(&self, _stage: Stage, n: u64) {
         if let Some(b) = self.bar.lock().expect("progress lock").as_ref() {
             b.inc(n);
+        }
+    }
+    fn iteration(&self, _stage: Stage, iteration: usize, chi2_red: f64) {
+        if let Some(b) = self.bar.lock().expect("progress lock").as_ref() {
+            b.set_message(format!("iteration {iteration}, reduced χ² {chi2_red:.3}"));
+        }
+    }
+    fn doing(&self, _stage: Stage, what: &str) {
+        if let Some(b) = self.bar.lock().expect("progress lock").as_ref() {
+            b.set_message(format!("fitting {what}"));
         }
     }
     fn finish(&self, stage: Stage, summary: &str) {
@@ -193,20 +229,29 @@ pub fn print_summary(a: &Analysis) {
         a.fit.reduced_chi2
     );
     for p in &a.fit.parameters {
+        // A length (a surface level) is a fraction of a millimetre: in µm, as residuals are.
+        let (k, unit) = if p.param.ends_with("_m") {
+            (1e6, " µm")
+        } else {
+            (1.0, "")
+        };
         let ci = p
             .interval
-            .map(|[lo, hi]| format!(" [{lo:.4}, {hi:.4}]"))
+            .map(|[lo, hi]| format!(" [{:.4}, {:.4}]", lo * k, hi * k))
             .unwrap_or_default();
-        println!("  {:<28} {:>12.4}{ci}", p.name, p.value);
+        println!("  {:<28} {:>12.4}{unit}{ci}", p.name, p.value * k);
     }
     for sentence in &a.failure.sentences {
-        println!("  {sentence}");
+        println!("  {}", sentence.replace('`', ""));
     }
     for (clip, why) in &a.excluded {
         println!("left out of the fit: {clip}: {why}");
     }
     if let Ok(d) = &a.diagnosis {
-        println!("diagnosis: {}", d.verdict.sentence);
+        println!(
+            "verdict: {} (the evidence: `bouncelab diagnose` or the report)",
+            bouncelab_analyze::verdict_headline(d)
+        );
         print_candidates(d, 5, false);
         if let Some(c) = d.candidates.first() {
             println!(

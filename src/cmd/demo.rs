@@ -135,7 +135,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         first.fit.rms_m * 1e6,
         first.fit.reduced_chi2
     );
-    println!("Verdict: {}", d.verdict.sentence);
+    println!("Verdict: {}", bouncelab_analyze::verdict_headline(d).replace('`', ""));
     let Some(effect) = d.verdict.effect.clone() else {
         println!("\nNo effect was named, so the model is left as it is.");
         print_report(&results, started);
@@ -146,12 +146,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let (_, values) = super::model::add(&effect, &model_path, Some(&diagnosis_json))?;
     let shown: Vec<String> = values.iter().map(|(n, v)| format!("{n} = {v:.4}")).collect();
     println!(
-        "\nAccepting it: `bouncelab model add {effect} --model {}` ({}), then analysing again …",
+        "\nAccepting it: bouncelab model add {effect} --model {} ({}), then analysing again …",
         model_path.display(),
         shown.join(", ")
     );
     let second = super::analyze::run_quiet(&args(Some(model_path.clone())))?;
-    println!("\nBefore and after adding `{effect}`:");
+    println!("\nBefore and after adding {effect}:");
     println!("  {:<30} {:>12} {:>12}", "shot", "before µm", "after µm");
     if let Some(b) = &second.before {
         for (clip, before, after) in &b.shots {
@@ -168,7 +168,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         );
     }
     if let Ok(d2) = &second.diagnosis {
-        println!("Verdict with `{effect}` added: {}", d2.verdict.sentence);
+        println!(
+            "Verdict with {effect} added: {}",
+            bouncelab_analyze::verdict_headline(d2).replace('`', "")
+        );
     }
     print_report(&results, started);
     Ok(())

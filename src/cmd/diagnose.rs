@@ -17,14 +17,14 @@ pub fn run(mut a: Args) -> anyhow::Result<()> {
         d.shots,
         analysis.model_origin
     );
-    println!("verdict: {}", d.verdict.kind.name());
+    println!("verdict: {}", bouncelab_analyze::verdict_headline(d).replace('`', ""));
     println!("{}", d.verdict.sentence);
     println!();
     println!("where the current model's residual sits (share of χ², systematic part above the noise):");
     for p in d.signature.phases.iter().take(4) {
         println!(
             "  {:<28} {:>5.1} %  {:>7.1} µm",
-            format!("{} {}", p.component.name(), p.phase.name()),
+            format!("{} {}", p.component.name(), p.phase.words()),
             100.0 * p.chi2_share,
             p.systematic_m * 1e6
         );

@@ -72,7 +72,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         downslope_negative_x: minus_x,
         ..ClipTracking::default()
     };
-    let bar = super::progress_bar(clip.len() as u64, "tracking");
+    let bar = super::progress_bar(clip.len() as u64, "tracking", "frames");
     let track = track_clip(&clip, &opts, |done, _| bar.set_position(done as u64))
         .with_context(|| format!("tracking {}", a.clip_dir.display()))?;
     bar.finish_and_clear();
@@ -92,7 +92,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
 
 fn print_table(clip: &Path, angle: f64, e: &Estimate) {
     println!("{}  (incline {angle}°)", clip.display());
-    let row = |name: &str, unit: &str, v: f64, se: f64| println!("  {name:<14} {v:>10.4} ± {se:<8.4} {unit}");
+    let row = |name: &str, unit: &str, v: f64, se: f64| println!("  {name:<14} {:>22} {unit}", super::pm(v, se));
     row("v_in_t", "m/s", e.v_in[0].value, e.v_in[0].se);
     row("v_in_n", "m/s", e.v_in[1].value, e.v_in[1].se);
     row("v_out_t", "m/s", e.v_out[0].value, e.v_out[0].se);

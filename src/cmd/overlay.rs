@@ -140,7 +140,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let mut style = Style::default();
     let mut key_pixels = HashMap::new();
     let mut written = 0usize;
-    let bar = super::progress_bar(clip.len() as u64, "drawing");
+    let bar = super::progress_bar(clip.len() as u64, "drawing", "frames");
     for (k, frame) in clip.frames().enumerate() {
         let frame = frame.with_context(|| format!("reading {} again to draw it", a.clip_dir.display()))?;
         bar.set_position(k as u64 + 1);

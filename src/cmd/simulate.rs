@@ -71,26 +71,28 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "{:<10} {:>7} {:>7} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>8}",
         "", "", "", "ms", "mm", "m/s", "m/s", "m/s", "m/s", "rad/s"
     );
+    // A value that rounds to zero is shown without a sign.
+    let z = |v: f64, d: usize| super::no_minus_zero(&format!("{v:.d$}"));
     for (s, i) in &rows {
         println!(
-            "{:<10} {:>7.4} {:>7.4} {:>9.4} {:>9.4} {:>9.4} {:>9.4} {:>9.4} {:>9.4} {:>8.2}",
+            "{:<10} {:>7.4} {:>7} {:>9.4} {:>9.4} {:>9} {:>9.4} {:>9} {:>9.4} {:>8}",
             s,
             i.restitution,
-            i.effective_friction,
+            z(i.effective_friction, 4),
             i.contact_time() * 1e3,
             i.delta_max * 1e3,
-            i.state_in.vx,
+            z(i.state_in.vx, 4),
             i.state_in.vy,
-            i.state_out.vx,
+            z(i.state_out.vx, 4),
             i.state_out.vy,
-            i.omega_out()
+            z(i.omega_out(), 2)
         );
     }
     for (s, i) in &rows {
         let events: Vec<String> = i
             .slip_events
             .iter()
-            .map(|e| format!("{:?} at {:.3} ms", e.kind, (e.t - i.t_touch) * 1e3))
+            .map(|e| format!("{} at {:.3} ms", slip_words(e.kind), (e.t - i.t_touch) * 1e3))
             .collect();
         println!(
             "{s}: max compression at {:.3} ms, separation at {:.3} ms{}{}",
@@ -109,6 +111,15 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+/// A stick/slip switch in words.
+fn slip_words(k: bouncelab_model::SlipEventKind) -> &'static str {
+    match k {
+        bouncelab_model::SlipEventKind::StartsSticking => "starts rolling (the contact point sticks)",
+        bouncelab_model::SlipEventKind::StartsSliding => "starts sliding",
+        bouncelab_model::SlipEventKind::Reverses => "slip reverses",
+    }
 }
 
 /// One impact at `speed` m/s falling vertically onto a surface inclined by `angle_deg`.

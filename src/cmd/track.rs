@@ -20,7 +20,7 @@ pub struct Args {
 /// How a clip is tracked: shared by `track` and `overlay`.
 #[derive(clap::Args)]
 pub struct Tracking {
-    /// Detector: the built-in Hough tracker (opencv needs the `opencv` feature).
+    /// Detector (builds with the `opencv` feature also offer OpenCV's HoughCircles as `opencv`).
     #[arg(long, value_enum, default_value_t = Detector::Hough)]
     detector: Detector,
     /// Frame rate, frames/s (beats clip.toml and session.toml).
@@ -38,7 +38,8 @@ pub struct Tracking {
 enum Detector {
     /// Our gradient Hough transform with sub-pixel refinement.
     Hough,
-    /// OpenCV's HoughCircles (needs the `opencv` feature).
+    /// OpenCV's HoughCircles on every frame, no refinement: the reference baseline.
+    #[cfg(feature = "opencv")]
     Opencv,
 }
 
@@ -62,10 +63,6 @@ fn session_minus_x(clip_dir: &Path) -> bool {
 
 /// Opens the clip and tracks it as `bouncelab track` does (warnings printed, a progress bar on a terminal).
 pub fn track_clip_dir(clip_dir: &Path, a: &Tracking) -> anyhow::Result<(Clip, Track)> {
-    #[cfg(not(feature = "opencv"))]
-    if matches!(a.detector, Detector::Opencv) {
-        anyhow::bail!("--detector opencv needs a build with `--features opencv` (not implemented in this build yet)");
-    }
     let mut options = ClipOptions::default();
     options.fps = a.fps;
     options.overrides.ball_diameter_m = a.diameter;
@@ -84,7 +81,7 @@ pub fn track_clip_dir(clip_dir: &Path, a: &Tracking) -> anyhow::Result<(Clip, Tr
         downslope_negative_x: minus_x,
         ..ClipTracking::default()
     };
-    let bar = super::progress_bar(clip.len() as u64, "tracking");
+    let bar = super::progress_bar(clip.len() as u64, "tracking", "frames");
     let progress = |done: usize, _| bar.set_position(done as u64);
     let track = match a.detector {
         Detector::Hough => track_clip(&clip, &opts, progress),
@@ -96,8 +93,6 @@ pub fn track_clip_dir(clip_dir: &Path, a: &Tracking) -> anyhow::Result<(Clip, Tr
             bouncelab_track::opencv::OpencvMethod::Gradient,
             progress,
         ),
-        #[cfg(not(feature = "opencv"))]
-        Detector::Opencv => unreachable!("refused above"),
     }
     .with_context(|| format!("tracking {}", clip_dir.display()))?;
     bar.finish_and_clear();

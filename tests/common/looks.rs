@@ -48,7 +48,10 @@ fn read_csv(path: &Path) -> Vec<BTreeMap<String, String>> {
     r.records()
         .map(|rec| {
             let rec = rec.unwrap();
-            h.iter().zip(rec.iter()).map(|(a, b)| (a.to_string(), b.to_string())).collect()
+            h.iter()
+                .zip(rec.iter())
+                .map(|(a, b)| (a.to_string(), b.to_string()))
+                .collect()
         })
         .collect()
 }
@@ -71,7 +74,13 @@ pub fn evaluate(session_dir: &Path, truth_dir: &Path) -> Vec<ClipResult> {
         let families = looks
             .iter()
             .find(|l| &l["clip"] == name)
-            .map(|l| l["families"].split('+').filter(|s| !s.is_empty()).map(str::to_string).collect())
+            .map(|l| {
+                l["families"]
+                    .split('+')
+                    .filter(|s| !s.is_empty())
+                    .map(str::to_string)
+                    .collect()
+            })
             .unwrap_or_default();
         out.push(evaluate_clip(&session, truth, truth_dir, families));
     }
@@ -209,7 +218,8 @@ pub fn family_table(results: &[ClipResult]) -> String {
         let found: usize = rs.iter().map(|r| r.frames_found.0).sum();
         let vis: usize = rs.iter().map(|r| r.frames_found.1).sum();
         let wrong: usize = rs.iter().map(|r| r.frames_wrong).sum();
-        let all = |k: fn(&ClipResult) -> f64| -> Vec<f64> { rs.iter().map(|r| k(r)).filter(|v| v.is_finite()).collect() };
+        let all =
+            |k: fn(&ClipResult) -> f64| -> Vec<f64> { rs.iter().map(|r| k(r)).filter(|v| v.is_finite()).collect() };
         let cor: Vec<f64> = rs.iter().filter_map(|r| r.cor.map(|c| c.0 - c.2)).collect();
         let mu: Vec<f64> = rs.iter().filter_map(|r| r.mu.map(|c| c.0 - c.2)).collect();
         let worst = |v: &[f64]| v.iter().fold(0.0f64, |a, b| a.max(b.abs()));
@@ -218,7 +228,10 @@ pub fn family_table(results: &[ClipResult]) -> String {
             rs.len(),
             rms(&all(|r| r.centre_rms_px.0)),
             rms(&all(|r| r.centre_rms_px.1)),
-            rms(&rs.iter().filter_map(|r| r.level.as_ref().map(|l| l.1)).collect::<Vec<_>>()),
+            rms(&rs
+                .iter()
+                .filter_map(|r| r.level.as_ref().map(|l| l.1))
+                .collect::<Vec<_>>()),
             rms(&cor),
             worst(&cor),
             rms(&mu),

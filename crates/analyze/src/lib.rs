@@ -15,15 +15,21 @@ mod shots;
 
 pub use error::AnalyzeError;
 pub use measure::{MeasureSummary, measure_session};
-pub use outputs::write_estimates_csv;
+pub use outputs::{
+    COMPARISON_COLUMNS, CURVE_COLUMNS, ESTIMATE_COLUMNS, FORCE_COLUMNS, PREDICTION_COLUMNS, SURFACE_COLUMNS,
+    write_comparison_csv, write_estimates_csv,
+};
+pub use report::{track_peak_deceleration, verdict_headline};
 pub use shots::{ShotData, load_failed_tracks, load_shots, measured_shot};
 
 use bouncelab_compare::{Comparison, FailureReport, ShotExtras, SpinFrame};
 use bouncelab_diagnose::{Diagnosis, SearchOptions, find_missing_effect_with};
-use bouncelab_fit::{FitOptions, FitResult, NoObserver, Problem, fit_problem};
+use bouncelab_fit::{FitOptions, FitResult, Problem, fit_problem};
 use bouncelab_frames::Session;
 use bouncelab_model::{EffectKind, EffectSetting, ModelSpec, ParamRef, ParamSetting};
-use bouncelab_stats::{Ancova, CorObservation, Dataset, PAPER_TERMS, TukeyHsd, ancova, tukey_hsd_factor};
+use bouncelab_stats::{
+    Ancova, AncovaInference, CorObservation, Dataset, PAPER_TERMS, TukeyHsd, ancova, ancova_inference, tukey_hsd_factor,
+};
 use bouncelab_store::{ClipFingerprint, Fingerprint, FitRecord, ModelHistoryRow, ModelVersionRecord, Store};
 use std::path::{Path, PathBuf};
 
@@ -64,6 +70,11 @@ pub trait Progress: Sync {
     fn start(&self, _stage: Stage, _total: u64) {}
     /// `n` more units of the stage are done.
     fn advance(&self, _stage: Stage, _n: u64) {}
+    /// A solver of the stage finished iteration `iteration` (0 is the starting point) at reduced χ²
+    /// `chi2_red` (χ²/ν, the fit's definition); calls come from the thread that runs the stage.
+    fn iteration(&self, _stage: Stage, _iteration: usize, _chi2_red: f64) {}
+    /// What the stage works on now, in a few words (e.g. "+ hertz": fitting the model with `hertz` added).
+    fn doing(&self, _stage: Stage, _what: &str) {}
     /// The stage is done; `summary` says what it did in one line.
     fn finish(&self, _stage: Stage, _summary: &str) {}
     /// Something a person should know (a shot that failed, a surface the model did not know …).
@@ -102,6 +113,10 @@ pub struct Analysis {
     pub fitted_at: Option<String>,
     /// The model fitted (its origin).
     pub model_origin: String,
+    /// The model file as fitted: the session's ball, a table for every surface, the surface level.
+    pub model: ModelSpec,
+    /// The store's id of the model version fitted.
+    pub model_version: i64,
     /// The fit.
     pub fit: FitResult,
     /// Every measured shot (conditions, track, estimate).
@@ -110,6 +125,8 @@ pub struct Analysis {
     pub excluded: Vec<(String, String)>,
     /// This model's errors against the previous model version fitted to the same session, if any.
     pub before: Option<BeforeAfter>,
+    /// The diagnosis of that previous model version, when this output folder kept it.
+    pub previous_diagnosis: Option<Diagnosis>,
     /// Every model version with its latest fit on this session (including this one).
     pub history: Vec<ModelHistoryRow>,
     /// The fitted model against every shot.
@@ -242,7 +259,7 @@ pub fn analyze(
         // tracked, an empty estimates.csv, and a report listing every shot's failure and how far it got.
         create_dir(&options.out_dir)?;
         let tracks: Vec<_> = failed_tracks.iter().map(|(c, t, _)| (c.clone(), t.clone())).collect();
-        let mut written = vec![outputs::write_estimates_only(&options.out_dir, &shots)?];
+        let mut written = vec![outputs::write_estimates_only(&options.out_dir, &shots, &spec)?];
         written.extend(outputs::write_failed_trajectories(&options.out_dir, &tracks)?);
         written.push(report::write_failure(
             &options.out_dir,
@@ -284,14 +301,22 @@ pub fn analyze(
     // effect: restitution damping's 65 µm misfit falls to 16 µm).
     let fit_options = FitOptions::default();
     let problem = Problem::new(&spec, measured, fit_options.sim)?.with_surface_offsets(fit_options.surface_offsets);
-    let fit = fit_problem(&problem, &spec.origin, &fit_options, &mut NoObserver)?;
+    // The fit's degrees of freedom, so each iteration's cost is shown as the reduced χ² the result reports.
+    let dof = problem
+        .n_residuals()
+        .saturating_sub(problem.params().len() + problem.nuisance_per_shot() * problem.shots().len())
+        .max(1) as f64;
+    let mut observer = |it: &bouncelab_fit::Iteration<'_>| progress.iteration(Stage::Fit, it.iteration, it.cost / dof);
+    let fit = fit_problem(&problem, &spec.origin, &fit_options, &mut observer)?;
     progress.finish(
         Stage::Fit,
         &format!(
-            "{} parameter(s), RMS {:.1} µm, {:?}",
+            "{} parameter(s), position RMS {:.1} µm, reduced χ² {:.2}, {} after {} iteration(s)",
             fit.parameters.len(),
             fit.rms_m * 1e6,
-            fit.termination
+            fit.reduced_chi2,
+            fit.termination,
+            fit.iterations
         ),
     );
     timings.push((Stage::Fit, t.elapsed().as_secs_f64()));
@@ -308,6 +333,9 @@ pub fn analyze(
         parent_id: None,
     })?;
     let before = before_after(&store, measure.session_id, version, &fit)?;
+    let previous_diagnosis = before
+        .as_ref()
+        .and_then(|b| outputs::kept_diagnosis(&options.out_dir, b.before_version));
     store.add_fit(&FitRecord {
         session_id: Some(measure.session_id),
         model_version_id: version,
@@ -391,15 +419,17 @@ pub fn analyze(
 
     let t = std::time::Instant::now();
     create_dir(&options.out_dir)?;
-    let mut outputs = outputs::write_all(&options.out_dir, &shots, &fit)?;
+    let mut outputs = outputs::write_all(&options.out_dir, &shots, &fit, &spec)?;
     let tracks: Vec<_> = failed_tracks.iter().map(|(c, t, _)| (c.clone(), t.clone())).collect();
     outputs::write_failed_trajectories(&options.out_dir, &tracks)?;
     outputs.push(outputs::write_comparison(&options.out_dir, &comparison)?);
     if let Ok(st) = &stats {
         outputs.push(outputs::write_anova(&options.out_dir, &st.ancova)?);
     }
-    if diagnosis.is_ok() {
+    if let Ok(d) = &diagnosis {
         outputs.push(options.out_dir.join("diagnosis.json"));
+        // Kept per model version, so a later run with another model can show this verdict as the earlier one.
+        outputs::keep_diagnosis(&options.out_dir, version, d)?;
     }
     timings.push((Stage::Report, t.elapsed().as_secs_f64()));
     let started_report = std::time::Instant::now();
@@ -417,6 +447,9 @@ pub fn analyze(
         shots_listed: session.clips.len(),
         measure,
         model_origin: spec.origin.clone(),
+        model: spec.clone(),
+        model_version: version,
+        previous_diagnosis,
         fit,
         shots,
         excluded,
@@ -429,8 +462,8 @@ pub fn analyze(
         outputs,
         timings,
     };
-    let report = report::write(&options.out_dir, &analysis, description.as_deref(), &warnings)?;
-    analysis.outputs.push(report);
+    let written = report::write(&options.out_dir, &analysis, description.as_deref(), &warnings)?;
+    analysis.outputs.extend(written);
     if let Some((_, t)) = analysis.timings.iter_mut().find(|(s, _)| *s == Stage::Report) {
         *t += started_report.elapsed().as_secs_f64();
     }
@@ -442,6 +475,10 @@ pub fn analyze(
 pub struct BeforeAfter {
     /// The earlier model version's name.
     pub before_model: String,
+    /// The store's id of the earlier model version.
+    pub before_version: i64,
+    /// The earlier model version's `model.toml` text.
+    pub before_toml: String,
     /// When it was fitted (ISO 8601, UTC).
     pub before_fitted_at: String,
     /// Position RMS of all residuals, m: (before, after).
@@ -470,10 +507,12 @@ fn before_after(
     let Ok(old) = serde_json::from_str::<FitResult>(&prev.record.json) else {
         return Ok(None);
     };
-    let name = store
+    let prev_version = store
         .model_versions()?
         .into_iter()
-        .find(|v| v.id == prev.record.model_version_id)
+        .find(|v| v.id == prev.record.model_version_id);
+    let name = prev_version
+        .as_ref()
         .map(|v| format!("{} (version {})", v.record.name, v.id))
         .unwrap_or_else(|| old.model.clone());
     let shots = fit
@@ -486,6 +525,8 @@ fn before_after(
         .collect();
     Ok(Some(BeforeAfter {
         before_model: name,
+        before_version: prev.record.model_version_id,
+        before_toml: prev_version.map(|v| v.record.toml).unwrap_or_default(),
         before_fitted_at: prev.created_at,
         total_rms_m: (old.rms_m, fit.rms_m),
         reduced_chi2: (old.reduced_chi2, fit.reduced_chi2),
@@ -576,7 +617,10 @@ fn diagnose_stage(
     {
         progress.finish(
             Stage::Diagnose,
-            &format!("unchanged since the last run: {}", d.verdict.sentence),
+            &format!(
+                "unchanged since the last run ({} candidate(s) in diagnosis.json)",
+                d.candidates.len()
+            ),
         );
         return Ok(d);
     }
@@ -591,11 +635,19 @@ fn diagnose_stage(
     let report = |p: bouncelab_diagnose::Progress| {
         let before = last.swap(p.done, std::sync::atomic::Ordering::Relaxed);
         progress.advance(Stage::Diagnose, p.done.saturating_sub(before) as u64);
+        progress.doing(Stage::Diagnose, &p.what);
     };
     let d = find_missing_effect_with(spec, &measured, extras, &options, &report)?;
     outputs::write_atomic(&path, |w| w.write_all(d.to_json().as_bytes()))?;
     outputs::write_atomic(&key_path, |w| w.write_all(key.as_bytes()))?;
-    progress.finish(Stage::Diagnose, &d.verdict.sentence);
+    progress.finish(
+        Stage::Diagnose,
+        &format!(
+            "{} candidate effect(s) fitted in {:.1} s",
+            d.candidates.len(),
+            d.seconds
+        ),
+    );
     Ok(d)
 }
 
@@ -606,8 +658,12 @@ pub struct SessionStats {
     pub terms: Vec<&'static str>,
     /// ANCOVA of COR (Type I and II), its fit and diagnostics.
     pub ancova: Ancova,
-    /// Tukey–Kramer comparisons of the surfaces at α = 0.05, when there are two or more.
+    /// Tukey–Kramer comparisons of the surfaces' raw means at α = 0.05, when there are two or more (one-way:
+    /// the impact speed is not accounted for; `inference` holds the comparisons that agree with the ANCOVA).
     pub tukey: Option<TukeyHsd>,
+    /// The same fit's coefficients with SE, t and p, adjusted means of every factor with Tukey–Kramer and
+    /// Holm comparisons, and its residual tests (α = 0.05), or why they could not be computed.
+    pub inference: Result<AncovaInference, String>,
 }
 
 /// ANCOVA of COR on surface and angle with the incoming normal speed as covariate, and Tukey–Kramer pairwise
@@ -645,7 +701,13 @@ pub fn session_stats(shots: &[ShotData]) -> Result<SessionStats, String> {
     } else {
         None
     };
-    Ok(SessionStats { terms, ancova, tukey })
+    let inference = ancova_inference(&data, &terms, 0.05).map_err(|e| e.to_string());
+    Ok(SessionStats {
+        terms,
+        ancova,
+        tukey,
+        inference,
+    })
 }
 
 /// The evidence a shot carries besides its frames: drop height, contact time, the camera's roll from the

@@ -1,43 +1,116 @@
-//! The files of SPEC §5, each written to a temporary name and renamed, so a reader never sees half a file.
+//! The output files (their columns are documented in `docs/outputs.md`), each written to a temporary name and
+//! renamed, so a reader never sees half a file.
 
 use crate::{AnalyzeError, ShotData};
 use bouncelab_fit::FitResult;
+use bouncelab_report as r;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-/// The columns of `estimates.csv` (SPEC §5), in order.
-pub const ESTIMATE_COLUMNS: [&str; 30] = [
+/// The columns of `estimates.csv`, in order. Every name ends in its unit (`_m_s`, `_ms`, `_mm`, `_deg`,
+/// `_rad_s`, `_m_s2`, `_s`, `_m`); `cor`, `mu_eff`, their `_se` and `chi2_red_flight` are dimensionless. A
+/// standard error is `<quantity>_se_<unit>` (see `docs/outputs.md`).
+pub const ESTIMATE_COLUMNS: [&str; 38] = [
     "clip",
     "surface",
     "angle_deg",
     "drop_height_m",
-    "v_in_t",
-    "v_in_t_se",
-    "v_in_n",
-    "v_in_n_se",
-    "v_out_t",
-    "v_out_t_se",
-    "v_out_n",
-    "v_out_n_se",
+    "v_in_t_m_s",
+    "v_in_t_se_m_s",
+    "v_in_n_m_s",
+    "v_in_n_se_m_s",
+    "v_out_t_m_s",
+    "v_out_t_se_m_s",
+    "v_out_n_m_s",
+    "v_out_n_se_m_s",
+    "impact_speed_m_s",
+    "impact_speed_se_m_s",
+    "impact_angle_deg",
+    "impact_angle_se_deg",
     "cor",
     "cor_se",
-    "mu",
-    "mu_se",
+    "mu_eff",
+    "mu_eff_se",
     "contact_ms",
-    "contact_ms_se",
-    "spin_in",
-    "spin_in_se",
-    "spin_out",
-    "spin_out_se",
+    "contact_se_ms",
     "delta_max_mm",
-    "delta_max_mm_se",
+    "delta_max_se_mm",
+    "spin_in_rad_s",
+    "spin_in_se_rad_s",
+    "spin_out_rad_s",
+    "spin_out_se_rad_s",
+    "peak_decel_track_m_s2",
+    "peak_decel_track_se_m_s2",
+    "peak_force_track_n",
+    "peak_force_track_se_n",
     "t_touch_s",
-    "t_touch_s_se",
+    "t_touch_se_s",
     "t_sep_s",
-    "t_sep_s_se",
+    "t_sep_se_s",
     "chi2_red_flight",
     "notes",
 ];
+
+/// The columns of `comparison.csv`: one row per shot, phase and component. `rms` is in `unit` (µm for the
+/// tangential and normal positions, rad/s for spin); the output errors are measured − predicted.
+pub const COMPARISON_COLUMNS: [&str; 15] = [
+    "clip",
+    "surface",
+    "angle_deg",
+    "phase",
+    "component",
+    "unit",
+    "n",
+    "rms",
+    "chi2_red",
+    "v_out_t_err_pct",
+    "v_out_n_err_pct",
+    "cor_err_pct",
+    "cor_err",
+    "mu_eff_err",
+    "contact_err_ms",
+];
+
+/// The columns of `model_predictions.csv`: per fitted shot, the fitted model hit at the shot's measured
+/// incoming velocity, and the fit's error on the shot.
+pub const PREDICTION_COLUMNS: [&str; 14] = [
+    "clip",
+    "surface",
+    "angle_deg",
+    "cor",
+    "mu_eff",
+    "contact_ms",
+    "delta_max_mm",
+    "spin_out_rad_s",
+    "peak_force_n",
+    "peak_decel_m_s2",
+    "frames",
+    "rms_um",
+    "chi2_red",
+    "notes",
+];
+
+/// The columns of `model_curves.csv`: the fitted model against the incoming normal speed, per surface and
+/// incline (the ball arriving vertically).
+pub const CURVE_COLUMNS: [&str; 10] = [
+    "surface",
+    "angle_deg",
+    "v_in_n_m_s",
+    "cor",
+    "mu_eff",
+    "contact_ms",
+    "delta_max_mm",
+    "spin_out_rad_s",
+    "peak_force_n",
+    "peak_decel_m_s2",
+];
+
+/// The columns of `contact_force.csv`: the contact force over one impact (the report's Figure 2 panel).
+pub const FORCE_COLUMNS: [&str; 5] = ["clip", "surface", "t_ms", "delta_mm", "force_n"];
+
+/// The columns of `surfaces.csv`: per surface and quantity, mean, sample SD and count over the shots; the
+/// rows mix quantities, so the unit is a column.
+pub const SURFACE_COLUMNS: [&str; 6] = ["surface", "quantity", "unit", "n", "mean", "sd"];
 
 /// Writes `path` through a temporary file in the same folder and a rename.
 pub(crate) fn write_atomic(
@@ -57,18 +130,36 @@ pub(crate) fn write_atomic(
     std::fs::rename(&tmp, path).map_err(io)
 }
 
-/// `estimates.csv`: one row per measured shot with every estimate and its standard error.
-pub fn write_estimates_csv(out: &mut dyn Write, shots: &[ShotData]) -> Result<(), csv::Error> {
+fn num(v: f64) -> String {
+    if v.is_finite() { format!("{v}") } else { String::new() }
+}
+
+/// `estimates.csv`: one row per measured shot with every estimate and its standard error; the ball's mass
+/// (kg) and gravity (m/s²) turn the track's peak deceleration into a force.
+pub fn write_estimates_csv(
+    out: &mut dyn Write,
+    shots: &[ShotData],
+    ball_mass_kg: f64,
+    gravity: f64,
+) -> Result<(), csv::Error> {
     let mut w = csv::Writer::from_writer(out);
     w.write_record(ESTIMATE_COLUMNS)?;
-    let num = |v: f64| if v.is_finite() { format!("{v}") } else { String::new() };
     for s in shots {
         let e = &s.estimate;
+        let m = crate::report::measurement(s, None, ball_mass_kg, gravity);
         let opt = |m: Option<bouncelab_estimate::Measured>| {
             m.map_or((String::new(), String::new()), |m| (num(m.value), num(m.se)))
         };
         let (si, si_se) = opt(e.spin_in);
         let (so, so_se) = opt(e.spin_out);
+        let pair = |v: Option<r::Measured>| {
+            v.map_or((String::new(), String::new()), |a| {
+                (num(a.value), a.se.map_or(String::new(), num))
+            })
+        };
+        let (pd, pd_se) = pair(m.peak_deceleration_track_m_s2);
+        let (pf, pf_se) = pair(m.peak_force_track_n);
+        let (speed, angle) = (m.impact_speed(), m.impact_angle());
         let worst_chi2 = e.chi2_red.iter().cloned().fold(f64::NAN, f64::max);
         w.write_record([
             s.clip.clone(),
@@ -83,18 +174,26 @@ pub fn write_estimates_csv(out: &mut dyn Write, shots: &[ShotData]) -> Result<()
             num(e.v_out[0].se),
             num(e.v_out[1].value),
             num(e.v_out[1].se),
+            num(speed.value),
+            speed.se.map_or(String::new(), num),
+            num(angle.value),
+            angle.se.map_or(String::new(), num),
             num(e.cor.value),
             num(e.cor.se),
             num(e.mu.value + 0.0),
             num(e.mu.se),
             num(e.contact_ms.value),
             num(e.contact_ms.se),
+            num(e.delta_max_m.value * 1e3),
+            num(e.delta_max_m.se * 1e3),
             si,
             si_se,
             so,
             so_se,
-            num(e.delta_max_m.value * 1e3),
-            num(e.delta_max_m.se * 1e3),
+            pd,
+            pd_se,
+            pf,
+            pf_se,
             num(e.t_touch.value),
             num(e.t_touch.se),
             num(e.t_sep.value),
@@ -132,10 +231,17 @@ pub(crate) fn write_failed_trajectories(
     Ok(written)
 }
 
-/// `estimates.csv` with no fit behind it: the rows of `shots` (possibly none).
-pub(crate) fn write_estimates_only(dir: &Path, shots: &[ShotData]) -> Result<PathBuf, AnalyzeError> {
+/// `estimates.csv` with no fit behind it: the rows of `shots` (possibly none); `spec` gives the ball's mass
+/// and gravity.
+pub(crate) fn write_estimates_only(
+    dir: &Path,
+    shots: &[ShotData],
+    spec: &bouncelab_model::ModelSpec,
+) -> Result<PathBuf, AnalyzeError> {
     let path = dir.join("estimates.csv");
-    write_atomic(&path, |w| write_estimates_csv(w, shots).map_err(csv_io))?;
+    write_atomic(&path, |w| {
+        write_estimates_csv(w, shots, spec.ball.mass_kg, spec.gravity).map_err(csv_io)
+    })?;
     Ok(path)
 }
 
@@ -144,7 +250,6 @@ fn write_track_rows(out: &mut dyn Write, track: &bouncelab_store::TrackRecord) -
     w.write_record([
         "frame", "t_s", "x_px", "y_px", "r_px", "sigma_px", "quality", "status", "x_m", "y_m",
     ])?;
-    let num = |v: f64| if v.is_finite() { format!("{v}") } else { String::new() };
     for r in &track.rows {
         w.write_record([
             r.frame.to_string(),
@@ -181,10 +286,17 @@ fn safe_name(clip: &str) -> String {
 }
 
 /// Writes `estimates.csv`, `trajectories/`, `fit.json` and returns their paths.
-pub(crate) fn write_all(dir: &Path, shots: &[ShotData], fit: &FitResult) -> Result<Vec<PathBuf>, AnalyzeError> {
+pub(crate) fn write_all(
+    dir: &Path,
+    shots: &[ShotData],
+    fit: &FitResult,
+    spec: &bouncelab_model::ModelSpec,
+) -> Result<Vec<PathBuf>, AnalyzeError> {
     let mut written = Vec::new();
     let path = dir.join("estimates.csv");
-    write_atomic(&path, |w| write_estimates_csv(w, shots).map_err(csv_io))?;
+    write_atomic(&path, |w| {
+        write_estimates_csv(w, shots, spec.ball.mass_kg, spec.gravity).map_err(csv_io)
+    })?;
     written.push(path);
     let traj = dir.join("trajectories");
     std::fs::create_dir_all(&traj).map_err(|source| AnalyzeError::Io {
@@ -202,16 +314,225 @@ pub(crate) fn write_all(dir: &Path, shots: &[ShotData], fit: &FitResult) -> Resu
     Ok(written)
 }
 
-/// `comparison.csv` (see `bouncelab_compare::COMPARISON_COLUMNS`).
+/// `comparison.csv` (see [`COMPARISON_COLUMNS`]).
 pub(crate) fn write_comparison(
     dir: &Path,
     comparison: &bouncelab_compare::Comparison,
 ) -> Result<PathBuf, AnalyzeError> {
     let path = dir.join("comparison.csv");
-    write_atomic(&path, |w| {
-        bouncelab_compare::write_comparison_csv(w, comparison).map_err(std::io::Error::other)
-    })?;
+    write_atomic(&path, |w| write_comparison_csv(w, comparison).map_err(csv_io))?;
     Ok(path)
+}
+
+/// Writes [`COMPARISON_COLUMNS`] rows of `comparison`.
+pub fn write_comparison_csv(out: &mut dyn Write, comparison: &bouncelab_compare::Comparison) -> Result<(), csv::Error> {
+    use bouncelab_compare::Component;
+    let mut w = csv::Writer::from_writer(out);
+    w.write_record(COMPARISON_COLUMNS)?;
+    let opt = |v: Option<f64>| v.map_or(String::new(), num);
+    for s in &comparison.shots {
+        let e = s.output_errors;
+        let tail = [
+            opt(e.and_then(|e| e.v_out_t_pct)),
+            opt(e.and_then(|e| e.v_out_n_pct)),
+            opt(e.map(|e| e.cor_pct)),
+            opt(e.map(|e| e.cor_abs)),
+            opt(e.map(|e| e.mu_abs)),
+            opt(s.contact_time_error_ms),
+        ];
+        for p in &s.by_phase {
+            let (unit, rms) = match p.component {
+                Component::Spin => ("rad/s", p.rms_m),
+                _ => ("um", p.rms_m * 1e6),
+            };
+            let mut row = vec![
+                s.shot.clone(),
+                s.surface.clone(),
+                num(s.incline_deg),
+                p.phase.name().to_string(),
+                p.component.name().to_string(),
+                unit.to_string(),
+                p.n.to_string(),
+                num(rms),
+                num(p.chi2_red),
+            ];
+            row.extend(tail.iter().cloned());
+            w.write_record(&row)?;
+        }
+    }
+    w.flush()?;
+    Ok(())
+}
+
+/// One quantity of `surfaces.csv`: its name there, its unit, the factor from SI, the value of a shot.
+type SurfaceQuantity = (&'static str, &'static str, f64, fn(&r::ShotMeasurement) -> Option<f64>);
+
+/// The quantities of `surfaces.csv`, measured first, then the model's.
+const SURFACE_QUANTITIES: [SurfaceQuantity; 16] = [
+    ("impact_speed", "m/s", 1.0, |m| Some(m.impact_speed().value)),
+    ("impact_angle", "deg", 1.0, |m| Some(m.impact_angle().value)),
+    ("v_in_n", "m/s", 1.0, |m| Some(m.v_in_m_s[1].value.abs())),
+    ("cor", "1", 1.0, |m| Some(m.cor.value)),
+    ("mu_eff", "1", 1.0, |m| Some(m.mu_eff.value)),
+    ("contact", "ms", 1e3, |m| Some(m.contact_time_s.value)),
+    ("delta_max", "mm", 1e3, |m| Some(m.delta_max_m.value)),
+    ("spin_in", "rad/s", 1.0, |m| m.spin_in_rad_s.map(|v| v.value)),
+    ("spin_out", "rad/s", 1.0, |m| m.spin_out_rad_s.map(|v| v.value)),
+    ("peak_decel_track", "m/s2", 1.0, |m| {
+        m.peak_deceleration_track_m_s2.map(|v| v.value)
+    }),
+    ("peak_force_track", "N", 1.0, |m| m.peak_force_track_n.map(|v| v.value)),
+    ("cor_model", "1", 1.0, |m| m.model.map(|p| p.cor)),
+    ("contact_model", "ms", 1e3, |m| m.model.map(|p| p.contact_time_s)),
+    ("delta_max_model", "mm", 1e3, |m| m.model.map(|p| p.delta_max_m)),
+    ("peak_force_model", "N", 1.0, |m| m.model.map(|p| p.peak_force_n)),
+    ("peak_decel_model", "m/s2", 1.0, |m| {
+        m.model.map(|p| p.peak_deceleration_m_s2)
+    }),
+];
+
+/// The files holding the numbers the report draws: `model_predictions.csv`, `model_curves.csv`,
+/// `contact_force.csv` (when the report has a contact) and `surfaces.csv`; returns their paths.
+pub(crate) fn write_figure_data(dir: &Path, report: &r::Report) -> Result<Vec<PathBuf>, AnalyzeError> {
+    let mut written = Vec::new();
+    let path = dir.join("model_predictions.csv");
+    write_atomic(&path, |out| {
+        let mut w = csv::Writer::from_writer(out);
+        w.write_record(PREDICTION_COLUMNS).map_err(csv_io)?;
+        for sh in &report.shots {
+            let p = report
+                .measurements
+                .iter()
+                .find(|m| m.clip == sh.clip)
+                .and_then(|m| m.model);
+            let f =
+                |g: fn(&r::ShotPrediction) -> f64, scale: f64| p.as_ref().map_or(String::new(), |p| num(g(p) * scale));
+            w.write_record([
+                sh.clip.clone(),
+                sh.surface.clone(),
+                num(sh.angle_deg),
+                f(|p| p.cor, 1.0),
+                f(|p| p.mu_eff, 1.0),
+                f(|p| p.contact_time_s, 1e3),
+                f(|p| p.delta_max_m, 1e3),
+                f(|p| p.spin_out_rad_s, 1.0),
+                f(|p| p.peak_force_n, 1.0),
+                f(|p| p.peak_deceleration_m_s2, 1.0),
+                sh.measured.len().to_string(),
+                sh.rms_m.map_or(String::new(), |v| num(v * 1e6)),
+                sh.chi2_red.map_or(String::new(), num),
+                sh.notes.join("; "),
+            ])
+            .map_err(csv_io)?;
+        }
+        w.flush()
+    })?;
+    written.push(path);
+    let path = dir.join("model_curves.csv");
+    write_atomic(&path, |out| {
+        let mut w = csv::Writer::from_writer(out);
+        w.write_record(CURVE_COLUMNS).map_err(csv_io)?;
+        for c in &report.model_curves {
+            for p in &c.points {
+                let q = &p.prediction;
+                w.write_record([
+                    c.surface.clone(),
+                    num(c.angle_deg),
+                    num(p.v_in_n_m_s),
+                    num(q.cor),
+                    num(q.mu_eff),
+                    num(q.contact_time_s * 1e3),
+                    num(q.delta_max_m * 1e3),
+                    num(q.spin_out_rad_s),
+                    num(q.peak_force_n),
+                    num(q.peak_deceleration_m_s2),
+                ])
+                .map_err(csv_io)?;
+            }
+        }
+        w.flush()
+    })?;
+    written.push(path);
+    if let Some(f) = report.contact_force.get() {
+        let path = dir.join("contact_force.csv");
+        write_atomic(&path, |out| {
+            let mut w = csv::Writer::from_writer(out);
+            w.write_record(FORCE_COLUMNS).map_err(csv_io)?;
+            for s in &f.samples {
+                w.write_record([
+                    f.clip.clone(),
+                    f.surface.clone(),
+                    num(s.t_s * 1e3),
+                    num(s.delta_m * 1e3),
+                    num(s.force_n),
+                ])
+                .map_err(csv_io)?;
+            }
+            w.flush()
+        })?;
+        written.push(path);
+    }
+    let path = dir.join("surfaces.csv");
+    write_atomic(&path, |out| {
+        let mut w = csv::Writer::from_writer(out);
+        w.write_record(SURFACE_COLUMNS).map_err(csv_io)?;
+        let mut surfaces: Vec<&str> = Vec::new();
+        for m in &report.measurements {
+            if !surfaces.contains(&m.surface.as_str()) {
+                surfaces.push(&m.surface);
+            }
+        }
+        for s in surfaces {
+            for (name, unit, scale, get) in SURFACE_QUANTITIES {
+                let v: Vec<f64> = report
+                    .measurements
+                    .iter()
+                    .filter(|m| m.surface == s)
+                    .filter_map(get)
+                    .map(|v| v * scale)
+                    .filter(|v| v.is_finite())
+                    .collect();
+                if v.is_empty() {
+                    continue;
+                }
+                let n = v.len() as f64;
+                let mean = v.iter().sum::<f64>() / n;
+                let sd = if v.len() > 1 {
+                    (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
+                } else {
+                    f64::NAN
+                };
+                w.write_record([s, name, unit, &v.len().to_string(), &num(mean), &num(sd)])
+                    .map_err(csv_io)?;
+            }
+        }
+        w.flush()
+    })?;
+    written.push(path);
+    Ok(written)
+}
+
+/// Where the diagnosis of model version `version` is kept in an output folder.
+fn kept_path(dir: &Path, version: i64) -> PathBuf {
+    dir.join("diagnoses").join(format!("model-v{version}.json"))
+}
+
+/// Keeps `d`, the diagnosis of model version `version`, in `dir/diagnoses/`.
+pub(crate) fn keep_diagnosis(dir: &Path, version: i64, d: &bouncelab_diagnose::Diagnosis) -> Result<(), AnalyzeError> {
+    let path = kept_path(dir, version);
+    if let Some(parent) = path.parent() {
+        std::fs::create_dir_all(parent).map_err(|source| AnalyzeError::Io {
+            path: parent.to_path_buf(),
+            source,
+        })?;
+    }
+    write_atomic(&path, |w| w.write_all(d.to_json().as_bytes()))
+}
+
+/// The kept diagnosis of model version `version`, if this output folder has a readable one.
+pub(crate) fn kept_diagnosis(dir: &Path, version: i64) -> Option<bouncelab_diagnose::Diagnosis> {
+    let text = std::fs::read_to_string(kept_path(dir, version)).ok()?;
+    serde_json::from_str(&text).ok()
 }
 
 /// `anova.csv`: the Type I table (the paper's Table 1), then the Type II table.
@@ -221,4 +542,78 @@ pub(crate) fn write_anova(dir: &Path, a: &bouncelab_stats::Ancova) -> Result<Pat
         bouncelab_stats::write_anova_csv(w, &[&a.type1, &a.type2]).map_err(std::io::Error::other)
     })?;
     Ok(path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every CSV's header, one file a line: the contract users read (refresh with BOUNCELAB_BLESS=1).
+    #[test]
+    fn csv_headers_match_the_golden_file() {
+        let actual: String = [
+            ("estimates.csv", &ESTIMATE_COLUMNS[..]),
+            ("comparison.csv", &COMPARISON_COLUMNS[..]),
+            ("model_predictions.csv", &PREDICTION_COLUMNS[..]),
+            ("model_curves.csv", &CURVE_COLUMNS[..]),
+            ("contact_force.csv", &FORCE_COLUMNS[..]),
+            ("surfaces.csv", &SURFACE_COLUMNS[..]),
+        ]
+        .iter()
+        .map(|(f, c)| format!("{f}: {}\n", c.join(",")))
+        .collect();
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/csv_headers.txt");
+        if std::env::var_os("BOUNCELAB_BLESS").is_some() {
+            std::fs::write(path, &actual).unwrap();
+        }
+        let expected = std::fs::read_to_string(path).expect("golden file (refresh with BOUNCELAB_BLESS=1)");
+        assert!(
+            expected == actual,
+            "CSV headers changed (refresh with BOUNCELAB_BLESS=1)\n--- expected\n{expected}\n--- actual\n{actual}"
+        );
+    }
+
+    /// Every column name but the text and dimensionless ones ends in a unit.
+    #[test]
+    fn every_column_names_its_unit() {
+        let units = ["_m_s", "_ms", "_mm", "_deg", "_rad_s", "_m_s2", "_s", "_m", "_n", "_um"];
+        let unitless = [
+            "clip",
+            "surface",
+            "notes",
+            "cor",
+            "cor_se",
+            "mu_eff",
+            "mu_eff_se",
+            "chi2_red_flight",
+            "phase",
+            "component",
+            "unit",
+            "n",
+            "rms",
+            "chi2_red",
+            "cor_err",
+            "mu_eff_err",
+            "quantity",
+            "mean",
+            "sd",
+            "frames",
+            "v_out_t_err_pct",
+            "v_out_n_err_pct",
+            "cor_err_pct",
+        ];
+        for c in ESTIMATE_COLUMNS
+            .iter()
+            .chain(&COMPARISON_COLUMNS)
+            .chain(&PREDICTION_COLUMNS)
+            .chain(&CURVE_COLUMNS)
+            .chain(&FORCE_COLUMNS)
+            .chain(&SURFACE_COLUMNS)
+        {
+            assert!(
+                unitless.contains(c) || units.iter().any(|u| c.ends_with(u)),
+                "column {c} names no unit"
+            );
+        }
+    }
 }

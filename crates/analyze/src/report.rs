@@ -1,18 +1,323 @@
-//! The report's data, filled from the analysis (the report crate takes plain data and knows no pipeline type).
+//! The report's data, filled from the analysis (the report crate takes plain data and knows no pipeline type),
+//! and the files that hold the same numbers as its figures (`model_predictions.csv`, `model_curves.csv`,
+//! `contact_force.csv`, `surfaces.csv`).
 
-use crate::{Analysis, BeforeAfter};
-use bouncelab_compare::{ImpactPhase, ShotComparison};
+use crate::{Analysis, ShotData};
+use bouncelab_compare::{Component, ImpactPhase, ShotComparison};
 use bouncelab_diagnose::{Diagnosis, VerdictKind};
+use bouncelab_fit::{FitResult, SimOptions, fitted_model, predict_impact};
+use bouncelab_model::{Model, ModelSpec};
 use bouncelab_report as r;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Points of each model curve.
+const CURVE_POINTS: usize = 25;
+/// The curves reach this far beyond a surface's measured speeds, as a fraction of their range.
+const CURVE_MARGIN: f64 = 0.1;
+/// Instants of the contact force, touch to separation.
+const FORCE_SAMPLES: usize = 200;
+/// Half-width of the local quadratic that gives the track's deceleration, s.
+const DECEL_HALF_WINDOW_S: f64 = 4e-4;
+/// Least frames in that quadratic.
+const DECEL_MIN_FRAMES: usize = 7;
+/// Least ratio of the peak deceleration to its standard error for it to count as measured.
+const DECEL_MIN_Z: f64 = 5.0;
+
+/// The peak normal deceleration of the ball's centre from its track (`frames` in the local frame, contact
+/// from `t0` to `t1`, s), m/s², with its standard error: a
+/// quadratic fitted by least squares to the height over ±0.4 ms around each contact frame (at least 7
+/// frames), twice its leading coefficient being the acceleration there; the largest over the contact. `None`
+/// when the contact holds too few frames for one such window (a slow camera) or the peak is not 5 standard
+/// errors above zero: then the track does not resolve it.
+///
+/// The window rounds the peak of a contact lasting T by about (2π·0.4 ms/T)²/10 (≈ 2 % at 4.5 ms), and the
+/// largest of several noisy windows leans high by about one to two standard errors: both are stated where
+/// the number is shown.
+pub fn track_peak_deceleration(frames: &[bouncelab_fit::MeasuredFrame], t0: f64, t1: f64) -> Option<(f64, f64)> {
+    if !(t0.is_finite() && t1 > t0) {
+        return None;
+    }
+    let mut best: Option<(f64, f64)> = None;
+    for (i, f) in frames.iter().enumerate() {
+        if f.t_s < t0 || f.t_s > t1 {
+            continue;
+        }
+        let window: Vec<&bouncelab_fit::MeasuredFrame> = frames
+            .iter()
+            .filter(|g| (g.t_s - f.t_s).abs() <= DECEL_HALF_WINDOW_S + 1e-9)
+            .collect();
+        if window.len() < DECEL_MIN_FRAMES {
+            continue;
+        }
+        let Some((a, se)) = curvature(&window, frames[i].t_s) else {
+            continue;
+        };
+        if best.is_none_or(|(b, _)| a > b) {
+            best = Some((a, se));
+        }
+    }
+    best.filter(|(a, se)| *se > 0.0 && *a > DECEL_MIN_Z * se)
+}
+
+/// Weighted least squares of y = c₀ + c₁τ + c₂τ² (τ = t − `at`): (2c₂, its standard error from the frames'
+/// σ, inflated by the fit's reduced χ² when that is above 1).
+fn curvature(window: &[&bouncelab_fit::MeasuredFrame], at: f64) -> Option<(f64, f64)> {
+    let mut ata = [[0.0f64; 3]; 3];
+    let mut aty = [0.0f64; 3];
+    for f in window {
+        let tau = f.t_s - at;
+        let w = 1.0 / (f.sigma_m * f.sigma_m);
+        let row = [1.0, tau, tau * tau];
+        for j in 0..3 {
+            aty[j] += w * row[j] * f.y_m;
+            for k in 0..3 {
+                ata[j][k] += w * row[j] * row[k];
+            }
+        }
+    }
+    let inv = invert3(&ata)?;
+    let c: Vec<f64> = (0..3).map(|j| (0..3).map(|k| inv[j][k] * aty[k]).sum()).collect();
+    let chi2: f64 = window
+        .iter()
+        .map(|f| {
+            let tau = f.t_s - at;
+            ((f.y_m - c[0] - c[1] * tau - c[2] * tau * tau) / f.sigma_m).powi(2)
+        })
+        .sum();
+    let dof = window.len().saturating_sub(3).max(1) as f64;
+    let scale = (chi2 / dof).max(1.0);
+    let se = 2.0 * (inv[2][2] * scale).sqrt();
+    (c[2].is_finite() && se.is_finite()).then_some((2.0 * c[2], se))
+}
+
+fn invert3(m: &[[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
+    let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+    if !(det.is_finite() && det.abs() > 0.0) {
+        return None;
+    }
+    let mut inv = [[0.0; 3]; 3];
+    for (i, row) in inv.iter_mut().enumerate() {
+        for (j, v) in row.iter_mut().enumerate() {
+            let (a, b) = ((j + 1) % 3, (j + 2) % 3);
+            let (c, d) = ((i + 1) % 3, (i + 2) % 3);
+            *v = (m[a][c] * m[b][d] - m[a][d] * m[b][c]) / det;
+        }
+    }
+    Some(inv)
+}
+
+/// What the fitted model predicts for the session: per shot, per surface against speed, and one contact.
+pub(crate) struct Predictions {
+    /// Per shot of `Analysis::shots`, in order.
+    pub per_shot: Vec<Option<r::ShotPrediction>>,
+    /// One curve per surface and incline.
+    pub curves: Vec<r::ModelCurve>,
+    /// The contact force of the shot nearest the median impact speed.
+    pub force: Result<r::ContactForce, String>,
+    /// Predictions that failed, one line each.
+    pub failures: Vec<String>,
+}
+
+fn prediction(p: &bouncelab_fit::ImpactPrediction) -> r::ShotPrediction {
+    r::ShotPrediction {
+        cor: p.cor,
+        mu_eff: p.mu_eff,
+        contact_time_s: p.contact_time_s,
+        delta_max_m: p.delta_max_m,
+        spin_out_rad_s: p.omega_out_rad_s,
+        peak_force_n: p.peak_force_n,
+        peak_deceleration_m_s2: p.peak_deceleration_m_s2,
+    }
+}
+
+/// The surfaces of `a`'s shots in order of first appearance.
+fn surfaces_of(shots: &[ShotData]) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    for s in shots {
+        if !out.contains(&s.surface) {
+            out.push(s.surface.clone());
+        }
+    }
+    out
+}
+
+/// The fitted model's predictions for every shot, every surface and incline over its measured speeds, and
+/// the contact force of the shot nearest the session's median impact speed.
+pub(crate) fn predictions(spec: &ModelSpec, fit: &FitResult, shots: &[ShotData]) -> Predictions {
+    let sim = SimOptions::default();
+    let mut failures = Vec::new();
+    let mut models: BTreeMap<String, Result<Model, String>> = BTreeMap::new();
+    for s in surfaces_of(shots) {
+        let m = fitted_model(spec, fit, &s).map_err(|e| e.to_string());
+        if let Err(e) = &m {
+            failures.push(format!("surface {s}: no fitted model to predict with: {e}"));
+        }
+        models.insert(s, m);
+    }
+    let at = |s: &ShotData, samples: usize| {
+        let model = models.get(&s.surface).and_then(|m| m.as_ref().ok())?;
+        let e = &s.estimate;
+        let v = [e.v_in[0].value, e.v_in[1].value];
+        Some(
+            predict_impact(
+                model,
+                s.angle_deg.to_radians(),
+                v,
+                e.spin_in.map_or(0.0, |w| w.value),
+                samples,
+                &sim,
+            )
+            .map_err(|err| format!("{}: the fitted model's prediction failed: {err}", s.clip)),
+        )
+    };
+    let per_shot = shots
+        .iter()
+        .map(|s| match at(s, 20)? {
+            Ok(p) => Some(prediction(&p)),
+            Err(e) => {
+                failures.push(e);
+                None
+            }
+        })
+        .collect();
+    let mut curves = Vec::new();
+    for (surface, model) in &models {
+        let Ok(model) = model else { continue };
+        let of: Vec<&ShotData> = shots.iter().filter(|s| &s.surface == surface).collect();
+        let speeds: Vec<f64> = of
+            .iter()
+            .map(|s| s.estimate.v_in[1].value.abs())
+            .filter(|v| v.is_finite() && *v > 0.0)
+            .collect();
+        let (lo, hi) = speeds
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(*v), b.max(*v)));
+        if !lo.is_finite() {
+            continue;
+        }
+        let pad = ((hi - lo) * CURVE_MARGIN).max(0.05 * lo);
+        let (lo, hi) = ((lo - pad).max(0.05), hi + pad);
+        let mut angles: Vec<f64> = of.iter().map(|s| s.angle_deg).filter(|a| a.is_finite()).collect();
+        angles.sort_by(f64::total_cmp);
+        angles.dedup();
+        for angle in angles {
+            let beta = angle.to_radians();
+            let mut points = Vec::with_capacity(CURVE_POINTS);
+            for k in 0..CURVE_POINTS {
+                let v = lo + (hi - lo) * k as f64 / (CURVE_POINTS - 1) as f64;
+                // A vertical drop onto the incline: the tangential speed is v_n·tan β.
+                match predict_impact(model, beta, [v * beta.tan(), -v], 0.0, 20, &sim) {
+                    Ok(p) => points.push(r::CurvePoint {
+                        v_in_n_m_s: v,
+                        prediction: prediction(&p),
+                    }),
+                    Err(e) => failures.push(format!(
+                        "surface {surface} at {angle}°: the model's curve stops at {v:.3} m/s: {e}"
+                    )),
+                }
+            }
+            curves.push(r::ModelCurve {
+                surface: surface.clone(),
+                angle_deg: angle,
+                points,
+            });
+        }
+    }
+    let force = median_shot(shots)
+        .ok_or_else(|| "no shot with a measured impact speed".to_string())
+        .and_then(|s| {
+            let p = at(s, FORCE_SAMPLES).ok_or_else(|| format!("no fitted model for surface {}", s.surface))??;
+            Ok(r::ContactForce {
+                clip: s.clip.clone(),
+                surface: s.surface.clone(),
+                angle_deg: s.angle_deg,
+                v_in_n_m_s: s.estimate.v_in[1].value.abs(),
+                why: "the shot nearest the session's median impact speed".into(),
+                samples: p
+                    .force
+                    .iter()
+                    .map(|f| r::ForceSample {
+                        t_s: f.t_s,
+                        delta_m: f.delta_m,
+                        force_n: f.force_n,
+                    })
+                    .collect(),
+            })
+        });
+    Predictions {
+        per_shot,
+        curves,
+        force,
+        failures,
+    }
+}
+
+/// The shot whose incoming normal speed is nearest the session's median (the lower median for an even
+/// count).
+fn median_shot(shots: &[ShotData]) -> Option<&ShotData> {
+    let mut v: Vec<(f64, usize)> = shots
+        .iter()
+        .enumerate()
+        .map(|(i, s)| (s.estimate.v_in[1].value.abs(), i))
+        .filter(|(v, _)| v.is_finite())
+        .collect();
+    v.sort_by(|a, b| a.0.total_cmp(&b.0));
+    v.get(v.len().saturating_sub(1) / 2).map(|&(_, i)| &shots[i])
+}
+
+fn measured(m: bouncelab_estimate::Measured) -> r::Measured {
+    r::Measured::new(m.value, m.se)
+}
+
+/// Every measured quantity of a shot, with the model's prediction for it; `ball_mass_kg` and `gravity`
+/// turn the track's deceleration into a force.
+pub(crate) fn measurement(
+    s: &ShotData,
+    model: Option<r::ShotPrediction>,
+    ball_mass_kg: f64,
+    gravity: f64,
+) -> r::ShotMeasurement {
+    let e = &s.estimate;
+    let decel = track_peak_deceleration(&s.measured.frames, e.t_touch.value, e.t_sep.value);
+    let g_n = gravity * s.angle_deg.to_radians().cos();
+    r::ShotMeasurement {
+        clip: s.clip.clone(),
+        surface: s.surface.clone(),
+        angle_deg: s.angle_deg,
+        drop_height_m: Some(s.drop_height_m).filter(|h| h.is_finite()),
+        v_in_m_s: [measured(e.v_in[0]), measured(e.v_in[1])],
+        v_out_m_s: [measured(e.v_out[0]), measured(e.v_out[1])],
+        cor: measured(e.cor),
+        // −0 (a vertical drop's exact zero) is shown as 0.
+        mu_eff: r::Measured::new(e.mu.value + 0.0, e.mu.se),
+        contact_time_s: r::Measured::new(e.contact_ms.value * 1e-3, e.contact_ms.se * 1e-3),
+        delta_max_m: measured(e.delta_max_m),
+        spin_in_rad_s: e.spin_in.map(measured),
+        spin_out_rad_s: e.spin_out.map(measured),
+        peak_deceleration_track_m_s2: decel.map(|(a, se)| r::Measured::new(a, se)),
+        peak_force_track_n: decel.map(|(a, se)| r::Measured::new(ball_mass_kg * (a + g_n), ball_mass_kg * se)),
+        model,
+    }
+}
+
+/// A shot's reduced χ²: its χ² over its share of the fit's degrees of freedom, in proportion to its
+/// residuals (two per frame), so the shots' values weighted by frames average to the fit's.
+pub(crate) fn shot_chi2_red(fit: &FitResult, shot: &str) -> Option<f64> {
+    let total: usize = fit.shots.iter().map(|s| 2 * s.frames).sum();
+    let s = fit.shots.iter().find(|s| s.name == shot)?;
+    let nu = (2 * s.frames) as f64 * fit.dof as f64 / total as f64;
+    (nu > 0.0).then(|| s.chi2 / nu)
+}
 
 /// Everything `report.html` shows about `a`.
-pub(crate) fn build(a: &Analysis, description: Option<&str>, warnings: &[String]) -> r::Report {
-    let mut surfaces: Vec<String> = a.shots.iter().map(|s| s.surface.clone()).collect();
-    surfaces.sort();
-    surfaces.dedup();
+pub(crate) fn build(a: &Analysis, p: &Predictions, description: Option<&str>, warnings: &[String]) -> r::Report {
+    let surfaces = surfaces_of(&a.shots);
     let mut notes: Vec<String> = warnings.to_vec();
     notes.extend(a.measure.failed.iter().map(|(c, m)| format!("{c}: not measured: {m}")));
     notes.extend(a.excluded.iter().map(|(c, m)| format!("{c}: left out of the fit: {m}")));
+    notes.extend(p.failures.iter().cloned());
     let session_name = a
         .session_dir
         .file_name()
@@ -27,41 +332,39 @@ pub(crate) fn build(a: &Analysis, description: Option<&str>, warnings: &[String]
             surfaces,
             generated_by: format!("bouncelab {}", env!("CARGO_PKG_VERSION")),
             generated_at: a.fitted_at.clone(),
-            metadata: vec![
-                ("model".into(), a.model_origin.clone()),
-                ("shots measured".into(), a.shots.len().to_string()),
-                ("shots fitted".into(), a.comparison.shots.len().to_string()),
-            ],
+            metadata: vec![("Model".into(), a.model_origin.clone())],
         },
         shots: a.comparison.shots.iter().map(|c| shot_plot(a, c)).collect(),
-        cor_points: a
+        measurements: a
             .shots
             .iter()
-            .map(|s| r::CorPoint {
-                clip: s.clip.clone(),
-                surface: s.surface.clone(),
-                angle_deg: s.angle_deg,
-                v_in_n: s.estimate.v_in[1].value.abs(),
-                v_in_n_se: Some(s.estimate.v_in[1].se),
-                cor: s.estimate.cor.value,
-                cor_se: Some(s.estimate.cor.se),
-            })
+            .zip(&p.per_shot)
+            .map(|(s, m)| measurement(s, *m, a.model.ball.mass_kg, a.model.gravity))
             .collect(),
+        model_curves: p.curves.clone(),
+        contact_force: match &p.force {
+            Ok(f) => r::Section::Available(f.clone()),
+            Err(e) => r::Section::unavailable(e.clone()),
+        },
         ancova: match &a.stats {
             Ok(s) => r::Section::Available(s.ancova.clone()),
             Err(e) => r::Section::unavailable(e.clone()),
         },
-        tukey: match &a.stats {
-            Ok(s) => match &s.tukey {
-                Some(t) => r::Section::Available(t.clone()),
-                None => r::Section::unavailable("one surface only: nothing to compare"),
+        inference: match &a.stats {
+            Ok(s) => match &s.inference {
+                Ok(i) => r::Section::Available(i.clone()),
+                Err(e) => r::Section::unavailable(e.clone()),
             },
             Err(e) => r::Section::unavailable(e.clone()),
         },
         fit: r::Section::Available(fit_summary(a)),
         diagnosis: match &a.diagnosis {
-            Ok(d) => r::Section::Available(diagnosis(d, a.before.as_ref(), a)),
+            Ok(d) => r::Section::Available(diagnosis(d, a)),
             Err(why) => r::Section::unavailable(why.clone()),
+        },
+        model_change: match &a.before {
+            Some(_) => r::Section::Available(model_change(a)),
+            None => r::Section::unavailable("this is the first model fitted to this session in the store"),
         },
         warnings: notes,
         timings: a.timings.iter().map(|(s, t)| (s.name().to_string(), *t)).collect(),
@@ -74,6 +377,18 @@ fn phase(p: ImpactPhase) -> r::Phase {
         ImpactPhase::Compression => r::Phase::Compression,
         ImpactPhase::Restitution => r::Phase::Restitution,
         ImpactPhase::FlightOut => r::Phase::FlightOut,
+    }
+}
+
+/// The fitted surface level of a shot (the surface's plus the shot's own offset), m.
+fn surface_level(a: &Analysis, surface: &str, shot: &str) -> Option<f64> {
+    let fit = a.fit.shots.iter().find(|s| s.name == shot);
+    match (
+        crate::fitted_surface_level(&a.fit, surface),
+        fit.and_then(|f| f.surface_offset_m),
+    ) {
+        (None, None) => None,
+        (a, b) => Some(a.unwrap_or(0.0) + b.unwrap_or(0.0)),
     }
 }
 
@@ -102,19 +417,19 @@ fn shot_plot(a: &Analysis, c: &ShotComparison) -> r::ShotPlot {
             y_m: f.y_m - p.dy_m,
         })
         .collect();
-    let fit = a.fit.shots.iter().find(|s| s.name == c.shot);
     let mut notes = data.map(|s| s.estimate.notes.clone()).unwrap_or_default();
-    let level = match (
-        crate::fitted_surface_level(&a.fit, &c.surface),
-        fit.and_then(|f| f.surface_offset_m),
-    ) {
-        (None, None) => None,
-        (a, b) => Some(a.unwrap_or(0.0) + b.unwrap_or(0.0)),
-    };
-    if let Some(level) = level {
+    if let Some(level) = surface_level(a, &c.surface, &c.shot) {
+        // The level is the true surface's height in the measured frame: a negative one lies below the line
+        // found in the image, so the line lies above the plane the ball touches.
+        let (where_, size) = if level <= 0.0 {
+            ("above", -level)
+        } else {
+            ("below", level)
+        };
         notes.push(format!(
-            "fitted surface level {:+.1} µm: the surface line found in the image lies that far above the plane the ball touches",
-            level * 1e6
+            "fitted surface level {} µm: the surface line found in the image lies {:.1} µm {where_} the plane the ball touches",
+            format!("{:+.1}", level * 1e6).replace('-', "\u{2212}"),
+            size * 1e6
         ));
     }
     r::ShotPlot {
@@ -143,8 +458,9 @@ fn shot_plot(a: &Analysis, c: &ShotComparison) -> r::ShotPlot {
             })
             .collect(),
         rms_m: Some(c.rms_m),
-        chi2_red: (c.n > 0).then(|| c.chi2 / c.n as f64),
+        chi2_red: shot_chi2_red(&a.fit, &c.shot),
         notes,
+        frames: Vec::new(),
     }
 }
 
@@ -176,8 +492,9 @@ fn fit_summary(a: &Analysis) -> r::FitSummary {
             .collect(),
         confidence: f.confidence,
         reduced_chi2: Some(f.reduced_chi2),
+        dof: Some(f.dof),
         rms_m: Some(f.rms_m),
-        termination: f.termination.to_string(),
+        termination: format!("{} after {} iteration(s)", f.termination, f.iterations),
         mean_abs_error_pct: f.mean_abs_cor_error_pct,
         by_surface: f
             .cor_error_by_surface
@@ -203,30 +520,108 @@ fn fit_summary(a: &Analysis) -> r::FitSummary {
     }
 }
 
-fn diagnosis(d: &Diagnosis, before: Option<&BeforeAfter>, a: &Analysis) -> r::DiagnosisSection {
-    let kind = match d.verdict.kind {
+fn verdict_kind(k: VerdictKind) -> r::VerdictKind {
+    match k {
         VerdictKind::MissingEffect => r::VerdictKind::MissingEffect,
         VerdictKind::NoMissingEffect => r::VerdictKind::NoMissingEffect,
         VerdictKind::Ambiguous => r::VerdictKind::Ambiguous,
         VerdictKind::NoneExplains => r::VerdictKind::NoCandidateExplains,
-    };
+    }
+}
+
+/// The verdict in a few words: the kind, the effect(s) named and the held-out error they leave.
+pub fn verdict_headline(d: &Diagnosis) -> String {
+    let named = |e: &str| d.candidate(e).and_then(|c| c.evidence.as_ref().map(|ev| (c, ev)));
+    match d.verdict.kind {
+        VerdictKind::MissingEffect => match d.verdict.effect.as_deref().and_then(|e| named(e).map(|x| (e, x))) {
+            Some((e, (c, ev))) => format!(
+                "`{e}` is missing: held-out error {:.1} → {:.1} µm",
+                c.heldout_error_before * 1e6,
+                ev.heldout_error_after * 1e6
+            ),
+            None => "an effect is missing".into(),
+        },
+        VerdictKind::Ambiguous => {
+            let names: Vec<String> = d.verdict.effects.iter().map(|e| format!("`{e}`")).collect();
+            format!("these explain the misfit about equally well: {}", names.join(", "))
+        }
+        VerdictKind::NoMissingEffect => format!(
+            "the model fits to the noise (position RMS {:.1} µm, noise {:.1} µm)",
+            d.baseline.fit.rms_m * 1e6,
+            d.noise.noise_m * 1e6
+        ),
+        VerdictKind::NoneExplains => format!(
+            "no library effect explains the misfit (systematic {:.1} µm); see its signature{}",
+            d.baseline.systematic_m * 1e6,
+            if d.proposal.is_some() {
+                " and the proposed formula term"
+            } else {
+                ""
+            }
+        ),
+    }
+}
+
+fn signature(d: &Diagnosis) -> Vec<r::SignatureRow> {
+    d.signature
+        .phases
+        .iter()
+        .filter(|p| p.component != Component::Spin)
+        .map(|p| r::SignatureRow {
+            phase: phase(p.phase),
+            normal: p.component == Component::Normal,
+            rms_m: p.rms_m,
+            systematic_m: p.systematic_m,
+            chi2_share: p.chi2_share,
+        })
+        .collect()
+}
+
+/// The signature of the current fit from its comparison, when no diagnosis ran: the systematic part taken
+/// above the RMS of the tracker's σ.
+fn signature_of_comparison(a: &Analysis) -> Vec<r::SignatureRow> {
+    let c = &a.comparison;
+    let (s2, n) = a
+        .shots
+        .iter()
+        .flat_map(|s| &s.measured.frames)
+        .fold((0.0, 0usize), |(acc, n), f| (acc + f.sigma_m * f.sigma_m, n + 1));
+    let noise2 = s2 / n.max(1) as f64;
+    let chi2: f64 = c
+        .overall
+        .iter()
+        .filter(|s| s.component != Component::Spin)
+        .map(|s| s.chi2)
+        .sum();
+    let mut rows: Vec<r::SignatureRow> = c
+        .overall
+        .iter()
+        .filter(|s| s.component != Component::Spin)
+        .map(|s| r::SignatureRow {
+            phase: phase(s.phase),
+            normal: s.component == Component::Normal,
+            rms_m: s.rms_m,
+            systematic_m: (s.rms_m * s.rms_m - noise2).max(0.0).sqrt(),
+            chi2_share: if chi2 > 0.0 { s.chi2 / chi2 } else { 0.0 },
+        })
+        .collect();
+    rows.sort_by(|a, b| b.chi2_share.total_cmp(&a.chi2_share));
+    rows
+}
+
+fn diagnosis(d: &Diagnosis, a: &Analysis) -> r::DiagnosisSection {
     let mut evidence: Vec<String> = d.signature.sentences.clone();
     for reason in &d.baseline.misfit_reasons {
         if !evidence.contains(reason) {
             evidence.push(reason.clone());
         }
     }
-    let surface_of = |clip: &str| {
-        a.shots
-            .iter()
-            .find(|s| s.clip == clip)
-            .map(|s| s.surface.clone())
-            .unwrap_or_default()
-    };
     r::DiagnosisSection {
-        verdict_kind: kind,
+        verdict_kind: verdict_kind(d.verdict.kind),
+        headline: verdict_headline(d),
         verdict_text: d.verdict.sentence.clone(),
         evidence,
+        signature: signature(d),
         error_metric: "position RMS of all frames (x and y), held-out by cross-validation across shots".into(),
         candidates: d
             .candidates
@@ -240,23 +635,6 @@ fn diagnosis(d: &Diagnosis, before: Option<&BeforeAfter>, a: &Analysis) -> r::Di
                 heldout_after: c.evidence.as_ref().map(|e| e.heldout_error_after),
             })
             .collect(),
-        model_before: before.map(|b| b.before_model.clone()).unwrap_or_default(),
-        model_after: a.model_origin.clone(),
-        before_after: before
-            .map(|b| {
-                b.shots
-                    .iter()
-                    .map(|(clip, x, y)| r::ShotBeforeAfter {
-                        clip: clip.clone(),
-                        surface: surface_of(clip),
-                        rms_before_m: *x,
-                        rms_after_m: *y,
-                    })
-                    .collect()
-            })
-            .unwrap_or_default(),
-        total_rms_before_m: before.map(|b| b.total_rms_m.0),
-        total_rms_after_m: before.map(|b| b.total_rms_m.1),
         model_history: a
             .history
             .iter()
@@ -274,16 +652,71 @@ fn diagnosis(d: &Diagnosis, before: Option<&BeforeAfter>, a: &Analysis) -> r::Di
     }
 }
 
-/// Writes `report.html` into `dir` and returns its path.
+/// The effects of a model file's text, by name; empty when it does not parse.
+fn effect_names(toml: &str) -> Vec<String> {
+    ModelSpec::parse(toml, "earlier model")
+        .map(|s| s.effects.iter().map(|e| e.name.clone()).collect())
+        .unwrap_or_default()
+}
+
+fn model_change(a: &Analysis) -> r::ModelChange {
+    let b = a.before.as_ref().expect("called with a previous fit");
+    let before: Vec<String> = effect_names(&b.before_toml);
+    // The analysis adds the surface level itself to every model; it is no change of the model file.
+    let before_has = |e: &str| before.iter().any(|x| x == e) || e == "surface_level";
+    let after: Vec<String> = a.model.effects.iter().map(|e| e.name.clone()).collect();
+    let surface_of = |clip: &str| {
+        a.shots
+            .iter()
+            .find(|s| s.clip == clip)
+            .map(|s| s.surface.clone())
+            .unwrap_or_default()
+    };
+    r::ModelChange {
+        model_before: b.before_model.clone(),
+        model_after: a.model_origin.clone(),
+        effects_added: after.iter().filter(|e| !before_has(e)).cloned().collect(),
+        effects_removed: before.iter().filter(|e| !after.contains(e)).cloned().collect(),
+        verdict_before: a.previous_diagnosis.as_ref().map(|d| r::EarlierVerdict {
+            kind: verdict_kind(d.verdict.kind),
+            text: d.verdict.sentence.clone(),
+        }),
+        signature_before: a.previous_diagnosis.as_ref().map(signature).unwrap_or_default(),
+        signature_after: match &a.diagnosis {
+            Ok(d) => signature(d),
+            Err(_) => signature_of_comparison(a),
+        },
+        shots: b
+            .shots
+            .iter()
+            .map(|(clip, x, y)| r::ShotBeforeAfter {
+                clip: clip.clone(),
+                surface: surface_of(clip),
+                rms_before_m: *x,
+                rms_after_m: *y,
+            })
+            .collect(),
+        total_rms_before_m: b.total_rms_m.0,
+        total_rms_after_m: b.total_rms_m.1,
+        reduced_chi2_before: b.reduced_chi2.0,
+        reduced_chi2_after: b.reduced_chi2.1,
+    }
+}
+
+/// Writes `report.html` and the files of its figures' numbers into `dir`; returns their paths.
 pub(crate) fn write(
-    dir: &std::path::Path,
+    dir: &Path,
     a: &Analysis,
     description: Option<&str>,
     warnings: &[String],
-) -> Result<std::path::PathBuf, crate::AnalyzeError> {
+) -> Result<Vec<PathBuf>, crate::AnalyzeError> {
+    let p = predictions(&a.model, &a.fit, &a.shots);
+    let report = build(a, &p, description, warnings);
+    let mut written = crate::outputs::write_figure_data(dir, &report)?;
     let path = dir.join("report.html");
-    bouncelab_report::write_report(&path, &build(a, description, warnings))?;
-    Ok(path)
+    bouncelab_report::write_report(&path, &report)?;
+    written.push(path);
+    Ok(written)
 }
 
 /// `report.html` when no shot could be measured: the session, and every shot's failure with how far it got
@@ -322,16 +755,94 @@ pub(crate) fn write_failure(
             generated_at: None,
             metadata: vec![("shots measured".into(), "0".into())],
         },
-        shots: Vec::new(),
-        cor_points: Vec::new(),
+        contact_force: r::Section::unavailable(none),
         ancova: r::Section::unavailable(none),
-        tukey: r::Section::unavailable(none),
+        inference: r::Section::unavailable(none),
         fit: r::Section::unavailable(none),
         diagnosis: r::Section::unavailable(none),
+        model_change: r::Section::unavailable(none),
         warnings: notes,
-        timings: Vec::new(),
+        ..Default::default()
     };
     let path = dir.join("report.html");
     bouncelab_report::write_report(&path, &report)?;
     Ok(path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use bouncelab_fit::MeasuredFrame;
+
+    #[test]
+    fn the_inverse_of_a_3x3_matrix() {
+        let m = [[4.0, 1.0, 0.5], [1.0, 3.0, 0.2], [0.5, 0.2, 2.0]];
+        let inv = invert3(&m).unwrap();
+        for (i, row) in m.iter().enumerate() {
+            for j in 0..3 {
+                let v: f64 = row.iter().zip(&inv).map(|(a, b)| a * b[j]).sum();
+                assert!((v - f64::from(u8::from(i == j))).abs() < 1e-12, "{i}{j}: {v}");
+            }
+        }
+        assert!(invert3(&[[1.0, 2.0, 3.0], [2.0, 4.0, 6.0], [0.0, 0.0, 1.0]]).is_none());
+    }
+
+    /// A half-sine contact sampled at `fps` with noise σ, and the true peak deceleration.
+    fn contact(fps: f64, sigma: f64, seed: u64) -> (Vec<MeasuredFrame>, f64, f64, f64) {
+        let (t0, tc, v) = (0.01, 4.5e-3, 2.5);
+        let w = std::f64::consts::PI / tc;
+        let mut state = seed;
+        let mut normal = || {
+            // Box–Muller from a SplitMix64 stream.
+            let mut u = || {
+                state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+                let mut z = state;
+                z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+                z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+                ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64 + 1e-12
+            };
+            let (a, b) = (u(), u());
+            (-2.0 * a.ln()).sqrt() * (std::f64::consts::TAU * b).cos()
+        };
+        let frames = (0..((0.02 * fps) as usize))
+            .map(|k| {
+                let t = k as f64 / fps;
+                let y = if t < t0 {
+                    0.0335 + v * (t0 - t)
+                } else if t < t0 + tc {
+                    0.0335 - v / w * (w * (t - t0)).sin()
+                } else {
+                    0.0335 + v * (t - t0 - tc)
+                };
+                MeasuredFrame {
+                    t_s: t,
+                    x_m: 0.0,
+                    y_m: y + sigma * normal(),
+                    sigma_m: sigma,
+                }
+            })
+            .collect();
+        (frames, t0, t0 + tc, v * w)
+    }
+
+    #[test]
+    fn the_track_gives_the_peak_deceleration_of_a_half_sine() {
+        // 10,000 fps, 5 µm noise: the truth within three standard errors plus the window's rounding (the
+        // largest of several windows leans high, the quadratic low).
+        for seed in 1..9 {
+            let (frames, t0, t1, truth) = contact(10_000.0, 5e-6, seed);
+            let (a, se) = track_peak_deceleration(&frames, t0, t1).expect("resolved at 10 kHz");
+            assert!(
+                (a - truth).abs() < 3.0 * se + 0.03 * truth,
+                "seed {seed}: {a} ± {se} vs {truth}"
+            );
+            assert!(se > 0.0 && se < 0.05 * truth, "{se}");
+        }
+        // A slow camera has too few contact frames for the quadratic: not measured, not guessed.
+        let (frames, t0, t1, _) = contact(1_000.0, 5e-6, 1);
+        assert!(track_peak_deceleration(&frames, t0, t1).is_none());
+        // Noise far above the signal: not measured either.
+        let (frames, t0, t1, _) = contact(10_000.0, 2e-3, 1);
+        assert!(track_peak_deceleration(&frames, t0, t1).is_none());
+    }
 }

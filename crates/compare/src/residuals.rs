@@ -217,9 +217,10 @@ pub struct Comparison {
     pub chi2: f64,
     /// Total number of residuals.
     pub n_residuals: usize,
-    /// Fitted parameters subtracted from the degrees of freedom.
+    /// Fitted parameters subtracted from the degrees of freedom (shared ones and per-shot nuisances).
     pub n_params: usize,
-    /// χ² / (n_residuals − n_params).
+    /// The fit's reduced χ²: the positions' χ² over their residuals − `n_params` (spin residuals, which the
+    /// fit does not minimise, are left out, so this is the number the fit reports).
     pub chi2_red_total: f64,
 }
 
@@ -447,20 +448,24 @@ pub fn compare(
     let overall = stats_of(&total);
     let chi2: f64 = per.iter().map(|s| s.chi2).sum();
     let n_residuals: usize = per.iter().map(|s| s.n).sum();
-    let dof = n_residuals.saturating_sub(n_params);
+    let positions = overall.iter().filter(|s| s.component != Component::Spin);
+    let (chi2_pos, n_pos) = positions.fold((0.0, 0usize), |(c, n), s| (c + s.chi2, n + s.n));
+    let dof = n_pos.saturating_sub(n_params);
     Ok(Comparison {
         shots: per,
         overall,
         chi2,
         n_residuals,
         n_params,
-        chi2_red_total: if dof > 0 { chi2 / dof as f64 } else { f64::NAN },
+        chi2_red_total: if dof > 0 { chi2_pos / dof as f64 } else { f64::NAN },
     })
 }
 
-/// Simulates the problem's shots at `theta` (e.g. the fitted parameters) and compares them; the number of
-/// free parameters is subtracted from the degrees of freedom.
+/// Simulates the problem's shots at `theta` (e.g. the fitted parameters) and compares them; the free
+/// parameters and each shot's surface level (when the problem fits them) are subtracted from the degrees of
+/// freedom, as the fit does.
 pub fn compare_problem(problem: &Problem, theta: &[f64], extras: &[ShotExtras]) -> Result<Comparison, CompareError> {
     let sims = problem.simulate(theta)?;
-    compare(problem.shots(), &sims, extras, problem.params().len())
+    let n_params = problem.params().len() + problem.nuisance_per_shot() * problem.shots().len();
+    compare(problem.shots(), &sims, extras, n_params)
 }

@@ -62,7 +62,11 @@ pub fn find_impact(points: &[HeightPoint], a_px: f64, m_per_px: f64) -> Result<u
     let margin = |p: &HeightPoint| 5.0 * p.sigma.max(0.05);
     let before = &points[..low];
     let after = &points[low + 1..];
-    if before.len() >= 3 && after.len() >= 3 && rise(before) > margin(&points[low]) && rise(after) > margin(&points[low]) {
+    if before.len() >= 3
+        && after.len() >= 3
+        && rise(before) > margin(&points[low])
+        && rise(after) > margin(&points[low])
+    {
         return Ok(low);
     }
     // No impact: the normal speed at the last frame from a ballistic fit of the whole clip (or of its last
@@ -169,11 +173,18 @@ fn onset(side: &[HeightPoint], _lowest: f64, a_px: f64, _radius_px: f64) -> Opti
     }
     let dt = median_step(side)?;
     let (t_first, t_low) = (side[0].t, side[side.len() - 1].t);
-    let early: Vec<HeightPoint> = side.iter().copied().filter(|p| p.t <= 0.5 * (t_first + t_low)).collect();
+    let early: Vec<HeightPoint> = side
+        .iter()
+        .copied()
+        .filter(|p| p.t <= 0.5 * (t_first + t_low))
+        .collect();
     if early.len() < MIN_FLIGHT_FRAMES {
         return None;
     }
-    let clock = Clock { t_ref: early[early.len() - 1].t, dt };
+    let clock = Clock {
+        t_ref: early[early.len() - 1].t,
+        dt,
+    };
     let (c, _, chi2) = fit_onset(&early, a_px, &clock, None)?;
     let inflate = (chi2 / (early.len() as f64 - 2.0).max(1.0)).max(1.0).sqrt();
     let a_u = a_px * dt * dt;
@@ -224,7 +235,11 @@ fn onset(side: &[HeightPoint], _lowest: f64, a_px: f64, _radius_px: f64) -> Opti
 
 /// The median time between consecutive points, s.
 fn median_step(points: &[HeightPoint]) -> Option<f64> {
-    let mut d: Vec<f64> = points.windows(2).map(|w| (w[1].t - w[0].t).abs()).filter(|d| *d > 0.0).collect();
+    let mut d: Vec<f64> = points
+        .windows(2)
+        .map(|w| (w[1].t - w[0].t).abs())
+        .filter(|d| *d > 0.0)
+        .collect();
     if d.is_empty() {
         return None;
     }
@@ -335,7 +350,9 @@ fn weighted_lsq(
 /// when it is singular.
 fn invert(mut a: Vec<Vec<f64>>) -> Option<Vec<Vec<f64>>> {
     let n = a.len();
-    let mut inv: Vec<Vec<f64>> = (0..n).map(|i| (0..n).map(|j| if i == j { 1.0 } else { 0.0 }).collect()).collect();
+    let mut inv: Vec<Vec<f64>> = (0..n)
+        .map(|i| (0..n).map(|j| if i == j { 1.0 } else { 0.0 }).collect())
+        .collect();
     for col in 0..n {
         let piv = (col..n).max_by(|&x, &y| a[x][col].abs().total_cmp(&a[y][col].abs()))?;
         let scale = a.iter().map(|r| r[col].abs()).fold(0.0, f64::max);

@@ -15,7 +15,9 @@ mod spin;
 
 pub use ballistic::{BallisticFit, fit_ballistic, fit_free_acceleration};
 pub use contact::{HeightPoint, TrajectoryContact, find_impact, trajectory_contact};
-pub use shot::{Conditions, Estimate, EstimateError, GravityCheck, MIN_FLIGHT_FRAMES, MIN_SIGMA_PX, Measured, PhaseFrames, estimate};
+pub use shot::{
+    Conditions, Estimate, EstimateError, GravityCheck, MIN_FLIGHT_FRAMES, MIN_SIGMA_PX, Measured, PhaseFrames, estimate,
+};
 pub use spin::{
     Rotation, Spin, SpinFrame, SpinOptions, estimate_with_frames, measure_spin, rotation_between, spin_from_frames,
 };

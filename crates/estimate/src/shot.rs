@@ -166,11 +166,7 @@ pub enum EstimateError {
         speed_m_s.abs(),
         se_m_s
     )]
-    NoImpact {
-        frames: usize,
-        speed_m_s: f64,
-        se_m_s: f64,
-    },
+    NoImpact { frames: usize, speed_m_s: f64, se_m_s: f64 },
     /// A flight phase has too few frames to fit.
     #[error(
         "{phase} flight too short to fit: {frames} usable frame(s), {needed} needed (the clip {which} too close to the impact)"
@@ -231,7 +227,10 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
     // The frame's origin: on the line, below the lowest centre.
     let lowest = measured
         .iter()
-        .min_by(|a, b| line.height_of(a.x_px, a.y_px).total_cmp(&line.height_of(b.x_px, b.y_px)))
+        .min_by(|a, b| {
+            line.height_of(a.x_px, a.y_px)
+                .total_cmp(&line.height_of(b.x_px, b.y_px))
+        })
         .expect("measured frames");
     let frame = SurfaceFrame::on_line(&line, lowest.x_px, lowest.y_px, track.downslope_negative_x, s);
     let points: Vec<Point> = measured
@@ -293,7 +292,11 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
     // surface's clips share (see `Estimate::surface_sigma_m`).
     // A level taken from the trajectory is where the centre was at the touch, one radius above a line put
     // one radius below it: the scale's error in that radius cancels.
-    let radius_scale = if line.cue == LineCue::Trajectory { 0.0 } else { radius / s };
+    let radius_scale = if line.cue == LineCue::Trajectory {
+        0.0
+    } else {
+        radius / s
+    };
     let sigma_level = ((line.sigma_y0.powi(2) + line.edge_definition_px.powi(2) / 3.0) * s * s
         + (radius_scale * scale.sigma_m_per_px).powi(2))
     .sqrt();
@@ -320,7 +323,8 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
             let stat = (sv * sv + (f.a[k] * c.t.se).powi(2)).sqrt();
             let dv_dlevel = f.a[k] * c.dt_dlevel;
             let tilt = v[1 - k] * sigma_theta;
-            let total = (stat * stat + (dv_dlevel * sigma_level).powi(2) + (v[k] * rel_scale).powi(2) + tilt * tilt).sqrt();
+            let total =
+                (stat * stat + (dv_dlevel * sigma_level).powi(2) + (v[k] * rel_scale).powi(2) + tilt * tilt).sqrt();
             VelocityPart {
                 value: v[k],
                 stat,
@@ -436,7 +440,9 @@ fn impossible(v_in_n: f64, v_out_n: f64, cor: f64, mu: f64, t_touch: f64, t_sep:
     }
     let contact_ms = (t_sep - t_touch) * 1e3;
     if !(0.1..=50.0).contains(&contact_ms) {
-        flags.push(format!("a contact of {contact_ms:.3} ms is impossible for a ball (0.1–50 ms)"));
+        flags.push(format!(
+            "a contact of {contact_ms:.3} ms is impossible for a ball (0.1–50 ms)"
+        ));
     }
     if !(mu.abs() <= 1.5) {
         flags.push(format!("μ_eff {mu:.3} is implausible (|μ_eff| ≤ 1.5)"));
@@ -631,9 +637,9 @@ fn contact_line(
 
 /// The image width the fixes suggest (for a reference column when no line is known), px.
 fn track_width(measured: &[&bouncelab_track::BallFix]) -> f64 {
-    let (lo, hi) = measured
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), f| (lo.min(f.x_px), hi.max(f.x_px)));
+    let (lo, hi) = measured.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), f| {
+        (lo.min(f.x_px), hi.max(f.x_px))
+    });
     lo + hi + 1.0
 }
 

@@ -224,9 +224,16 @@ fn a_surface_line_off_by_its_sigma_is_one_standard_error_of_the_contact_time() {
 fn without_a_surface_line_the_trajectory_tells_the_contact() {
     let model = Model::paper(25_650.0, 14.0, 0.5);
     let mut z_level = Vec::new();
-    for (k, (angle, drop)) in [(0.0, 0.2), (7.5, 0.3), (15.0, 0.5), (22.5, 0.9), (0.0, 0.6), (15.0, 0.25)]
-        .into_iter()
-        .enumerate()
+    for (k, (angle, drop)) in [
+        (0.0, 0.2),
+        (7.5, 0.3),
+        (15.0, 0.5),
+        (22.5, 0.9),
+        (0.0, 0.6),
+        (15.0, 0.25),
+    ]
+    .into_iter()
+    .enumerate()
     {
         let (mut track, truth) = shot(&model, angle, drop, 0.02, 50 + k as u64);
         track.surface = None;
@@ -236,11 +243,28 @@ fn without_a_surface_line_the_trajectory_tells_the_contact() {
         // The level against the truth (the plane at SURFACE_Y), px.
         let err = SURFACE_Y - line.y0;
         z_level.push(err / line.sigma_y0);
-        assert!(err.abs() < 1.5 && line.sigma_y0 < 1.0, "{angle}°: level {err} px ± {}", line.sigma_y0);
-        assert!((e.cor.value - truth.restitution).abs() < 0.003, "{angle}°: e {} vs {}", e.cor.value, truth.restitution);
-        assert!((e.mu.value - truth.effective_friction).abs() < 0.01, "{angle}°: μ {}", e.mu.value);
+        assert!(
+            err.abs() < 1.5 && line.sigma_y0 < 1.0,
+            "{angle}°: level {err} px ± {}",
+            line.sigma_y0
+        );
+        assert!(
+            (e.cor.value - truth.restitution).abs() < 0.003,
+            "{angle}°: e {} vs {}",
+            e.cor.value,
+            truth.restitution
+        );
+        assert!(
+            (e.mu.value - truth.effective_friction).abs() < 0.01,
+            "{angle}°: μ {}",
+            e.mu.value
+        );
         let contact_err = e.contact_ms.value - truth.contact_time() * 1e3;
-        assert!(contact_err.abs() < 3.0 * e.contact_ms.se + 0.05, "{angle}°: contact {contact_err} ms ± {}", e.contact_ms.se);
+        assert!(
+            contact_err.abs() < 3.0 * e.contact_ms.se + 0.05,
+            "{angle}°: contact {contact_err} ms ± {}",
+            e.contact_ms.se
+        );
         assert!(e.notes.iter().any(|n| n.contains("trajectory")), "{:?}", e.notes);
         assert!(e.surface_tilt_deg.is_none());
     }
@@ -260,7 +284,13 @@ fn a_line_the_ball_does_not_land_on_gives_way_to_the_trajectory() {
     assert_eq!(used.cue, LineCue::Trajectory);
     assert!((SURFACE_Y - used.y0).abs() < 1.5, "{used:?}");
     assert!((e.cor.value - truth.restitution).abs() < 0.003);
-    assert!(e.notes.iter().any(|n| n.contains("from where the ball's trajectory puts the contact")), "{:?}", e.notes);
+    assert!(
+        e.notes
+            .iter()
+            .any(|n| n.contains("from where the ball's trajectory puts the contact")),
+        "{:?}",
+        e.notes
+    );
 }
 
 /// A clip that holds no impact says so, with the speed the ball has at its end.
@@ -273,9 +303,16 @@ fn a_fall_without_an_impact_is_no_impact_with_its_speed() {
     let t_last = track.fixes[99].t_s;
     let expected = truth.state_in.vy + 9.81 * (0.015 - t_last);
     match estimate(&track, &conditions(0.0)) {
-        Err(EstimateError::NoImpact { frames, speed_m_s, se_m_s }) => {
+        Err(EstimateError::NoImpact {
+            frames,
+            speed_m_s,
+            se_m_s,
+        }) => {
             assert_eq!(frames, 100);
-            assert!((speed_m_s - expected).abs() < 3.0 * se_m_s + 1e-3, "{speed_m_s} ± {se_m_s} vs {expected}");
+            assert!(
+                (speed_m_s - expected).abs() < 3.0 * se_m_s + 1e-3,
+                "{speed_m_s} ± {se_m_s} vs {expected}"
+            );
         }
         other => panic!("{other:?}"),
     }

@@ -62,6 +62,13 @@ pub enum FitError {
     /// in a custom problem).
     #[error("bad residuals: {0}")]
     BadResiduals(String),
+    /// A free parameter of the model file that the fit result does not hold (the result comes from
+    /// another model file).
+    #[error("the fit has no value for the free parameter `{name}` (was it fitted with another model file?)")]
+    MissingParameter {
+        /// The parameter's name (`clay:spring.k`).
+        name: String,
+    },
 }
 
 impl From<ModelError> for FitError {

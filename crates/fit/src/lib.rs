@@ -13,6 +13,7 @@
 mod error;
 mod measurement;
 mod params;
+mod predict;
 mod problem;
 mod result;
 mod shot;
@@ -24,6 +25,7 @@ pub use bouncelab_model::{ModelSpec, SimOptions, State};
 pub use error::FitError;
 pub use measurement::{observe, observes, true_start};
 pub use params::FreeParam;
+pub use predict::{ForceSample, ImpactPrediction, fitted_model, predict_impact};
 pub use problem::{Problem, profile_surface_level, surface_prior, weighted_residuals};
 pub use result::{FitResult, FittedParam, ObliqueRow, ShotFit, SurfaceError, normal_inverse};
 pub use shot::{MeasuredFrame, MeasuredOutputs, MeasuredShot, StartState};

@@ -106,13 +106,16 @@ pub struct FitResult {
     pub confidence: f64,
     /// Student t quantile used for the intervals (n − p degrees of freedom).
     pub t_quantile: f64,
-    /// χ² = Σ ((pred − meas)/σ)² over both coordinates of every frame.
+    /// χ² = Σ ((pred − meas)/σ)² over both coordinates of every frame (the surface levels' prior terms,
+    /// which the solver also minimises, are not part of it).
     pub chi2: f64,
-    /// Degrees of freedom n − p (n = 2 × frames).
+    /// Degrees of freedom ν = n − p (n = 2 × frames; p the free parameters and, when fitted, one surface
+    /// level per shot).
     pub dof: usize,
-    /// χ² / (n − p).
+    /// The reduced χ², χ² / ν: the one definition the comparison, the terminal and the report use.
     pub reduced_chi2: f64,
-    /// Factor applied to (JᵀJ)⁻¹: max(1, reduced χ²).
+    /// Factor applied to (JᵀJ)⁻¹: max(1, the minimised objective over `dof`), the reduced χ² plus the
+    /// surface levels' prior terms when they are fitted.
     pub covariance_scale: f64,
     /// RMS of all position residuals (x and y), m.
     pub rms_m: f64,
@@ -208,9 +211,10 @@ pub(crate) fn build(
         .saturating_sub(p + problem.nuisance_per_shot() * problem.shots().len())
         .max(1);
     let offsets = problem.offsets();
-    let chi2 = out.cost;
-    let reduced_chi2 = chi2 / dof as f64;
-    let covariance_scale = reduced_chi2.max(1.0);
+    // The covariance is scaled by the objective the solver minimised (with surface levels, the frames'
+    // χ² plus each level's prior term); the χ² reported below is the frames' alone, the one number the
+    // comparison, the terminal and the report show.
+    let covariance_scale = (out.cost / dof as f64).max(1.0);
     let t_quantile = StudentsT::new(0.0, 1.0, dof as f64)
         .map(|t| t.inverse_cdf(0.5 + confidence / 2.0))
         .unwrap_or(f64::NAN);
@@ -300,6 +304,8 @@ pub(crate) fn build(
             });
         }
     }
+    let chi2: f64 = shots.iter().map(|s| s.chi2).sum();
+    let reduced_chi2 = chi2 / dof as f64;
     let mean = |xs: &[f64]| xs.iter().sum::<f64>() / xs.len() as f64;
     let errs: Vec<f64> = shots.iter().filter_map(|s| s.cor_error_pct).collect();
     let mut surfaces: Vec<&str> = Vec::new();

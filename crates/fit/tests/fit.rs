@@ -108,6 +108,35 @@ fn recovers_k_and_b_per_surface_with_intervals_covering_truth() {
     }
     assert_eq!(back.termination, result.termination);
     assert!(json.contains("\"reason\": \"converged_"));
+
+    // The fitted model of a surface carries the fitted values, and predicts what the fit simulated.
+    let clay = bouncelab_fit::fitted_model(&spec, &result, "clay").unwrap();
+    let k = result.param("clay:spring.k").unwrap().value;
+    assert_eq!(clay.effect("spring").unwrap().params(), [k]);
+    // An oblique shot: the fit's validation row holds its velocity at touch.
+    let row = result.oblique.iter().find(|o| o.surface == "clay").unwrap();
+    let shot = result.shots.iter().find(|s| s.name == row.shot).unwrap();
+    let beta = shot.incline_deg.to_radians();
+    let p = bouncelab_fit::predict_impact(&clay, beta, row.v_in, 0.0, 50, &SimOptions::default()).unwrap();
+    assert!((p.cor - shot.cor_sim).abs() < 1e-3, "{} vs {}", p.cor, shot.cor_sim);
+    assert!(
+        (p.contact_time_s * 1e3 - shot.contact_ms_sim).abs() < 1e-3,
+        "{} vs {}",
+        p.contact_time_s,
+        shot.contact_ms_sim
+    );
+    let e = bouncelab_fit::fitted_model(&spec, &result, "grass").unwrap_err();
+    assert!(matches!(e, FitError::UnknownSurface { .. }), "{e}");
+    let other = ModelSpec::parse(
+        &spec_toml(
+            &["clay", "tape1"],
+            "[effects.hertz]\nk_h = { value = 1e5, free = true, min = 0, max = 1e7 }\n",
+        ),
+        "other",
+    )
+    .unwrap();
+    let e = bouncelab_fit::fitted_model(&other, &result, "clay").unwrap_err();
+    assert!(e.to_string().contains("hertz.k_h"), "{e}");
 }
 
 #[test]

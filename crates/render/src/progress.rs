@@ -18,8 +18,12 @@ impl ProgressBarObserver {
             bar.set_draw_target(ProgressDrawTarget::stderr());
         }
         bar.set_style(
-            ProgressStyle::with_template("{spinner} rendering [{bar:40}] {pos}/{len} frames ({per_sec}, eta {eta})")
+            ProgressStyle::with_template("{spinner} rendering [{bar:40}] {pos}/{len} frames ({rate}, eta {eta})")
                 .expect("valid template")
+                // indicatif's own {per_sec} prints "254.9181/s": the rate with its unit and no false digits.
+                .with_key("rate", |s: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
+                    let _ = write!(w, "{:.0} frames/s", s.per_sec());
+                })
                 .progress_chars("=> "),
         );
         ProgressBarObserver { bar }

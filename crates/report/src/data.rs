@@ -6,7 +6,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use bouncelab_stats::{Ancova, TukeyHsd};
+use bouncelab_stats::{Ancova, AncovaInference};
 
 /// A report section that may be missing; a missing one is shown as one line, "not available: reason".
 ///
@@ -67,20 +67,30 @@ pub struct Report {
     pub session: SessionInfo,
     /// One entry per shot: trajectory, model and residuals, in the order shown in the shot table.
     pub shots: Vec<ShotPlot>,
-    /// One entry per shot with a measured COR (the paper's Figures 6–8).
-    pub cor_points: Vec<CorPoint>,
+    /// Every measured quantity of every measured shot, with the fitted model's prediction for it (the
+    /// per-shot tables, the per-surface summary and the paper's Figures 6–8).
+    pub measurements: Vec<ShotMeasurement>,
+    /// The fitted model's COR, contact time, δ_max and peak loads against impact speed, one curve per
+    /// surface and angle, drawn over the measured points.
+    pub model_curves: Vec<ModelCurve>,
+    /// The contact force over time of one shot as the fitted model predicts it (the paper's Figure 2).
+    pub contact_force: Section<ContactForce>,
     /// ANCOVA of COR on surface and angle with the incoming normal speed as covariate (Table 1, Figure 11).
     ///
-    /// When `cor_points` has exactly as many entries as the ANCOVA has observations, they are taken to be
+    /// When `measurements` has exactly as many entries as the ANCOVA has observations, they are taken to be
     /// in the same order (as when the ANCOVA is fitted from them) and residual points are labelled with
     /// their clip.
     pub ancova: Section<Ancova>,
-    /// Tukey–Kramer pairwise comparisons of the surfaces (Figure 10).
-    pub tukey: Section<TukeyHsd>,
+    /// The inference of the same fit: coefficients with SE, t, p; covariate-adjusted (estimated marginal)
+    /// means of every factor with Tukey–Kramer and Holm comparisons; residual tests with their caption.
+    pub inference: Section<AncovaInference>,
     /// The contact model fitted to the measured trajectories.
     pub fit: Section<FitSummary>,
-    /// Which effect is missing from the model, with before/after errors.
+    /// Which effect is missing from the model.
     pub diagnosis: Section<DiagnosisSection>,
+    /// What changed since the previous model fitted to this session: effects added, the earlier verdict,
+    /// the residual's signature and the error per shot before and after.
+    pub model_change: Section<ModelChange>,
     /// Warnings of the run (dropped frames, frames without the ball, default fps, …), one line each.
     pub warnings: Vec<String>,
     /// Wall-clock time per pipeline stage: (stage name, seconds).
@@ -213,30 +223,172 @@ pub struct ShotPlot {
     /// RMS of the position residuals (x and y together), m; when `None` it is computed from `residuals`
     /// as √(Σ(dx² + dy²) / 2n).
     pub rms_m: Option<f64>,
-    /// Reduced χ² of the shot against the tracking σ, if known.
+    /// Reduced χ² of the shot against the tracking σ ([`FitSummary::reduced_chi2`]'s definition, the shot's
+    /// χ² over its share of the degrees of freedom), if known.
     pub chi2_red: Option<f64>,
     /// Status notes of the shot, one line each (e.g. "3 frames without the ball", "re-used from the store").
+    /// A note every shot carries is shown once for the session.
     pub notes: Vec<String>,
+    /// Annotated frames of the shot (approach, touch, maximum compression, separation, leave), shown as a
+    /// strip above its plots; empty when none were drawn.
+    pub frames: Vec<FrameImage>,
 }
 
-/// One shot's coefficient of restitution with its conditions (the paper's Figures 6–8).
+/// One annotated video frame, embedded in the page.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct CorPoint {
-    /// Clip name; the point links to the shot's plot when a shot of that name is in the report.
+pub struct FrameImage {
+    /// What the frame shows (e.g. "touch, frame 312").
+    pub caption: String,
+    /// The image as PNG bytes.
+    pub png: Vec<u8>,
+}
+
+/// A measured value and its standard error, in the value's unit.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Measured {
+    /// The value.
+    pub value: f64,
+    /// Its standard error, same unit; `None` when not known.
+    pub se: Option<f64>,
+}
+
+impl Measured {
+    /// A value with its standard error.
+    pub fn new(value: f64, se: f64) -> Measured {
+        Measured { value, se: Some(se) }
+    }
+}
+
+/// Every quantity measured for one shot, in SI units, and what the fitted model predicts for it.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct ShotMeasurement {
+    /// Clip name; links to the shot's plots when a shot of that name is in the report.
     pub clip: String,
     /// Surface name.
     pub surface: String,
     /// Surface incline, degrees.
     pub angle_deg: f64,
-    /// Incoming normal velocity, m/s (negative toward the surface, SPEC §3); plotted as the impact speed
-    /// |v_n,in|.
-    pub v_in_n: f64,
-    /// Standard error of `v_in_n`, m/s.
-    pub v_in_n_se: Option<f64>,
-    /// Coefficient of restitution |v_n,out / v_n,in|, dimensionless.
+    /// Drop height from `clips.csv`, m, if known.
+    pub drop_height_m: Option<f64>,
+    /// Incoming velocity at touch (tangential down-slope, normal), m/s; the normal one is negative.
+    pub v_in_m_s: [Measured; 2],
+    /// Outgoing velocity at separation (tangential, normal), m/s.
+    pub v_out_m_s: [Measured; 2],
+    /// Coefficient of restitution |v_n,out / v_n,in|.
+    pub cor: Measured,
+    /// Effective friction −Δv_t / Δv_n.
+    pub mu_eff: Measured,
+    /// Contact time, s.
+    pub contact_time_s: Measured,
+    /// Maximum penetration δ_max, m.
+    pub delta_max_m: Measured,
+    /// Spin before the impact, rad/s (counter-clockwise as seen), when measured.
+    pub spin_in_rad_s: Option<Measured>,
+    /// Spin after the impact, rad/s, when measured.
+    pub spin_out_rad_s: Option<Measured>,
+    /// Peak normal deceleration of the ball's centre from the track's second difference, m/s², when the
+    /// track resolves it.
+    pub peak_deceleration_track_m_s2: Option<Measured>,
+    /// Peak normal contact force from the same, N: the mass times (the deceleration + gravity's normal
+    /// component).
+    pub peak_force_track_n: Option<Measured>,
+    /// The fitted model hit at this shot's measured incoming velocity, when a model was fitted.
+    pub model: Option<ShotPrediction>,
+}
+
+impl ShotMeasurement {
+    /// Impact speed |v_in|, m/s, with its standard error (components taken as independent).
+    pub fn impact_speed(&self) -> Measured {
+        let [t, n] = self.v_in_m_s;
+        let v = t.value.hypot(n.value);
+        let se = match (t.se, n.se) {
+            (Some(a), Some(b)) if v > 0.0 => Some((t.value * a).hypot(n.value * b) / v),
+            _ => None,
+        };
+        Measured { value: v, se }
+    }
+
+    /// Impact angle of the incoming velocity from the surface normal, degrees (positive down-slope), with
+    /// its standard error: a vertical drop on an incline β arrives at β.
+    pub fn impact_angle(&self) -> Measured {
+        let [t, n] = self.v_in_m_s;
+        let v2 = t.value * t.value + n.value * n.value;
+        let value = t.value.atan2(n.value.abs()).to_degrees();
+        let se = match (t.se, n.se) {
+            (Some(a), Some(b)) if v2 > 0.0 => {
+                Some((n.value * a).hypot(t.value * b) / v2 * 180.0 / std::f64::consts::PI)
+            }
+            _ => None,
+        };
+        Measured { value, se }
+    }
+}
+
+/// What the fitted model predicts for one impact (no standard errors: the model's, at its fitted values).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct ShotPrediction {
+    /// Coefficient of restitution.
     pub cor: f64,
-    /// Standard error of `cor`; drawn as a ±1 SE error bar.
-    pub cor_se: Option<f64>,
+    /// Effective friction.
+    pub mu_eff: f64,
+    /// Contact time, s.
+    pub contact_time_s: f64,
+    /// Maximum penetration, m.
+    pub delta_max_m: f64,
+    /// Spin after the impact, rad/s.
+    pub spin_out_rad_s: f64,
+    /// Peak normal contact force, N.
+    pub peak_force_n: f64,
+    /// Peak normal deceleration of the ball's centre, m/s².
+    pub peak_deceleration_m_s2: f64,
+}
+
+/// The fitted model of one surface at one angle against the impact speed.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct ModelCurve {
+    /// Surface name.
+    pub surface: String,
+    /// Surface incline, degrees (the ball arriving vertically, as in a drop).
+    pub angle_deg: f64,
+    /// The prediction at each incoming normal speed, ascending.
+    pub points: Vec<CurvePoint>,
+}
+
+/// The fitted model at one incoming speed.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct CurvePoint {
+    /// Incoming normal speed |v_n,in|, m/s.
+    pub v_in_n_m_s: f64,
+    /// The prediction there.
+    pub prediction: ShotPrediction,
+}
+
+/// The contact force over one impact as the fitted model predicts it.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct ContactForce {
+    /// The shot whose incoming velocity was used.
+    pub clip: String,
+    /// Its surface.
+    pub surface: String,
+    /// Its incline, degrees.
+    pub angle_deg: f64,
+    /// Its incoming normal speed |v_n,in|, m/s.
+    pub v_in_n_m_s: f64,
+    /// Why this shot (e.g. "the shot nearest the session's median impact speed").
+    pub why: String,
+    /// Evenly spaced instants from touch to separation.
+    pub samples: Vec<ForceSample>,
+}
+
+/// One instant of a contact.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct ForceSample {
+    /// Time since touch, s.
+    pub t_s: f64,
+    /// Penetration δ, m.
+    pub delta_m: f64,
+    /// Normal contact force, N.
+    pub force_n: f64,
 }
 
 /// One fitted model parameter.
@@ -293,8 +445,12 @@ pub struct FitSummary {
     pub parameters: Vec<FitParameter>,
     /// Confidence level of the intervals, 0–1 (e.g. 0.95).
     pub confidence: f64,
-    /// Reduced χ² of the whole fit against the tracking σ, if known.
+    /// Reduced χ² of the whole fit against the tracking σ, χ²/ν, if known: χ² = Σ((model − measured)/σ)²
+    /// over both coordinates of every fitted frame, ν = `dof`.
     pub reduced_chi2: Option<f64>,
+    /// Degrees of freedom ν of `reduced_chi2`: residuals − fitted parameters (shared ones and one surface
+    /// level per shot), if known.
+    pub dof: Option<usize>,
     /// RMS of all position residuals (x and y), m, if known.
     pub rms_m: Option<f64>,
     /// Why the solver stopped, as text (e.g. "converged: relative cost change below 1e-10 after 14
@@ -352,10 +508,10 @@ pub struct Candidate {
     pub heldout_after: Option<f64>,
 }
 
-/// Per-shot error before and after adding the suggested effect.
+/// Per-shot error before and after a model change.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct ShotBeforeAfter {
-    /// Clip name (links to the shot's plot when present).
+    /// Clip name (links to the shot's plots when present).
     pub clip: String,
     /// Surface name.
     pub surface: String,
@@ -380,31 +536,78 @@ pub struct ModelVersion {
     pub chi2_red: Option<f64>,
 }
 
-/// Which effect is missing, and the proof that adding it lowers the error.
+/// Which effect is missing.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct DiagnosisSection {
     /// The conclusion.
     pub verdict_kind: VerdictKind,
-    /// The verdict in one or two sentences (names the effect and the error it removes).
+    /// The verdict in a few words, for the summary (e.g. "`hunt_crossley` is missing: held-out error
+    /// 87.0 → 12.6 µm"); the summary shows `verdict_text` when empty.
+    pub headline: String,
+    /// The verdict with its evidence in full (names the effect and the error it removes).
     pub verdict_text: String,
     /// Evidence, or the residual's signature when no candidate explains it: plain sentences (e.g. "COR
     /// falls with impact speed, slope −0.04 per m/s, p < 0.001; the model predicts none").
     pub evidence: Vec<String>,
-    /// Name and unit of the candidates' error columns (e.g. "held-out RMS, mm" or "reduced χ²").
+    /// Where the current model's residual sits, largest χ² share first.
+    pub signature: Vec<SignatureRow>,
+    /// Name of the candidates' error columns (e.g. "position RMS, held-out by cross-validation").
     pub error_metric: String,
     /// Candidates, best first.
     pub candidates: Vec<Candidate>,
-    /// Name of the model before (e.g. "v3: paper").
-    pub model_before: String,
-    /// Name of the model after (e.g. "v4: paper + hunt_crossley").
-    pub model_after: String,
-    /// Per-shot RMS before and after; empty before the effect was added.
-    pub before_after: Vec<ShotBeforeAfter>,
-    /// RMS of all residuals with the earlier model, m; `None` shows the quadratic mean of the per-shot
-    /// values.
-    pub total_rms_before_m: Option<f64>,
-    /// RMS of all residuals with the new model, m; `None` as above.
-    pub total_rms_after_m: Option<f64>,
     /// Model versions of the store, oldest first.
     pub model_history: Vec<ModelVersion>,
+}
+
+/// The residual of one phase and component.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SignatureRow {
+    /// The phase.
+    pub phase: Phase,
+    /// True for the normal component (y), false for the tangential one (x).
+    pub normal: bool,
+    /// RMS of the residuals, m.
+    pub rms_m: f64,
+    /// Its part above the noise, √max(0, RMS² − noise²), m.
+    pub systematic_m: f64,
+    /// Share of the total χ², 0–1.
+    pub chi2_share: f64,
+}
+
+/// A verdict as it was given.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct EarlierVerdict {
+    /// The conclusion.
+    pub kind: VerdictKind,
+    /// Its sentence.
+    pub text: String,
+}
+
+/// The previous model fitted to this session against the current one.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct ModelChange {
+    /// The earlier model (e.g. "built-in paper model (version 1)").
+    pub model_before: String,
+    /// The current model.
+    pub model_after: String,
+    /// Effects in the current model that the earlier one lacked (e.g. `hunt_crossley`).
+    pub effects_added: Vec<String>,
+    /// Effects of the earlier model that the current one dropped.
+    pub effects_removed: Vec<String>,
+    /// The diagnosis of the earlier model, when it was kept.
+    pub verdict_before: Option<EarlierVerdict>,
+    /// Where the earlier model's residual sat.
+    pub signature_before: Vec<SignatureRow>,
+    /// Where the current model's residual sits.
+    pub signature_after: Vec<SignatureRow>,
+    /// Per shot present in both fits.
+    pub shots: Vec<ShotBeforeAfter>,
+    /// RMS of all position residuals with the earlier model, m.
+    pub total_rms_before_m: f64,
+    /// RMS of all position residuals with the current model, m.
+    pub total_rms_after_m: f64,
+    /// Reduced χ² of the earlier fit.
+    pub reduced_chi2_before: f64,
+    /// Reduced χ² of the current fit.
+    pub reduced_chi2_after: f64,
 }

@@ -1,10 +1,8 @@
 //! The model fit: parameters with intervals, the paper's mean absolute COR error per surface, and the
 //! oblique validation (the paper's Figure 9) as a table and a predicted-vs-measured plot.
 
-use std::fmt::Write;
-
 use crate::data::FitSummary;
-use crate::fmt::{esc, fixed, mm, num, opt, short};
+use crate::fmt::{esc, fixed, num, opt, short, um};
 use crate::page::{Ctx, nc, table, tc};
 use crate::svg::{Chart, Item, Key, Mark, Shape};
 
@@ -15,19 +13,24 @@ pub(crate) fn render(ctx: &mut Ctx, f: &FitSummary) -> String {
         facts.push(("Solver".into(), esc(&f.termination)));
     }
     if let Some(c) = f.reduced_chi2 {
-        facts.push(("Reduced χ²".into(), num(c, 3)));
+        let nu = f.dof.map_or(String::new(), |d| format!(" (ν = {d})"));
+        facts.push(("Reduced χ² χ²<sub>ν</sub>".into(), format!("{}{nu}", num(c, 3))));
     }
     if let Some(r) = f.rms_m {
-        facts.push(("RMS position residual".into(), format!("{} mm", mm(r, 3))));
+        facts.push(("RMS position residual".into(), format!("{} µm", um(r))));
     }
     if let Some(e) = f.mean_abs_error_pct {
         facts.push(("Mean absolute COR error".into(), format!("{} %", num(e, 3))));
     }
-    let mut s = String::from(r#"<table class="facts"><tbody>"#);
-    for (k, v) in facts {
-        let _ = write!(s, "<tr><th>{k}</th><td>{v}</td></tr>");
-    }
-    s.push_str("</tbody></table>\n");
+    let mut s = crate::page::facts(&facts);
+    s.push_str(
+        "<p>The reduced χ² used throughout this report: χ²<sub>ν</sub> = χ²/ν, where χ² = Σ((model − measured)/σ)² \
+         over both coordinates of every fitted frame (σ the tracker's uncertainty of that frame) and ν = the number \
+         of those residuals − the fitted parameters (the shared ones and one surface level per shot). A shot's \
+         χ²<sub>ν</sub> is its own χ² over its share of ν, in proportion to its frames, so the shots' values \
+         average (weighted by frames) to the fit's. About 1 means the model follows the data to the tracking \
+         noise.</p>\n",
+    );
 
     s.push_str("<h3>Parameters</h3>\n");
     let level = if f.confidence > 0.0 && f.confidence < 1.0 {
@@ -39,13 +42,19 @@ pub(crate) fn render(ctx: &mut Ctx, f: &FitSummary) -> String {
         .parameters
         .iter()
         .map(|p| {
+            // A length parameter (a surface level) is a fraction of a millimetre: shown in µm.
+            let (k, unit) = if p.unit == "m" {
+                (1e6, "µm".to_string())
+            } else {
+                (1.0, p.unit.clone())
+            };
             vec![
                 format!("<code>{}</code>", esc(&p.name)),
-                num(p.value, 4),
-                opt(p.std_error, 2),
+                num(p.value * k, 4),
+                opt(p.std_error.map(|e| e * k), 2),
                 p.interval
-                    .map_or("—".into(), |[a, b]| format!("{} – {}", num(a, 4), num(b, 4))),
-                esc(&p.unit),
+                    .map_or("—".into(), |[a, b]| format!("{} – {}", num(a * k, 4), num(b * k, 4))),
+                crate::fmt::esc_code(&unit),
                 if p.at_bound {
                     r#"<span class="bad">at a bound of the fit</span>"#.into()
                 } else {
@@ -99,6 +108,11 @@ pub(crate) fn render(ctx: &mut Ctx, f: &FitSummary) -> String {
         ));
     }
 
+    s.push_str("<h3>Contact force</h3>\n");
+    let report = ctx.report;
+    s.push_str(&crate::page::section_or(&report.contact_force, |c| {
+        crate::force::render(ctx, c)
+    }));
     s.push_str("<h3>Oblique validation</h3>\n");
     if f.oblique.is_empty() {
         s.push_str(&crate::page::unavailable(

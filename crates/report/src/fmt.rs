@@ -21,6 +21,66 @@ pub(crate) fn esc(s: &str) -> String {
     out
 }
 
+/// [`esc`] of a sentence in which `name` in backticks marks a name to type (an effect, a command): those
+/// spans become `<code>`, an unpaired backtick stays as it is; outside them a power written `x^1.5`,
+/// `δ^n` or `m^(1+n)` becomes a superscript.
+pub(crate) fn esc_code(s: &str) -> String {
+    let parts: Vec<&str> = s.split('`').collect();
+    if parts.len() < 3 {
+        return powers(&esc(s));
+    }
+    let mut out = String::with_capacity(s.len() + 16);
+    let pairs = (parts.len() - 1) / 2;
+    for (i, p) in parts.iter().enumerate() {
+        if i % 2 == 1 && i < 2 * pairs {
+            out.push_str("<code>");
+            out.push_str(&esc(p));
+            out.push_str("</code>");
+        } else {
+            if i > 2 * pairs {
+                out.push('`');
+            }
+            out.push_str(&powers(&esc(p)));
+        }
+    }
+    out
+}
+
+/// `^(…)` and `^token` (letters, digits, `.`, `+`, `-`) of escaped text as `<sup>`.
+fn powers(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    let mut rest = s;
+    while let Some(i) = rest.find('^') {
+        out.push_str(&rest[..i]);
+        let after = &rest[i + 1..];
+        let (exp, tail) = if let Some(inner) = after.strip_prefix('(') {
+            match inner.find(')') {
+                Some(j) => (&inner[..j], &inner[j + 1..]),
+                None => ("", after),
+            }
+        } else {
+            let end = after
+                .char_indices()
+                .find(|(k, c)| !(c.is_alphanumeric() || *c == '.' || ((*c == '+' || *c == '-') && *k == 0)))
+                .map_or(after.len(), |(k, _)| k);
+            // A trailing full stop ends the sentence, not the exponent.
+            let end = if after[..end].ends_with('.') { end - 1 } else { end };
+            (&after[..end], &after[end..])
+        };
+        if exp.is_empty() {
+            out.push('^');
+            rest = after;
+        } else {
+            out.push_str("<sup>");
+            out.push_str(exp);
+            out.push_str("</sup>");
+            rest = tail;
+        }
+    }
+    out.push_str(rest);
+    out
+}
+
 /// A typographic minus sign for negative numbers.
 fn minus(s: String) -> String {
     if let Some(rest) = s.strip_prefix('-') {
@@ -105,9 +165,35 @@ pub(crate) fn p_value(p: f64) -> String {
     }
 }
 
-/// A value in metres shown in millimetres.
-pub(crate) fn mm(v_m: f64, sig: usize) -> String {
-    num(v_m * 1e3, sig)
+/// A value in metres shown in micrometres (residuals), one decimal below 100 µm.
+pub(crate) fn um(v_m: f64) -> String {
+    let v = v_m * 1e6;
+    if v.is_finite() && v.abs() < 100.0 {
+        fixed(v, 1)
+    } else {
+        num(v, 3)
+    }
+}
+
+/// A value and its standard error, the error to two significant digits and the value to the same decimal
+/// place ("0.7160", "0.0012"; "123.4", "5.6"), so the error is never shown as zero; without a usable error
+/// the value to `sig` significant digits and `None`.
+pub(crate) fn pm(v: f64, se: Option<f64>, sig: usize) -> (String, Option<String>) {
+    match se.filter(|e| e.is_finite() && *e > 0.0) {
+        Some(e) if v.is_finite() && v.abs() < 1e9 && e < 1e9 => {
+            let decimals = (1 - e.log10().floor() as i32).clamp(0, 12) as usize;
+            (fixed(v, decimals), Some(fixed(e, decimals)))
+        }
+        _ => (num(v, sig), None),
+    }
+}
+
+/// [`pm`] as one text: "0.7160 ± 0.0012", or the value alone.
+pub(crate) fn pm_text(v: f64, se: Option<f64>, sig: usize) -> String {
+    match pm(v, se, sig) {
+        (v, Some(e)) => format!("{v} ± {e}"),
+        (v, None) => v,
+    }
 }
 
 /// A pixel coordinate for SVG: one decimal, no trailing ".0", clamped to ±1e5 (never NaN).
@@ -158,6 +244,23 @@ mod tests {
     }
 
     #[test]
+    fn backticks_become_code() {
+        assert_eq!(
+            esc_code("add `hertz` & <go>"),
+            "add <code>hertz</code> &amp; &lt;go&gt;"
+        );
+        assert_eq!(esc_code("a `b` c `d"), "a <code>b</code> c `d");
+        assert_eq!(esc_code("`<x>`"), "<code>&lt;x&gt;</code>");
+        assert_eq!(esc_code("no ticks"), "no ticks");
+        assert_eq!(esc_code("P = λ·δ^n·dδ/dt"), "P = λ·δ<sup>n</sup>·dδ/dt");
+        assert_eq!(
+            esc_code("N·s/m^(1+n) and k·δ^1.5."),
+            "N·s/m<sup>1+n</sup> and k·δ<sup>1.5</sup>."
+        );
+        assert_eq!(esc_code("a ^ b"), "a ^ b");
+    }
+
+    #[test]
     fn numbers() {
         assert_eq!(num(0.77012, 4), "0.7701");
         assert_eq!(num(25650.0, 4), "25650");
@@ -176,6 +279,22 @@ mod tests {
         assert_eq!(short(0.05, 3), "0.05");
         assert_eq!(short(1e-7, 3), "1.00e-7");
         assert_eq!(p_value(2.1e-9), "2.1e-9");
+        assert_eq!(um(7.8e-6), "7.8");
+        assert_eq!(um(1.234e-4), "123");
+    }
+
+    #[test]
+    fn errors_set_the_digits_and_are_never_zero() {
+        assert_eq!(
+            pm(0.68612, Some(0.00031), 3),
+            ("0.68612".into(), Some("0.00031".into()))
+        );
+        assert_eq!(pm_text(0.686, Some(0.0004), 3), "0.68600 ± 0.00040");
+        assert_eq!(pm_text(123.44, Some(5.6), 3), "123.4 ± 5.6");
+        assert_eq!(pm_text(1234.0, Some(56.0), 3), "1234 ± 56");
+        assert_eq!(pm_text(0.5, Some(0.0), 3), "0.500");
+        assert_eq!(pm_text(0.5, Some(f64::NAN), 3), "0.500");
+        assert_eq!(pm_text(f64::NAN, Some(0.1), 3), "NaN");
     }
 
     #[test]

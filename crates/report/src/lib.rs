@@ -1,7 +1,8 @@
 //! The session report: one self-contained HTML file, with every plot drawn as inline SVG, that a lab
 //! keeps with its data and opens offline. The crate's design choice is that it knows nothing of the
-//! pipeline: [`render_html`] takes a [`Report`] of plain data structs (trajectories, COR points, the fit,
-//! the diagnosis; the ANCOVA and Tukey results as `bouncelab-stats` gives them) and returns a `String`,
+//! pipeline: [`render_html`] takes a [`Report`] of plain data structs (trajectories, every measured quantity,
+//! the fitted model's curves, the fit, the diagnosis; the ANCOVA and its inference as `bouncelab-stats` gives
+//! them) and returns a `String`,
 //! deterministically (same input, same bytes), escaping every text that came from input files and
 //! drawing what it can of odd numbers (NaN, infinities, empty or constant series) without panicking.
 //! Plots come from a small hand-written SVG module (see `svg.rs` for why not plotters), so the page
@@ -19,15 +20,18 @@
 //! assert!(html.contains("not available: not computed"));
 //! ```
 
+mod change;
 mod cor;
 mod data;
 mod diagnosis;
 mod error;
 mod fit;
 mod fmt;
+mod force;
 mod page;
 mod shots;
 mod stats;
+mod summary;
 mod svg;
 pub mod testutil;
 mod thin;
@@ -36,9 +40,10 @@ use std::io::Write;
 use std::path::Path;
 
 pub use data::{
-    Candidate, CorPoint, DiagnosisSection, FitParameter, FitSummary, MeasuredPoint, ModelPoint, ModelVersion,
-    ObliqueRow, Phase, PhaseSpan, Report, Residual, Section, SessionInfo, ShotBeforeAfter, ShotPlot, SurfaceError,
-    VerdictKind,
+    Candidate, ContactForce, CurvePoint, DiagnosisSection, EarlierVerdict, FitParameter, FitSummary, ForceSample,
+    FrameImage, Measured, MeasuredPoint, ModelChange, ModelCurve, ModelPoint, ModelVersion, ObliqueRow, Phase,
+    PhaseSpan, Report, Residual, Section, SessionInfo, ShotBeforeAfter, ShotMeasurement, ShotPlot, ShotPrediction,
+    SignatureRow, SurfaceError, VerdictKind,
 };
 pub use error::ReportError;
 
@@ -46,12 +51,13 @@ pub use error::ReportError;
 /// without data says why in one line.
 pub const SECTIONS: &[(&str, &str)] = &[
     ("summary", "Summary"),
-    ("warnings", "Warnings"),
+    ("warnings", "Warnings and notes"),
     ("diagnosis", "Diagnosis: which effect is missing"),
+    ("model-change", "Model change: before and after"),
     ("fit", "Model fit"),
-    ("cor", "Coefficient of restitution"),
+    ("cor", "Measured quantities and the model against impact speed"),
     ("ancova", "ANCOVA"),
-    ("tukey", "Pairwise comparisons of surfaces"),
+    ("comparisons", "Comparisons of surfaces at equal impact speed"),
     ("residual-diagnostics", "ANCOVA residual diagnostics"),
     ("shots", "Shots"),
     ("timings", "Timings"),

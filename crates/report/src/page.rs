@@ -7,7 +7,7 @@ use std::fmt::Write;
 use crate::data::{Report, Section};
 use crate::fmt::{esc, slug};
 use crate::svg::{Chart, Shape};
-use crate::{SECTIONS, cor, diagnosis, fit, shots, stats};
+use crate::{SECTIONS, change, cor, diagnosis, fit, shots, stats, summary};
 
 /// Okabe–Ito colours (distinguishable with the common colour-vision deficiencies), yellow last.
 pub(crate) const PALETTE: [&str; 8] = [
@@ -16,7 +16,8 @@ pub(crate) const PALETTE: [&str; 8] = [
 
 const STYLE: &str = r#"
 :root{--fg:#1a1a1a;--muted:#5f6368;--line:#dcdcdc}
-body{font:15px/1.45 system-ui,-apple-system,"Segoe UI",Roboto,"Helvetica Neue",Arial,sans-serif;color:var(--fg);background:#fff;max-width:1080px;margin:0 auto;padding:0 20px 48px}
+body{font:15px/1.45 system-ui,-apple-system,"Segoe UI",Roboto,"Helvetica Neue",Arial,sans-serif;color:var(--fg);background:#fff;max-width:1240px;margin:0 auto;padding:0 20px 48px}
+p,li{max-width:900px}
 h1{font-size:1.75em;margin:.9em 0 .2em}
 h2{font-size:1.35em;border-bottom:2px solid var(--line);padding-bottom:.15em;margin:2.2em 0 .6em}
 h3{font-size:1.08em;margin:1.5em 0 .4em}
@@ -27,6 +28,13 @@ th,td{padding:3px 10px;border-bottom:1px solid var(--line);text-align:left;verti
 th{background:#f4f5f6;font-weight:600}
 td a,.tag{white-space:nowrap}
 td.n,th.n{text-align:right;font-variant-numeric:tabular-nums;white-space:nowrap}
+td.wide{min-width:18em;white-space:normal}
+.se{color:var(--muted);font-size:.86em}
+td .se{margin-left:.15em}
+table.quantities td.n{min-width:7em}
+table.stacked td .se{display:block;margin-left:0}
+table.stacked th{white-space:normal;vertical-align:bottom}
+table.stacked td.wide{min-width:14em}
 tr.total td{font-weight:600;border-top:1.5px solid #999}
 table.facts th{background:none;font-weight:normal;color:var(--muted);padding-left:0}
 .scroll{overflow-x:auto}
@@ -52,7 +60,11 @@ details.shot>summary{cursor:pointer;padding:.35em 0}
 details.shot:target{outline:2px solid #0b5fa5}
 .tag{font-size:.78em;padding:.05em .45em;border-radius:3px;background:#eee;margin-left:.5em}
 .tag.worst{background:#fde2d5}.tag.best{background:#d6f0e2}
-.notes{color:#8a4b00;font-size:.92em}
+.notes{color:var(--muted);font-size:.92em}
+.strip{display:flex;flex-wrap:wrap;gap:6px;margin:.4em 0 .6em}
+.strip figure{margin:0}
+.strip img{display:block;max-width:180px;height:auto;border:1px solid var(--line)}
+.strip figcaption{font-size:.8em;max-width:180px}
 nav ol{columns:2;max-width:640px;padding-left:1.4em}
 footer{margin-top:3em;color:var(--muted);font-size:.85em;border-top:1px solid var(--line);padding-top:.6em}
 @media print{nav,#shot-selector{display:none}details.shot,figure{break-inside:avoid}}
@@ -101,7 +113,7 @@ impl<'a> Ctx<'a> {
             .shots
             .iter()
             .map(|s| &s.surface)
-            .chain(report.cor_points.iter().map(|c| &c.surface))
+            .chain(report.measurements.iter().map(|c| &c.surface))
             .chain(
                 report
                     .fit
@@ -191,17 +203,18 @@ impl<'a> Ctx<'a> {
     }
 }
 
-/// One table column: heading (HTML) and whether it holds numbers (right-aligned).
+/// One table column: heading (HTML) and its cells' class ("n": numbers, right-aligned; "wide": free text
+/// that wraps at a readable width; "": plain text).
 pub(crate) struct Col {
     pub head: String,
-    pub num: bool,
+    pub class: &'static str,
 }
 
 /// A text column.
 pub(crate) fn tc(head: &str) -> Col {
     Col {
         head: head.into(),
-        num: false,
+        class: "",
     }
 }
 
@@ -209,16 +222,33 @@ pub(crate) fn tc(head: &str) -> Col {
 pub(crate) fn nc(head: &str) -> Col {
     Col {
         head: head.into(),
-        num: true,
+        class: "n",
+    }
+}
+
+/// A column of sentences (notes): wraps at a readable width instead of one word per line.
+pub(crate) fn wc(head: &str) -> Col {
+    Col {
+        head: head.into(),
+        class: "wide",
     }
 }
 
 /// A table; cells are HTML (escape input text in them). A row whose first cell starts with `\u{0}` is a
 /// total row (the marker is removed).
 pub(crate) fn table(cols: &[Col], rows: &[Vec<String>]) -> String {
-    let mut s = String::from(r#"<div class="scroll"><table><thead><tr>"#);
+    table_with_class("", cols, rows)
+}
+
+/// [`table`] with a class on the `<table>` element.
+pub(crate) fn table_with_class(class: &str, cols: &[Col], rows: &[Vec<String>]) -> String {
+    let mut s = if class.is_empty() {
+        String::from(r#"<div class="scroll"><table><thead><tr>"#)
+    } else {
+        format!(r#"<div class="scroll"><table class="{class}"><thead><tr>"#)
+    };
     for c in cols {
-        let _ = write!(s, "<th{}>{}</th>", if c.num { r#" class="n""# } else { "" }, c.head);
+        let _ = write!(s, "<th{}>{}</th>", cell_class(c.class), c.head);
     }
     s.push_str("</tr></thead><tbody>");
     for row in rows {
@@ -226,12 +256,38 @@ pub(crate) fn table(cols: &[Col], rows: &[Vec<String>]) -> String {
         s.push_str(if total { r#"<tr class="total">"# } else { "<tr>" });
         for (i, cell) in row.iter().enumerate() {
             let cell = if i == 0 { cell.trim_start_matches('\u{0}') } else { cell };
-            let num = cols.get(i).is_some_and(|c| c.num);
-            let _ = write!(s, "<td{}>{cell}</td>", if num { r#" class="n""# } else { "" });
+            let class = cols.get(i).map_or("", |c| c.class);
+            let _ = write!(s, "<td{}>{cell}</td>", cell_class(class));
         }
         s.push_str("</tr>");
     }
     s.push_str("</tbody></table></div>\n");
+    s
+}
+
+fn cell_class(class: &str) -> String {
+    if class.is_empty() {
+        String::new()
+    } else {
+        format!(r#" class="{class}""#)
+    }
+}
+
+/// A value and its standard error as table-cell HTML: the error smaller, after the value.
+pub(crate) fn pm_cell(v: f64, se: Option<f64>, sig: usize) -> String {
+    match crate::fmt::pm(v, se, sig) {
+        (v, Some(e)) => format!(r#"{v}<span class="se">±{e}</span>"#),
+        (v, None) => v,
+    }
+}
+
+/// The facts table at the top of a section: (heading, value HTML) rows.
+pub(crate) fn facts(rows: &[(String, String)]) -> String {
+    let mut s = String::from(r#"<table class="facts"><tbody>"#);
+    for (k, v) in rows {
+        let _ = write!(s, "<tr><th>{k}</th><td>{v}</td></tr>");
+    }
+    s.push_str("</tbody></table>\n");
     s
 }
 
@@ -280,10 +336,10 @@ fn header(ctx: &Ctx) -> String {
         (
             "Shots".into(),
             format!(
-                "{} in the session, {} plotted, {} with a COR",
+                "{} in the session, {} measured, {} fitted",
                 si.shots,
-                r.shots.len(),
-                r.cor_points.len()
+                r.measurements.len(),
+                r.shots.len()
             ),
         ),
     ];
@@ -326,14 +382,29 @@ fn nav() -> String {
 }
 
 fn warnings(r: &Report) -> String {
+    let shared = crate::shots::shared_notes(r);
+    let mut s = String::new();
     if r.warnings.is_empty() {
-        return "<p>No warnings.</p>\n".into();
+        s.push_str("<p>No warnings were raised by this run.</p>\n");
+    } else {
+        s.push_str("<ul class=\"warnings\">");
+        for w in &r.warnings {
+            let _ = write!(s, "<li>{}</li>", esc(w));
+        }
+        s.push_str("</ul>\n");
     }
-    let mut s = String::from("<ul class=\"warnings\">");
-    for w in &r.warnings {
-        let _ = write!(s, "<li>{}</li>", esc(w));
+    if !shared.is_empty() {
+        let _ = write!(
+            s,
+            "<h3>Notes on every shot</h3>\n<p>Each of the {} shots carries these notes; they are said once here \
+             and left out of the shots' own notes.</p>\n<ul>",
+            r.shots.len()
+        );
+        for n in &shared {
+            let _ = write!(s, "<li>{}</li>", esc(n));
+        }
+        s.push_str("</ul>\n");
     }
-    s.push_str("</ul>\n");
     s
 }
 
@@ -382,13 +453,14 @@ pub(crate) fn render(report: &Report) -> String {
     for (id, _) in SECTIONS {
         open_section(&mut out, id);
         let body = match *id {
-            "summary" => shots::summary(&mut ctx),
+            "summary" => summary::render(&mut ctx),
             "warnings" => warnings(report),
             "diagnosis" => section_or(&report.diagnosis, |d| diagnosis::render(&mut ctx, d)),
+            "model-change" => section_or(&report.model_change, |c| change::render(&mut ctx, c)),
             "fit" => section_or(&report.fit, |f| fit::render(&mut ctx, f)),
             "cor" => cor::render(&mut ctx),
-            "ancova" => section_or(&report.ancova, stats::ancova_tables),
-            "tukey" => section_or(&report.tukey, |t| stats::tukey(&mut ctx, t)),
+            "ancova" => stats::ancova_section(&ctx),
+            "comparisons" => section_or(&report.inference, |i| stats::comparisons(&mut ctx, i)),
             "residual-diagnostics" => section_or(&report.ancova, |a| stats::diagnostics(&mut ctx, a)),
             "shots" => shots::render(&mut ctx),
             "timings" => timings(report),

@@ -1,12 +1,13 @@
-//! The summary and the shots section: a table of every shot linking to its plots (trajectory with the
-//! model over it, residuals shaded by phase), a bar chart of the fit error per shot, and the plots
-//! themselves in collapsed blocks, the worst and best fits open.
+//! The shots section: every measured quantity per shot with its standard error, the fitted model's
+//! prediction and fit error per shot, a bar chart of the fit error, and each shot's plots in a collapsed
+//! block (trajectory with the model over it and the residual below, per component, shaded by phase), the
+//! worst and best fits open, with a strip of annotated frames when the run drew one.
 
 use std::fmt::Write;
 
-use crate::data::{Phase, ShotPlot, VerdictKind};
-use crate::fmt::{esc, fixed, mm, num, opt, p_value, short};
-use crate::page::{Ctx, nc, table, tc};
+use crate::data::{Phase, Report, ShotMeasurement, ShotPlot};
+use crate::fmt::{esc, num, opt, short, um};
+use crate::page::{Ctx, nc, pm_cell, tc, wc};
 use crate::svg::{Bar, Chart, Item, Key, Mark, Shape};
 use crate::thin::thin_indices;
 
@@ -39,6 +40,31 @@ pub(crate) fn rms_of(shot: &ShotPlot) -> Option<f64> {
     } else {
         Some((ok.iter().sum::<f64>() / (2.0 * ok.len() as f64)).sqrt())
     }
+}
+
+/// Notes every shot carries (two shots or more), in the first shot's order: said once for the session.
+pub(crate) fn shared_notes(r: &Report) -> Vec<String> {
+    if r.shots.len() < 2 {
+        return Vec::new();
+    }
+    let mut out: Vec<String> = Vec::new();
+    for n in &r.shots[0].notes {
+        if !out.contains(n) && r.shots.iter().all(|s| s.notes.contains(n)) {
+            out.push(n.clone());
+        }
+    }
+    out
+}
+
+/// A shot's notes without those every shot carries.
+fn own_notes(sh: &ShotPlot, shared: &[String]) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    for n in &sh.notes {
+        if !shared.contains(n) && !out.contains(n) {
+            out.push(n.clone());
+        }
+    }
+    out
 }
 
 /// Shot indices with a finite RMS, best first (ties by input order).
@@ -75,7 +101,7 @@ pub(crate) struct BarRow {
     pub values: Vec<f64>,
 }
 
-/// Bars per shot (in millimetres): horizontal with clip names for up to 40 shots, vertical and unlabelled
+/// Bars per shot (in micrometres): horizontal with clip names for up to 40 shots, vertical and unlabelled
 /// (tooltips and links only) beyond. One series is coloured by surface; several by series.
 pub(crate) fn per_shot_bars(
     ctx: &Ctx,
@@ -96,7 +122,7 @@ pub(crate) fn per_shot_bars(
                 (series[j].1, format!("{}: ", series[j].0))
             };
             let a = i as f64 - 0.4 + j as f64 * thick;
-            let val = v * 1e3;
+            let val = v * 1e6;
             let (x0, x1, y0, y1) = if horizontal {
                 (0.0, val, a, a + thick)
             } else {
@@ -108,7 +134,7 @@ pub(crate) fn per_shot_bars(
                 y0,
                 y1,
                 color,
-                tip: Some(format!("{} ({}) {label}{} mm", row.clip, row.surface, num(val, 3))),
+                tip: Some(format!("{} ({}) {label}{} µm", row.clip, row.surface, um(*v))),
                 href: ctx.shot_href(&row.clip),
             });
         }
@@ -117,7 +143,7 @@ pub(crate) fn per_shot_bars(
     let mut c = if horizontal {
         let mut c = Chart::new(
             id,
-            720.0,
+            760.0,
             70.0 + 17.0 * legend_rows as f64 + rows.len().max(1) as f64 * (8.0 + 8.0 * m as f64),
         );
         c.y_categories = rows.iter().map(|r| r.clip.clone()).collect();
@@ -125,7 +151,7 @@ pub(crate) fn per_shot_bars(
         c.x_include.push(0.0);
         c
     } else {
-        let mut c = Chart::new(id, 960.0, 300.0);
+        let mut c = Chart::new(id, 1000.0, 300.0);
         c.y_label = value_label.into();
         c.x_label = "shots (hover a bar for its clip, click it for its plots)".into();
         c.x_ticks = false;
@@ -151,173 +177,145 @@ pub(crate) fn per_shot_bars(
     c
 }
 
-/// The summary section.
-pub(crate) fn summary(ctx: &mut Ctx) -> String {
-    let r = ctx.report;
-    let mut facts: Vec<(String, String)> = Vec::new();
-    match r.diagnosis.get() {
-        Some(d) => {
-            let class = match d.verdict_kind {
-                VerdictKind::MissingEffect => "bad",
-                VerdictKind::NoMissingEffect => "good",
-                VerdictKind::NoCandidateExplains | VerdictKind::Ambiguous => "bad",
-            };
-            facts.push((
-                "Verdict".into(),
-                format!(
-                    r##"<a href="#diagnosis"><b class="{class}">{}</b></a>: {}"##,
-                    d.verdict_kind.label(),
-                    esc(&d.verdict_text)
-                ),
-            ));
-        }
-        None => facts.push(("Verdict".into(), "no diagnosis in this report".into())),
-    }
-    if let Some(f) = r.fit.get() {
-        let mut s = format!(r##"<a href="#fit">{}</a>"##, esc(&f.model_name));
-        if let Some(e) = f.mean_abs_error_pct {
-            let _ = write!(s, "; mean absolute COR error {} %", num(e, 3));
-        }
-        if let Some(c) = f.reduced_chi2 {
-            let _ = write!(s, "; reduced χ² {}", num(c, 3));
-        }
-        facts.push(("Model".into(), s));
-    }
-    if let Some(row) = r
-        .ancova
-        .get()
-        .and_then(|a| a.type1.terms.iter().find(|t| t.source == "surface"))
-    {
-        facts.push((
-            "Surface effect on COR".into(),
-            format!(
-                r##"F = {}, p = {} (<a href="#ancova">ANCOVA, Type I</a>)"##,
-                opt(row.f, 3),
-                row.p.map_or("—".into(), p_value)
-            ),
-        ));
-    }
-    let ranked = ranked(ctx);
-    if let (Some(best), Some(worst)) = (ranked.first(), ranked.last()) {
-        let clip = |i: usize| {
-            let s = &r.shots[i];
-            format!(r##"<a href="#{}">{}</a>"##, esc(&ctx.shot_ids[i]), esc(&s.clip))
-        };
-        facts.push((
-            "Fit error per shot".into(),
-            format!(
-                "RMS {} mm ({}) to {} mm ({})",
-                mm(best.1, 3),
-                clip(best.0),
-                mm(worst.1, 3),
-                clip(worst.0)
-            ),
-        ));
-    }
-    facts.push((
-        "Warnings".into(),
-        if r.warnings.is_empty() {
-            "none".into()
-        } else {
-            format!(r##"<a href="#warnings">{}</a>"##, r.warnings.len())
-        },
-    ));
-    let mut s = String::from(r#"<table class="facts"><tbody>"#);
-    for (k, v) in facts {
-        let _ = write!(s, "<tr><th>{k}</th><td>{v}</td></tr>");
-    }
-    s.push_str("</tbody></table>\n");
-    s.push_str(&cor_by_surface(ctx));
-    s
+/// A link to shot `clip`'s plots with its tags, or its name.
+fn clip_cell(ctx: &Ctx, clip: &str, tags: &str) -> String {
+    format!("{}{tags}", ctx.clip_link(clip))
 }
 
-fn mean_sd(v: &[f64]) -> (f64, f64) {
-    let n = v.len() as f64;
-    let mean = v.iter().sum::<f64>() / n;
-    let sd = if v.len() > 1 {
-        (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
-    } else {
-        f64::NAN
-    };
-    (mean, sd)
+fn opt_pm(m: Option<crate::data::Measured>, scale: f64, sig: usize) -> String {
+    m.map_or("—".into(), |m| pm_cell(m.value * scale, m.se.map(|e| e * scale), sig))
 }
 
-/// COR per surface: count, mean, SD, speeds and angles.
-fn cor_by_surface(ctx: &Ctx) -> String {
-    let pts = &ctx.report.cor_points;
-    if pts.is_empty() {
-        return String::new();
-    }
-    let mut rows = Vec::new();
-    for surface in &ctx.surfaces {
-        let of: Vec<_> = pts.iter().filter(|p| &p.surface == surface).collect();
-        if of.is_empty() {
-            continue;
-        }
-        let cors: Vec<f64> = of.iter().map(|p| p.cor).filter(|v| v.is_finite()).collect();
-        let speeds: Vec<f64> = of.iter().map(|p| p.v_in_n.abs()).filter(|v| v.is_finite()).collect();
-        let mut angles: Vec<f64> = of.iter().map(|p| p.angle_deg).filter(|v| v.is_finite()).collect();
-        angles.sort_by(f64::total_cmp);
-        angles.dedup();
-        let (mean, sd) = if cors.is_empty() {
-            (f64::NAN, f64::NAN)
-        } else {
-            mean_sd(&cors)
-        };
-        let range = if speeds.is_empty() {
-            "—".into()
-        } else {
-            let lo = speeds.iter().copied().fold(f64::INFINITY, f64::min);
-            let hi = speeds.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            format!("{}–{}", fixed(lo, 2), fixed(hi, 2))
-        };
-        let angles: Vec<String> = angles.iter().map(|a| short(*a, 3)).collect();
-        rows.push(vec![
-            ctx.surface_cell(surface),
-            of.len().to_string(),
-            fixed(mean, 3),
-            fixed(sd, 3),
-            range,
-            angles.join(", "),
-        ]);
-    }
-    let mut s = String::from("<h3>COR by surface</h3>\n");
-    s.push_str(&table(
+/// The measured quantities per shot.
+fn measured_table(ctx: &Ctx) -> String {
+    let rows: Vec<Vec<String>> = ctx
+        .report
+        .measurements
+        .iter()
+        .enumerate()
+        .map(|(i, m): (usize, &ShotMeasurement)| {
+            let speed = m.impact_speed();
+            let angle = m.impact_angle();
+            vec![
+                (i + 1).to_string(),
+                clip_cell(ctx, &m.clip, ""),
+                ctx.surface_cell(&m.surface),
+                short(m.angle_deg, 3),
+                pm_cell(speed.value, speed.se, 4),
+                pm_cell(angle.value, angle.se, 3),
+                pm_cell(m.cor.value, m.cor.se, 4),
+                pm_cell(m.mu_eff.value + 0.0, m.mu_eff.se, 3),
+                pm_cell(m.contact_time_s.value * 1e3, m.contact_time_s.se.map(|e| e * 1e3), 4),
+                pm_cell(m.delta_max_m.value * 1e3, m.delta_max_m.se.map(|e| e * 1e3), 3),
+                opt_pm(m.spin_in_rad_s, 1.0, 3),
+                opt_pm(m.spin_out_rad_s, 1.0, 3),
+                opt_pm(m.peak_deceleration_track_m_s2, 1.0, 4),
+                opt_pm(m.peak_force_track_n, 1.0, 4),
+            ]
+        })
+        .collect();
+    crate::page::table_with_class(
+        "stacked",
         &[
+            nc("#"),
+            tc("Clip"),
             tc("Surface"),
-            nc("Shots"),
-            nc("Mean COR"),
-            nc("SD"),
-            nc("|v<sub>n,in</sub>| (m/s)"),
-            tc("Angles (°)"),
+            nc("Incline (°)"),
+            nc("|v<sub>in</sub>| (m/s)"),
+            nc("Impact angle (°)"),
+            nc("COR e"),
+            nc("μ<sub>eff</sub>"),
+            nc("Contact (ms)"),
+            nc("δ<sub>max</sub> (mm)"),
+            nc("ω<sub>in</sub> (rad/s)"),
+            nc("ω<sub>out</sub> (rad/s)"),
+            nc("Peak decel. (m/s²)"),
+            nc("Peak force (N)"),
         ],
         &rows,
-    ));
-    s
+    )
+}
+
+/// The model and the fit per shot, with the notes.
+fn model_table(ctx: &Ctx, worst: &[usize], best: &[usize], shared: &[String]) -> String {
+    let r = ctx.report;
+    let mut rows = Vec::new();
+    for (i, sh) in r.shots.iter().enumerate() {
+        let m = r.measurements.iter().find(|m| m.clip == sh.clip);
+        let p = m.and_then(|m| m.model);
+        let mut tags = String::new();
+        if worst.contains(&i) {
+            tags.push_str(r#"<span class="tag worst">worst</span>"#);
+        }
+        if best.contains(&i) {
+            tags.push_str(r#"<span class="tag best">best</span>"#);
+        }
+        let pred = |f: fn(&crate::data::ShotPrediction) -> f64, scale: f64, sig: usize| {
+            p.as_ref().map_or("—".into(), |p| num(f(p) * scale, sig))
+        };
+        rows.push(vec![
+            format!(r##"<a href="#{}">{}</a>{tags}"##, esc(&ctx.shot_ids[i]), esc(&sh.clip)),
+            ctx.surface_cell(&sh.surface),
+            pred(|p| p.cor, 1.0, 4),
+            pred(|p| p.contact_time_s, 1e3, 4),
+            pred(|p| p.delta_max_m, 1e3, 3),
+            pred(|p| p.peak_force_n, 1.0, 4),
+            pred(|p| p.peak_deceleration_m_s2, 1.0, 4),
+            sh.measured.len().to_string(),
+            rms_of(sh).map_or("—".into(), um),
+            opt(sh.chi2_red, 3),
+            esc(&own_notes(sh, shared).join("; ")),
+        ]);
+    }
+    crate::page::table_with_class(
+        "stacked",
+        &[
+            tc("Clip"),
+            tc("Surface"),
+            nc("COR e"),
+            nc("Contact (ms)"),
+            nc("δ<sub>max</sub> (mm)"),
+            nc("Peak force (N)"),
+            nc("Peak decel. (m/s²)"),
+            nc("Frames"),
+            nc("RMS (µm)"),
+            nc("χ²<sub>ν</sub>"),
+            wc("Notes"),
+        ],
+        &rows,
+    )
 }
 
 /// The shots section.
 pub(crate) fn render(ctx: &mut Ctx) -> String {
     let r = ctx.report;
-    if r.shots.is_empty() {
+    if r.shots.is_empty() && r.measurements.is_empty() {
         return crate::page::unavailable("no shot was tracked");
     }
+    let shared = shared_notes(r);
     let (worst, best) = featured(ctx);
     let mut s = String::new();
-    let link = |i: usize| {
-        format!(
-            r##"<a href="#{}">{}</a>"##,
-            esc(&ctx.shot_ids[i]),
-            esc(&r.shots[i].clip)
-        )
-    };
-    if !worst.is_empty() {
-        let w: Vec<String> = worst.iter().map(|&i| link(i)).collect();
-        let _ = write!(s, "<p>Worst fits: {}.", w.join(", "));
-        if let Some(&b) = best.first() {
-            let _ = write!(s, " Best fit: {}.", link(b));
-        }
-        s.push_str(" Their plots are open below; every other shot's plots open from its name in the table.</p>\n");
+    if !r.measurements.is_empty() {
+        s.push_str(
+            "<h3>Measured per shot</h3>\n<p>Each value with its standard error (smaller, after it). Velocities at \
+             touch; the impact angle is the incoming velocity's from the surface normal (a vertical drop on an \
+             incline arrives at the incline); the peak deceleration is the largest normal acceleration of the \
+             ball's centre from the track's second difference, where the track resolves it.</p>\n",
+        );
+        s.push_str(&measured_table(ctx));
+    }
+    if r.shots.is_empty() {
+        return s;
+    }
+    s.push_str(
+        "<h3>The fitted model per shot</h3>\n<p>The fitted model hit at each shot's measured incoming velocity, and \
+         how well it follows the shot's trajectory: RMS of the position residuals (x and y together) and the \
+         reduced χ² χ²<sub>ν</sub> (the shot's χ² over its share of the fit's degrees of freedom; see \
+         <a href=\"#fit\">Model fit</a>).</p>\n",
+    );
+    s.push_str(&model_table(ctx, &worst, &best, &shared));
+    if !shared.is_empty() {
+        s.push_str(r##"<p class="notes">Notes every shot carries are listed once under <a href="#warnings">Warnings and notes</a>.</p>"##);
     }
     // Fit error per shot.
     let rows: Vec<BarRow> = r
@@ -338,7 +336,7 @@ pub(crate) fn render(ctx: &mut Ctx) -> String {
             id,
             &rows,
             &[("RMS".into(), "#0072B2")],
-            "RMS position residual (mm)",
+            "RMS position residual (µm)",
         );
         chart.title = "Fit error per shot".into();
         s.push_str(&ctx.figure(
@@ -347,6 +345,22 @@ pub(crate) fn render(ctx: &mut Ctx) -> String {
             "RMS of the position residuals (measured − model, x and y together) per shot, coloured by surface. \
              Each bar links to the shot's plots.",
         ));
+    }
+    s.push_str("<h3>Trajectories and residuals</h3>\n");
+    let link = |i: usize| {
+        format!(
+            r##"<a href="#{}">{}</a>"##,
+            esc(&ctx.shot_ids[i]),
+            esc(&r.shots[i].clip)
+        )
+    };
+    if !worst.is_empty() {
+        let w: Vec<String> = worst.iter().map(|&i| link(i)).collect();
+        let _ = write!(s, "<p>Worst fits: {}.", w.join(", "));
+        if let Some(&b) = best.first() {
+            let _ = write!(s, " Best fit: {}.", link(b));
+        }
+        s.push_str(" Their plots are open below; every other shot's plots open from its name.</p>\n");
     }
     // Selector (shown by the script only).
     s.push_str(
@@ -362,62 +376,54 @@ pub(crate) fn render(ctx: &mut Ctx) -> String {
         );
     }
     s.push_str("</select></label></p>\n");
-    // Table.
-    let mut rows = Vec::new();
-    for (i, sh) in r.shots.iter().enumerate() {
-        let cp = r.cor_points.iter().find(|c| c.clip == sh.clip);
-        let cor = cp.map_or("—".into(), |c| match c.cor_se {
-            Some(se) => format!("{} ± {}", fixed(c.cor, 3), fixed(se, 3)),
-            None => fixed(c.cor, 3),
-        });
-        let mut tags = String::new();
-        if worst.contains(&i) {
-            tags.push_str(r#"<span class="tag worst">worst</span>"#);
-        }
-        if best.contains(&i) {
-            tags.push_str(r#"<span class="tag best">best</span>"#);
-        }
-        rows.push(vec![
-            (i + 1).to_string(),
-            format!(r##"<a href="#{}">{}</a>{tags}"##, esc(&ctx.shot_ids[i]), esc(&sh.clip)),
-            ctx.surface_cell(&sh.surface),
-            short(sh.angle_deg, 3),
-            sh.drop_height_m.map_or("—".into(), |h| fixed(h, 3)),
-            cp.map_or("—".into(), |c| fixed(c.v_in_n.abs(), 3)),
-            cor,
-            sh.measured.len().to_string(),
-            rms_of(sh).map_or("—".into(), |v| mm(v, 3)),
-            opt(sh.chi2_red, 3),
-            esc(&sh.notes.join("; ")),
-        ]);
-    }
-    s.push_str(&table(
-        &[
-            nc("#"),
-            tc("Clip"),
-            tc("Surface"),
-            nc("Angle (°)"),
-            nc("Drop (m)"),
-            nc("|v<sub>n,in</sub>| (m/s)"),
-            nc("COR"),
-            nc("Frames"),
-            nc("RMS (mm)"),
-            nc("χ²<sub>red</sub>"),
-            tc("Notes"),
-        ],
-        &rows,
-    ));
-    // Plots.
-    s.push_str("<h3>Trajectories and residuals</h3>\n");
     let budget = (POINT_BUDGET / r.shots.len()).clamp(60, 250);
     for i in 0..r.shots.len() {
         let open = worst.contains(&i) || best.contains(&i);
-        s.push_str(&shot_block(ctx, i, open, budget, worst.contains(&i), best.contains(&i)));
+        s.push_str(&shot_block(
+            ctx,
+            i,
+            open,
+            budget,
+            worst.contains(&i),
+            best.contains(&i),
+            &shared,
+        ));
     }
     s
 }
 
-fn shot_block(ctx: &mut Ctx, i: usize, open: bool, budget: usize, worst: bool, best: bool) -> String {
+fn base64(bytes: &[u8]) -> String {
+    use base64::Engine;
+    base64::engine::general_purpose::STANDARD.encode(bytes)
+}
+
+/// The strip of annotated frames of a shot.
+fn frame_strip(sh: &ShotPlot) -> String {
+    if sh.frames.is_empty() {
+        return String::new();
+    }
+    let mut s = String::from(r#"<div class="strip">"#);
+    for f in &sh.frames {
+        let _ = write!(
+            s,
+            r#"<figure><img alt="{alt}" src="data:image/png;base64,{}"><figcaption>{alt}</figcaption></figure>"#,
+            base64(&f.png),
+            alt = esc(&f.caption)
+        );
+    }
+    s.push_str("</div>\n");
+    s
+}
+
+fn shot_block(
+    ctx: &mut Ctx,
+    i: usize,
+    open: bool,
+    budget: usize,
+    worst: bool,
+    best: bool,
+    shared: &[String],
+) -> String {
     let sh = &ctx.report.shots[i];
     let mut s = format!(
         r#"<details class="shot" id="{}"{}><summary><b>{}</b> · {} · {}°"#,
@@ -428,10 +434,10 @@ fn shot_block(ctx: &mut Ctx, i: usize, open: bool, budget: usize, worst: bool, b
         short(sh.angle_deg, 3)
     );
     if let Some(rms) = rms_of(sh) {
-        let _ = write!(s, " · RMS {} mm", mm(rms, 3));
+        let _ = write!(s, " · RMS {} µm", um(rms));
     }
     if let Some(c) = sh.chi2_red {
-        let _ = write!(s, " · χ²<sub>red</sub> {}", num(c, 3));
+        let _ = write!(s, " · χ²<sub>ν</sub> {}", num(c, 3));
     }
     if worst {
         s.push_str(r#"<span class="tag worst">worst fit</span>"#);
@@ -440,10 +446,12 @@ fn shot_block(ctx: &mut Ctx, i: usize, open: bool, budget: usize, worst: bool, b
         s.push_str(r#"<span class="tag best">best fit</span>"#);
     }
     s.push_str("</summary>\n");
-    if !sh.notes.is_empty() {
-        let notes: Vec<String> = sh.notes.iter().map(|n| esc(n)).collect();
+    let notes = own_notes(sh, shared);
+    if !notes.is_empty() {
+        let notes: Vec<String> = notes.iter().map(|n| esc(n)).collect();
         let _ = writeln!(s, r#"<p class="notes">{}</p>"#, notes.join("<br>"));
     }
+    s.push_str(&frame_strip(sh));
     if sh.measured.is_empty() && sh.model.is_empty() {
         s.push_str(&crate::page::unavailable(
             "no tracked frames and no model for this shot",
@@ -472,22 +480,11 @@ fn median(mut v: Vec<f64>) -> Option<f64> {
     Some(v[v.len() / 2])
 }
 
-/// The contact window of a shot, s: from the first contact phase's start to the last one's end, widened
-/// by 2 ms on each side.
-fn contact_window(sh: &ShotPlot) -> Option<(f64, f64)> {
-    let spans = sh
-        .phases
-        .iter()
-        .filter(|p| matches!(p.phase, Phase::Compression | Phase::Restitution));
-    let (lo, hi) = spans
-        .flat_map(|p| [p.t0_s, p.t1_s])
-        .filter(|t| t.is_finite() && t.abs() < 1e12)
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), t| (a.min(t), b.max(t)));
-    (lo.is_finite() && hi >= lo).then_some((lo - 2e-3, hi + 2e-3))
-}
-
+/// One shot's figure (the paper's Figure 9): per component a column, the trajectory with the model
+/// drawn over the measured centres on top, the residual measured − model below on the same time axis,
+/// both shaded by phase.
 fn shot_figure(ctx: &mut Ctx, i: usize, budget: usize) -> String {
-    const W: f64 = 490.0;
+    const W: f64 = 540.0;
     let sh = &ctx.report.shots[i];
     let ms = |t: f64| t * 1e3;
     let times = sh
@@ -517,98 +514,85 @@ fn shot_figure(ctx: &mut Ctx, i: usize, budget: usize) -> String {
         .map(|p| (p.label().to_string(), Key::Swatch { fill: phase_fill(*p) }))
         .collect();
     let idx = thin_indices(sh.measured.len(), budget, |k| in_contact(sh, sh.measured[k].t_s));
+    let ridx = thin_indices(sh.residuals.len(), budget, |k| in_contact(sh, sh.residuals[k].t_s));
+    let sigma = median(sh.measured.iter().map(|p| p.sigma_m).collect());
     let model_color = "#D55E00";
-    let panel = |id: String,
-                 title: &str,
-                 y_label: &str,
-                 get: &dyn Fn(usize) -> (f64, f64),
-                 model: &dyn Fn(usize) -> (f64, f64)| {
-        let mut c = Chart::new(id, W, 260.0);
+    let data_color = "#7a7a7a";
+    let (n, id) = ctx.next_figure();
+    let mut charts = Vec::new();
+    for (k, (title, label, normal)) in [
+        ("Height above the surface", "y", true),
+        ("Position along the surface (down-slope)", "x", false),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let coord = |p: (f64, f64)| if normal { p.1 } else { p.0 };
+        let mut c = Chart::new(format!("{id}{}", ['a', 'b'][k]), W, 250.0);
         c.title = title.into();
-        c.y_label = y_label.into();
+        c.y_label = format!("{label} (mm)");
         c.x_label = "t (ms)".into();
         c.x_range = x_range;
         c.items.extend(bands.iter().cloned());
+        // Measured centres first, small and hollow; the model's line over them, so both stay visible.
+        c.items.push(Item::Marks {
+            marks: idx
+                .iter()
+                .map(|&j| {
+                    let p = &sh.measured[j];
+                    Mark::at(ms(p.t_s), coord((p.x_m, p.y_m)) * 1e3)
+                })
+                .collect(),
+            color: data_color,
+            shape: Shape::Circle,
+            size: 4.6,
+        });
+        // Thinner than the dots, so where they coincide both stay visible.
         if !sh.model.is_empty() {
             c.items.push(Item::Line {
-                pts: (0..sh.model.len()).map(model).collect(),
+                pts: sh
+                    .model
+                    .iter()
+                    .map(|p| (ms(p.t_s), coord((p.x_m, p.y_m)) * 1e3))
+                    .collect(),
                 color: model_color,
-                width: 1.6,
+                width: 1.4,
                 dash: false,
             });
         }
-        c.items.push(Item::Marks {
-            marks: idx.iter().map(|&k| get(k)).map(|(x, y)| Mark::at(x, y)).collect(),
-            color: "#222",
-            shape: Shape::Circle,
-            size: 3.2,
-        });
         c.legend.push((
             "measured".into(),
             Key::Mark {
-                color: "#222",
+                color: data_color,
                 shape: Shape::Circle,
             },
         ));
         if !sh.model.is_empty() {
             c.legend.push((
-                "model".into(),
+                "fitted model".into(),
                 Key::Line {
                     color: model_color,
                     dash: false,
                 },
             ));
         }
-        c
-    };
-    let (n, id) = ctx.next_figure();
-    let mut charts = vec![
-        panel(
-            format!("{id}a"),
-            "Height above the surface",
-            "y (mm)",
-            &|k| (ms(sh.measured[k].t_s), sh.measured[k].y_m * 1e3),
-            &|k| (ms(sh.model[k].t_s), sh.model[k].y_m * 1e3),
-        ),
-        panel(
-            format!("{id}b"),
-            "Position along the surface (down-slope)",
-            "x (mm)",
-            &|k| (ms(sh.measured[k].t_s), sh.measured[k].x_m * 1e3),
-            &|k| (ms(sh.model[k].t_s), sh.model[k].x_m * 1e3),
-        ),
-    ];
-    let mut caption = format!(
-        "Shot {} on {} at {}°: tracked ball centre (dots; {} of {} frames shown, every frame near contact) ",
-        esc(&sh.clip),
-        esc(&sh.surface),
-        short(sh.angle_deg, 3),
-        idx.len(),
-        sh.measured.len()
-    );
-    caption.push_str(if sh.model.is_empty() {
-        "without a model"
-    } else {
-        "and the fitted model simulated for this shot (line)"
-    });
-    if sh.residuals.is_empty() {
-        caption.push_str(". No residuals (no model was fitted to this shot).");
-        return ctx.figure(n, &charts, &caption);
+        if k == 0 {
+            c.legend.extend(phase_legend.iter().cloned());
+        }
+        charts.push(c);
     }
-    let sigma = median(sh.measured.iter().map(|p| p.sigma_m).collect());
-    let zoom = contact_window(sh);
-    let residual_chart =
-        |id: String, title: &str, range: Option<(f64, f64)>, ridx: &[usize], legend: Vec<(String, Key)>| {
-            let mut c = Chart::new(id, W, 280.0);
-            c.title = title.into();
-            c.y_label = "residual (mm)".into();
+    if !sh.residuals.is_empty() {
+        for (k, normal) in [true, false].into_iter().enumerate() {
+            let mut c = Chart::new(format!("{id}{}", ['c', 'd'][k]), W, 210.0);
+            c.title = format!("Residual, measured − model, {}", if normal { "y" } else { "x" });
+            c.y_label = "residual (µm)".into();
             c.x_label = "t (ms)".into();
-            c.x_range = range;
+            c.x_range = x_range;
             c.items.extend(bands.iter().cloned());
             if let Some(sg) = sigma {
                 c.items.push(Item::YBand {
-                    y0: -sg * 1e3,
-                    y1: sg * 1e3,
+                    y0: -sg * 1e6,
+                    y1: sg * 1e6,
                     fill: "#cfcfcf",
                 });
             }
@@ -618,73 +602,74 @@ fn shot_figure(ctx: &mut Ctx, i: usize, budget: usize) -> String {
                 dash: false,
             });
             c.y_include.push(0.0);
-            let pick = |f: &dyn Fn(usize) -> f64| -> Vec<Mark> {
-                ridx.iter()
-                    .map(|&k| Mark::at(ms(sh.residuals[k].t_s), f(k) * 1e3))
-                    .collect()
-            };
             c.items.push(Item::Marks {
-                marks: pick(&|k| sh.residuals[k].dx_m),
-                color: "#D55E00",
+                marks: ridx
+                    .iter()
+                    .map(|&j| {
+                        let r = &sh.residuals[j];
+                        Mark::at(ms(r.t_s), if normal { r.dy_m } else { r.dx_m } * 1e6)
+                    })
+                    .collect(),
+                color: if normal { "#0072B2" } else { "#D55E00" },
                 shape: Shape::Circle,
-                size: 3.4,
+                size: 3.2,
             });
-            c.items.push(Item::Marks {
-                marks: pick(&|k| sh.residuals[k].dy_m),
-                color: "#0072B2",
-                shape: Shape::Square,
-                size: 3.4,
-            });
-            c.legend = legend;
-            c
-        };
-    let mut main_legend = vec![
-        (
-            "x (along surface)".to_string(),
-            Key::Mark {
-                color: "#D55E00",
-                shape: Shape::Circle,
-            },
-        ),
-        (
-            "y (normal)".to_string(),
-            Key::Mark {
-                color: "#0072B2",
-                shape: Shape::Square,
-            },
-        ),
-    ];
-    if sigma.is_some() {
-        main_legend.push(("±1σ tracking".into(), Key::Swatch { fill: "#cfcfcf" }));
+            if sigma.is_some() {
+                c.legend.push(("±1σ tracking".into(), Key::Swatch { fill: "#cfcfcf" }));
+            }
+            charts.push(c);
+        }
+        // Column order in the grid: y trajectory, x trajectory, y residual, x residual.
     }
-    if zoom.is_none() {
-        main_legend.extend(phase_legend.iter().cloned());
-    }
-    let ridx = thin_indices(sh.residuals.len(), budget, |k| in_contact(sh, sh.residuals[k].t_s));
-    charts.push(residual_chart(
-        format!("{id}c"),
-        "Residuals, measured − model",
-        x_range,
-        &ridx,
-        main_legend,
-    ));
-    if let Some((z0, z1)) = zoom {
-        let inside: Vec<usize> = (0..sh.residuals.len())
-            .filter(|&k| (z0..=z1).contains(&sh.residuals[k].t_s))
-            .collect();
-        let keep = thin_indices(inside.len(), budget, |_| false);
-        let zidx: Vec<usize> = keep.into_iter().map(|k| inside[k]).collect();
-        charts.push(residual_chart(
-            format!("{id}d"),
-            "Residuals around the contact",
-            Some((ms(z0), ms(z1))),
-            &zidx,
-            phase_legend,
-        ));
-    }
-    caption.push_str(
-        "; residuals over the whole clip and around the contact (±2 ms), with the tracking uncertainty (median σ) \
-         shaded grey. The background is shaded by phase: flight in, compression, restitution, flight out.",
+    let mut caption = format!(
+        "Shot {} on {} at {}° (the paper's Figure 9): tracked ball centre (dots; {} of {} frames shown, every frame \
+         near contact) ",
+        esc(&sh.clip),
+        esc(&sh.surface),
+        short(sh.angle_deg, 3),
+        idx.len(),
+        sh.measured.len()
     );
+    caption.push_str(if sh.model.is_empty() {
+        "without a model"
+    } else {
+        "and the fitted model simulated for this shot (line), normal component left, tangential right"
+    });
+    if sh.residuals.is_empty() {
+        caption.push_str(". No residuals (no model was fitted to this shot).");
+    } else {
+        caption.push_str(
+            "; below each, the residual measured − model in µm with the tracking uncertainty (median σ) shaded grey. \
+             The background is shaded by phase: flight in, compression, restitution, flight out.",
+        );
+    }
     ctx.figure(n, &charts, &caption)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn notes_every_shot_carries_are_said_once() {
+        let shot = |notes: &[&str]| ShotPlot {
+            notes: notes.iter().map(|s| s.to_string()).collect(),
+            ..Default::default()
+        };
+        let r = Report {
+            shots: vec![
+                shot(&["level", "gap", "level"]),
+                shot(&["gap", "level"]),
+                shot(&["level"]),
+            ],
+            ..Default::default()
+        };
+        assert_eq!(shared_notes(&r), ["level"]);
+        assert_eq!(own_notes(&r.shots[0], &shared_notes(&r)), ["gap"]);
+        let one = Report {
+            shots: vec![shot(&["level"])],
+            ..Default::default()
+        };
+        assert!(shared_notes(&one).is_empty(), "one shot: its notes are its own");
+    }
 }

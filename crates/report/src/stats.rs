@@ -1,10 +1,15 @@
 //! The statistics sections from `bouncelab-stats` results: ANCOVA tables (the paper's Table 1, Type I and
-//! Type II), Tukey–Kramer comparisons with an interval plot (Figure 10) and residual diagnostics
-//! (Figure 11).
+//! Type II) with the coefficients' tests, comparisons of surfaces and angles on covariate-adjusted means
+//! from the same fit with an interval plot (Figure 10), and residual diagnostics whose caption says what the
+//! curvature and normality tests found (Figure 11).
 
 use std::fmt::Write;
 
-use bouncelab_stats::{Ancova, AnovaRow, AnovaTable, TukeyHsd};
+use bouncelab_stats::{
+    Ancova, AncovaInference, AnovaRow, AnovaTable, FTest, MarginalComparison, MarginalMeans, TestOutcome,
+};
+
+use crate::data::Section;
 
 use crate::fmt::{esc, fixed, num, opt, p_value, short};
 use crate::page::{Ctx, nc, table, tc};
@@ -34,15 +39,20 @@ fn anova_table(t: &AnovaTable) -> String {
     )
 }
 
-/// The ANCOVA section: model summary, Type I and Type II tables, coefficients.
-pub(crate) fn ancova_tables(a: &Ancova) -> String {
+/// The ANCOVA section: model summary, Type I and Type II tables, and the coefficients with their tests.
+pub(crate) fn ancova_section(ctx: &Ctx) -> String {
+    let r = ctx.report;
+    let Some(a) = r.ancova.get() else {
+        return crate::page::section_or(&r.ancova, |_| String::new());
+    };
     let fit = &a.fit;
     let total_ss = a.type1.total.ss;
     let r2 = 1.0 - fit.rss / total_ss;
     let terms: Vec<String> = fit.terms.iter().map(|t| esc(t)).collect();
     let mut s = format!(
-        "<p>Main-effects linear model of the COR on {} (factors treatment-coded, no interactions): n = {}, residual \
-         df = {}, σ̂ = {}, R² = {}.</p>\n",
+        "<p>Main-effects linear model of the COR on {} (factors treatment-coded, first level the reference; no \
+         interactions; v_in_n is the incoming normal speed |v<sub>n,in</sub>| in m/s): n = {}, residual df = {}, \
+         σ̂ = {}, R² = {}.</p>\n",
         if terms.is_empty() {
             "an intercept only".into()
         } else {
@@ -60,131 +70,227 @@ pub(crate) fn ancova_tables(a: &Ancova) -> String {
     s.push_str("<p>Each term adjusted for every other term (no interactions, so the same as Type III).</p>\n");
     s.push_str(&anova_table(&a.type2));
     s.push_str("<h3>Coefficients</h3>\n");
-    let rows: Vec<Vec<String>> = fit
-        .coefficient_names
-        .iter()
-        .zip(&fit.coefficients)
-        .map(|(n, c)| vec![esc(n), num(*c, 4)])
-        .collect();
-    s.push_str(&table(&[tc("Coefficient"), nc("Estimate")], &rows));
+    match r.inference.get() {
+        Some(inf) => {
+            let t = &inf.coefficients;
+            let level = format!("{}%", short(100.0 * (1.0 - t.alpha), 3));
+            let _ = writeln!(
+                s,
+                "<p>Each coefficient with its standard error, t on the residual df ({}) and two-sided p, and its {level} \
+                 confidence interval. A surface or angle coefficient is the COR difference from the reference level at \
+                 equal other terms; the v_in_n row is the COR's slope per m/s of impact speed.</p>",
+                t.df
+            );
+            let rows: Vec<Vec<String>> = t
+                .rows
+                .iter()
+                .map(|c| {
+                    vec![
+                        format!("<code>{}</code>", esc(&c.name)),
+                        num(c.estimate, 4),
+                        num(c.se, 3),
+                        num(c.t, 3),
+                        p_value(c.p),
+                        format!("{} to {}", num(c.lower, 4), num(c.upper, 4)),
+                    ]
+                })
+                .collect();
+            s.push_str(&table(
+                &[
+                    tc("Coefficient"),
+                    nc("Estimate"),
+                    nc("SE"),
+                    nc("t"),
+                    nc("p"),
+                    nc(&format!("{level} interval")),
+                ],
+                &rows,
+            ));
+        }
+        None => {
+            let rows: Vec<Vec<String>> = fit
+                .coefficient_names
+                .iter()
+                .zip(&fit.coefficients)
+                .map(|(n, c)| vec![format!("<code>{}</code>", esc(n)), num(*c, 4)])
+                .collect();
+            s.push_str(&table(&[tc("Coefficient"), nc("Estimate")], &rows));
+            if let Section::Unavailable(why) = &r.inference {
+                s.push_str(&crate::page::unavailable(&format!("standard errors and tests: {why}")));
+            }
+        }
+    }
     s
 }
 
-/// The Tukey–Kramer section.
-pub(crate) fn tukey(ctx: &mut Ctx, t: &TukeyHsd) -> String {
-    // "95% " when α is a probability, nothing otherwise.
-    let level = if t.alpha > 0.0 && t.alpha < 1.0 {
-        format!("{}% ", short(100.0 * (1.0 - t.alpha), 3))
+/// One factor's adjusted means and their comparisons, with the interval figure.
+fn factor_comparisons(ctx: &mut Ctx, m: &MarginalMeans) -> String {
+    let level = if m.alpha > 0.0 && m.alpha < 1.0 {
+        format!("{}% ", short(100.0 * (1.0 - m.alpha), 3))
     } else {
         String::new()
     };
-    let mut s = format!(
-        "<p>Tukey–Kramer comparisons of the mean COR of every pair of surfaces at a family-wise level α = {} \
-         (critical studentized range q = {}, error df = {}, pooled MSE = {}).</p>\n",
-        short(t.alpha, 3),
-        num(t.q_crit, 4),
-        t.df,
-        num(t.mse, 3)
-    );
-    let rows: Vec<Vec<String>> = t
-        .groups
+    let at: Vec<String> = m
+        .covariates_at
         .iter()
-        .map(|g| vec![ctx.surface_cell(&g.name), g.n.to_string(), fixed(g.mean, 4)])
+        .map(|g| {
+            let unit = if g.name == "v_in_n" { " m/s" } else { "" };
+            format!("{} = {}{unit}", esc(&g.name), num(g.value, 4))
+        })
         .collect();
-    s.push_str(&table(&[tc("Surface"), nc("Shots"), nc("Mean COR")], &rows));
-    if t.pairs.is_empty() {
-        s.push_str(&crate::page::unavailable("fewer than two groups to compare"));
+    let over = if m.averaged_over.is_empty() {
+        String::new()
+    } else {
+        format!(
+            ", averaged with equal weights over the levels of {}",
+            m.averaged_over.iter().map(|f| esc(f)).collect::<Vec<_>>().join(", ")
+        )
+    };
+    let is_surface = m.factor == "surface";
+    let label = |l: &str| {
+        if is_surface {
+            ctx.surface_cell(l)
+        } else {
+            format!("{}°", esc(l))
+        }
+    };
+    let mut s = format!(
+        "<h3>By {}</h3>\n<p>Estimated marginal means of the COR from the same ANCOVA fit: each {} at {}{over}. Pairs \
+         are compared on these adjusted means with the fit's residual mean square ({}) and df ({}); p-values are \
+         adjusted for the {} pairs by Tukey–Kramer (simultaneous {level}intervals, critical q = {}) and by \
+         Holm.</p>\n",
+        esc(&m.factor),
+        if is_surface { "surface" } else { "level" },
+        if at.is_empty() {
+            "the reference grid".to_string()
+        } else {
+            at.join(", ")
+        },
+        num(m.mse, 3),
+        m.df,
+        m.pairs.len(),
+        num(m.q_crit, 4),
+    );
+    let rows: Vec<Vec<String>> = m
+        .means
+        .iter()
+        .map(|g| {
+            vec![
+                label(&g.level),
+                g.n.to_string(),
+                fixed(g.raw_mean, 4),
+                crate::page::pm_cell(g.estimate, Some(g.se), 4),
+                format!("{} to {}", fixed(g.lower, 4), fixed(g.upper, 4)),
+            ]
+        })
+        .collect();
+    s.push_str(&table(
+        &[
+            tc(if is_surface { "Surface" } else { "Incline" }),
+            nc("Shots"),
+            nc("Raw mean COR"),
+            nc("Adjusted mean ± SE"),
+            nc(&format!("{level}interval")),
+        ],
+        &rows,
+    ));
+    if m.pairs.is_empty() {
+        s.push_str(&crate::page::unavailable("fewer than two levels to compare"));
         return s;
     }
-    let rows: Vec<Vec<String>> = t
+    let name = |p: &MarginalComparison| format!("{} − {}", p.level2, p.level1);
+    let rows: Vec<Vec<String>> = m
         .pairs
         .iter()
         .map(|p| {
             vec![
-                format!("{} − {}", esc(&p.group2), esc(&p.group1)),
-                num(p.mean_diff, 3),
-                num(p.std_err, 3),
-                num(p.q, 3),
-                p_value(p.p_adj),
-                num(p.lower, 3),
-                num(p.upper, 3),
-                if p.reject { "<b>yes</b>".into() } else { "no".into() },
+                esc(&name(p)),
+                crate::page::pm_cell(p.estimate, Some(p.se), 3),
+                num(p.t, 3),
+                p_value(p.p),
+                p_value(p.p_tukey),
+                p_value(p.p_holm),
+                format!("{} to {}", num(p.lower, 3), num(p.upper, 3)),
+                if p.reject_tukey {
+                    "<b>yes</b>".into()
+                } else {
+                    "no".into()
+                },
             ]
         })
         .collect();
     s.push_str(&table(
         &[
             tc("Difference"),
-            nc("Mean diff."),
-            nc("SE"),
-            nc("q"),
-            nc("p (adj.)"),
-            nc(&format!("{level}CI low")),
-            nc("high"),
+            nc("Estimate ± SE"),
+            nc("t"),
+            nc("p (unadjusted)"),
+            nc("p (Tukey)"),
+            nc("p (Holm)"),
+            nc(&format!("Tukey {level}interval")),
             tc("Differ?"),
         ],
         &rows,
     ));
     let (n, id) = ctx.next_figure();
-    let mut c = Chart::new(id, 760.0, 110.0 + 30.0 * t.pairs.len() as f64);
-    c.title = "Pairwise differences of mean COR".into();
-    c.x_label = format!("difference in mean COR, with {level}simultaneous interval");
-    c.y_categories = t.pairs.iter().map(|p| format!("{} − {}", p.group2, p.group1)).collect();
+    let mut c = Chart::new(id, 760.0, 110.0 + 30.0 * m.pairs.len() as f64);
+    c.title = format!("Differences of adjusted mean COR by {}", m.factor);
+    c.x_label = format!("difference in adjusted mean COR, with Tukey {level}simultaneous interval");
+    c.y_categories = m.pairs.iter().map(name).collect();
     c.x_include.push(0.0);
     c.items.push(Item::VRule {
         x: 0.0,
         color: "#555",
         dash: true,
     });
-    for (reject, color, label) in [
+    for (reject, color, text) in [
         (true, "#D55E00", "interval excludes 0: means differ"),
         (false, "#0072B2", "interval includes 0"),
     ] {
-        let idx: Vec<usize> = (0..t.pairs.len()).filter(|&i| t.pairs[i].reject == reject).collect();
+        let idx: Vec<usize> = (0..m.pairs.len())
+            .filter(|&i| m.pairs[i].reject_tukey == reject)
+            .collect();
         if idx.is_empty() {
             continue;
         }
-        let bars = idx
-            .iter()
-            .map(|&i| {
-                let p = &t.pairs[i];
-                ErrorBar {
-                    x: p.mean_diff,
+        c.items.push(Item::ErrorBars {
+            bars: idx
+                .iter()
+                .map(|&i| ErrorBar {
+                    x: m.pairs[i].estimate,
                     y: i as f64,
-                    x_span: Some((p.lower, p.upper)),
+                    x_span: Some((m.pairs[i].lower, m.pairs[i].upper)),
                     y_span: None,
-                }
-            })
-            .collect();
-        c.items.push(Item::ErrorBars { bars, color });
-        let marks = idx
-            .iter()
-            .map(|&i| {
-                let p = &t.pairs[i];
-                Mark {
-                    x: p.mean_diff,
-                    y: i as f64,
-                    tip: Some(format!(
-                        "{} − {}: {} [{}, {}], p = {}",
-                        p.group2,
-                        p.group1,
-                        num(p.mean_diff, 3),
-                        num(p.lower, 3),
-                        num(p.upper, 3),
-                        p_value(p.p_adj)
-                    )),
-                    href: None,
-                }
-            })
-            .collect();
+                })
+                .collect(),
+            color,
+        });
         c.items.push(Item::Marks {
-            marks,
+            marks: idx
+                .iter()
+                .map(|&i| {
+                    let p = &m.pairs[i];
+                    Mark {
+                        x: p.estimate,
+                        y: i as f64,
+                        tip: Some(format!(
+                            "{}: {} [{}, {}], p (Tukey) = {}",
+                            name(p),
+                            num(p.estimate, 3),
+                            num(p.lower, 3),
+                            num(p.upper, 3),
+                            p_value(p.p_tukey)
+                        )),
+                        href: None,
+                    }
+                })
+                .collect(),
             color,
             shape: Shape::Circle,
             size: 8.0,
         });
         c.legend.push((
-            label.into(),
+            text.into(),
             Key::Mark {
                 color,
                 shape: Shape::Circle,
@@ -194,15 +300,40 @@ pub(crate) fn tukey(ctx: &mut Ctx, t: &TukeyHsd) -> String {
     s.push_str(&ctx.figure(
         n,
         &[c],
-        "Tukey–Kramer simultaneous confidence intervals of the differences between surface mean COR (the paper's \
-         Figure 10). An interval that does not cross the dashed zero line marks a significant difference.",
+        &format!(
+            "Tukey–Kramer simultaneous {level}intervals of the differences between adjusted mean COR by {} (the paper's \
+             Figure 10, on covariate-adjusted means). An interval that does not cross the dashed zero line marks a \
+             difference at the family-wise level α = {}.",
+            esc(&m.factor),
+            short(m.alpha, 3)
+        ),
     ));
+    s
+}
+
+/// The comparisons section: every factor of the fit, surfaces first.
+pub(crate) fn comparisons(ctx: &mut Ctx, inf: &AncovaInference) -> String {
+    let mut s = String::from(
+        "<p>Comparisons on the covariate-adjusted means of the same ANCOVA that tests the surfaces above, so they \
+         agree with it: a one-way comparison of raw means would leave the impact speed's effect in its error and \
+         can miss a difference the ANCOVA finds.</p>\n",
+    );
+    let mut ordered: Vec<&MarginalMeans> = inf.marginal_means.iter().filter(|m| m.factor == "surface").collect();
+    ordered.extend(inf.marginal_means.iter().filter(|m| m.factor != "surface"));
+    if ordered.is_empty() {
+        s.push_str(&crate::page::unavailable(
+            "the fit has no factor with two or more levels",
+        ));
+    }
+    for m in ordered {
+        s.push_str(&factor_comparisons(ctx, m));
+    }
     s
 }
 
 /// Observation labels: the clips of the COR points when they match the ANCOVA one to one.
 fn obs_label(ctx: &Ctx, n: usize, i: usize) -> (String, Option<String>) {
-    let pts = &ctx.report.cor_points;
+    let pts = &ctx.report.measurements;
     match pts.get(i).filter(|_| pts.len() == n) {
         Some(p) => (format!("{} on {}", p.clip, p.surface), ctx.shot_href(&p.clip)),
         None => (format!("observation {}", i.saturating_add(1)), None),
@@ -324,13 +455,67 @@ pub(crate) fn diagnostics(ctx: &mut Ctx, a: &Ancova) -> String {
         shape: Shape::Circle,
         size: 6.0,
     });
+    let found = match ctx.report.inference.get() {
+        Some(i) => esc(&i.residual_tests.caption()),
+        None => "Curvature and normality were not tested.".into(),
+    };
     let mut s = ctx.figure(
         fig,
         &[c1, c2],
-        "Residual diagnostics of the ANCOVA (the paper's Figure 11): externally studentized residuals against the \
-         fitted COR (no pattern and few points beyond ±2 expected), and the normal probability plot of the raw \
-         residuals (points on a straight line if normal).",
+        &format!(
+            "Residual diagnostics of the ANCOVA (the paper's Figure 11): externally studentized residuals against the \
+             fitted COR, and the normal probability plot of the raw residuals. {found}"
+        ),
     );
+    if let Some(i) = ctx.report.inference.get() {
+        let t = &i.residual_tests;
+        let ftest = |what: String, o: &TestOutcome<FTest>| match o {
+            TestOutcome::Ran(f) => vec![
+                what,
+                format!("F({}, {}) = {}", f.df_num, f.df_den, num(f.f, 3)),
+                p_value(f.p),
+                if f.p < t.alpha {
+                    "curvature".into()
+                } else {
+                    "none found".into()
+                },
+            ],
+            TestOutcome::NotRun { reason } => vec![what, "—".into(), "—".into(), format!("not run: {}", esc(reason))],
+        };
+        let mut rows = vec![ftest("RESET (squared fitted values)".into(), &t.reset)];
+        for q in &t.quadratic {
+            rows.push(ftest(format!("quadratic term in {}", esc(&q.covariate)), &q.test));
+        }
+        rows.push(match &t.normality {
+            TestOutcome::Ran(n) => vec![
+                "D'Agostino–Pearson normality".into(),
+                format!(
+                    "K² = {} (skew {}, kurtosis {})",
+                    num(n.k2, 3),
+                    num(n.skewness, 3),
+                    num(n.kurtosis, 3)
+                ),
+                p_value(n.p),
+                if n.p < t.alpha {
+                    "not normal".into()
+                } else {
+                    "consistent with normal".into()
+                },
+            ],
+            TestOutcome::NotRun { reason } => vec![
+                "D'Agostino–Pearson normality".into(),
+                "—".into(),
+                "—".into(),
+                format!("not run: {}", esc(reason)),
+            ],
+        });
+        let _ = writeln!(
+            s,
+            "<p>Tests of the residuals, each at α = {} on its own:</p>",
+            short(t.alpha, 3)
+        );
+        s.push_str(&table(&[tc("Test"), nc("Statistic"), nc("p"), tc("Finding")], &rows));
+    }
     let (worst_i, worst) = d
         .studentized_external
         .iter()

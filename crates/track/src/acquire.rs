@@ -126,7 +126,6 @@ pub(crate) fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32, noise: f32) -
                                 }))
                         })? {
                             let r = 0.5 * (ca.r + cb.r);
-                            if std::env::var("ACQ_DEBUG").is_ok() { eprintln!("ACQ thr {threshold} band {:?} voters {} votes {} k {k}: {ca:?} -> {cb:?}", bands[band], voters == Voters::Strongest, votes == Votes::Moving); }
                             // `k` counts files; time follows frame indices, which count dropped frames too.
                             let t = |pos: usize| clip.time_of(clip.files()[pos].index);
                             return Ok(Acquired {
@@ -230,7 +229,11 @@ impl<'a> FrameCache<'a> {
     fn levels(&mut self, k: usize) -> Result<Vec<f32>, TrackError> {
         let gain = self.gain;
         let f = self.get(k)?;
-        Ok(with_plane(&f.pixels, gain, |p| on_plane!(p, p => p.data.iter().map(|v| crate::plane::Pixel::level(*v) * gain).collect())))
+        Ok(with_plane(
+            &f.pixels,
+            gain,
+            |p| on_plane!(p, p => p.data.iter().map(|v| crate::plane::Pixel::level(*v) * gain).collect()),
+        ))
     }
 
     /// The per-pixel median of [`BACKGROUND_FRAMES`] frames spread over the clip: the scene without what

@@ -6,9 +6,9 @@
 //! round things (screw heads, fixtures, a second ball at rest) by its motion: it is the circle that moved
 //! between two frames.
 
-use crate::refine::{EdgeSearch, NOISY_SIGMA};
-use crate::plane::{Pixel, Plane};
 use crate::local::SurfaceFrame;
+use crate::plane::{Pixel, Plane};
+use crate::refine::{EdgeSearch, NOISY_SIGMA};
 use crate::surface::SurfaceLine;
 use crate::tracker::{BallFix, CLEAN_QUALITY, Status, TrackOptions, Tracker};
 use bouncelab_frames::{Clip, FramesError, GrayPixels, ReadOptions};
@@ -132,11 +132,10 @@ impl Track {
     /// centre, axes along the line and its normal), when both the line and the scale are known.
     pub fn surface_frame(&self) -> Option<SurfaceFrame> {
         let (line, scale) = (self.surface.as_ref()?, self.scale.as_ref()?);
-        let lowest = self
-            .fixes
-            .iter()
-            .filter(|f| f.status.measured())
-            .min_by(|a, b| line.height_of(a.x_px, a.y_px).total_cmp(&line.height_of(b.x_px, b.y_px)))?;
+        let lowest = self.fixes.iter().filter(|f| f.status.measured()).min_by(|a, b| {
+            line.height_of(a.x_px, a.y_px)
+                .total_cmp(&line.height_of(b.x_px, b.y_px))
+        })?;
         Some(SurfaceFrame::on_line(
             line,
             lowest.x_px,
@@ -216,7 +215,11 @@ pub fn track_clip(
         Some(first) => {
             let first = first?;
             let gain = with_plane(&first.pixels, 1.0, |p| on_plane!(p, p => crate::plane::level_gain(&p)));
-            let noise = with_plane(&first.pixels, gain, |p| on_plane!(p, p => crate::plane::noise_sigma(&p)));
+            let noise = with_plane(
+                &first.pixels,
+                gain,
+                |p| on_plane!(p, p => crate::plane::noise_sigma(&p)),
+            );
             (gain, noise)
         }
         None => (1.0, 0.0),

@@ -25,8 +25,8 @@ mod tracker;
 
 pub use clip::{ClipTracking, Scale, Track, TrackError, TrajectoryRow, track_clip};
 pub use fit::{CircleFit, fit_circle};
-pub use local::SurfaceFrame;
 pub use hough::{Circle, CircleDetection, detect_circles, outermost, radius_bands};
+pub use local::SurfaceFrame;
 pub use plane::{Pixel, Plane};
 pub use refine::{
     EdgeSearch, Refined, RimShape, RimShapeLearner, refine_candidates, refine_circle, refined_candidates, rim_residuals,

@@ -497,7 +497,14 @@ pub fn refined_candidates<P: Pixel>(
     // the rays (the wide, re-centring searches are most of the cost), and only a peak that is still a
     // plausible circle there (half the quality asked for: a quarter of the rays measures the kept fraction to
     // about ±0.08) is measured with every ray.
-    refine_candidates(img, crate::detect_circles(img, detection), detection, search, surface, min_quality)
+    refine_candidates(
+        img,
+        crate::detect_circles(img, detection),
+        detection,
+        search,
+        surface,
+        min_quality,
+    )
 }
 
 /// [`refined_candidates`] from vote peaks found elsewhere (e.g. on the part of the frame that moves): each

@@ -291,13 +291,16 @@ pub(crate) fn lines_through(
     let mut kept: Vec<(f64, f64)> = Vec::new();
     let mut out: Vec<SurfaceLine> = Vec::new();
     for (_, c, slope, _) in good {
-        let same = |k: &(f64, f64)| (k.0 - c).abs() <= 2.0 * tol && (k.0 + k.1 * wf - c - slope * wf).abs() <= 2.0 * tol;
+        let same =
+            |k: &(f64, f64)| (k.0 - c).abs() <= 2.0 * tol && (k.0 + k.1 * wf - c - slope * wf).abs() <= 2.0 * tol;
         if kept.iter().any(same) {
             continue;
         }
         kept.push((c, slope));
         if let Some(line) = refine_line(cands, leans, c, slope, tol, xc)
-            && !out.iter().any(|o| (o.y0 - line.y0).abs() <= tol && (o.slope - line.slope).abs() * wf <= tol)
+            && !out
+                .iter()
+                .any(|o| (o.y0 - line.y0).abs() <= tol && (o.slope - line.slope).abs() * wf <= tol)
         {
             out.push(line);
         }

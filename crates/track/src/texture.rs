@@ -99,7 +99,10 @@ fn column_steps(profile: &[f32]) -> Vec<(usize, f64)> {
     let mean = |a: usize, b: usize| (sum[b] - sum[a]) / (b - a) as f64;
     // d[y]: the step between row y and y + 1.
     let rows: Vec<usize> = (k - 1..h - k - 1).collect();
-    let d: Vec<f64> = rows.iter().map(|&y| mean(y + 1, y + 1 + k) - mean(y + 1 - k, y + 1)).collect();
+    let d: Vec<f64> = rows
+        .iter()
+        .map(|&y| mean(y + 1, y + 1 + k) - mean(y + 1 - k, y + 1))
+        .collect();
     let mut abs_dev: Vec<f64> = {
         let mut s = d.clone();
         let mid = s.len() / 2;
@@ -164,7 +167,11 @@ mod tests {
             };
             let px = render(&s);
             let line = texture_line(&Plane::new(&px, 256, 256)).expect("a texture line");
-            assert!((line.y0 - y0).abs() < 0.5 + 0.5 * rough, "y0 {} vs {y0} (rough {rough}): {line:?}", line.y0);
+            assert!(
+                (line.y0 - y0).abs() < 0.5 + 0.5 * rough,
+                "y0 {} vs {y0} (rough {rough}): {line:?}",
+                line.y0
+            );
             assert!((line.tilt_deg() - deg).abs() < 0.3, "tilt {} vs {deg}", line.tilt_deg());
             assert!(line.roughness_px < 0.6 * rough + 0.6, "{line:?}");
             assert_eq!(line.cue, LineCue::Texture);
@@ -195,6 +202,9 @@ mod tests {
         let wide: Vec<u16> = px.iter().map(|&v| ((v as u32 * 4095 / 255) as u16) << 4).collect();
         let a = texture_line(&Plane::new(&px, 256, 256)).unwrap();
         let b = texture_line(&Plane::new(&wide, 256, 256)).unwrap();
-        assert!((a.y0 - b.y0).abs() < 0.05 && (a.slope - b.slope).abs() < 1e-3, "{a:?} vs {b:?}");
+        assert!(
+            (a.y0 - b.y0).abs() < 0.05 && (a.slope - b.slope).abs() < 1e-3,
+            "{a:?} vs {b:?}"
+        );
     }
 }

@@ -251,8 +251,10 @@ impl Tracker {
         if self.surface.is_none() && self.surface_tries < 5 {
             self.surface_tries += 1;
             // Where the ball is expected, a line above it is not the surface.
-            let ball = self.predict(t_s).zip(self.expected_radius()).map(|((x, y), r)| (x, y, r));
-            if std::env::var("LINE_DEBUG").is_ok() { eprintln!("LINE frame {frame} ball {ball:?} cands {:?}", find_surface_lines(img, None).map(|l| std::iter::once(l.line).chain(l.alternatives).map(|l| (l.y0, l.cue)).collect::<Vec<_>>())); }
+            let ball = self
+                .predict(t_s)
+                .zip(self.expected_radius())
+                .map(|((x, y), r)| (x, y, r));
             if let Some(lines) = find_surface_lines(img, ball) {
                 self.surface = Some(lines.line);
                 self.surface_alternatives = lines.alternatives;
@@ -322,7 +324,8 @@ impl Tracker {
         if cands.is_empty() {
             self.missed += 1;
             if self.missed == 3 {
-                self.warnings.push(format!("frame {frame}: ball lost; looking for it along its path"));
+                self.warnings
+                    .push(format!("frame {frame}: ball lost; looking for it along its path"));
             }
             return BallFix::absent(frame, t_s, Status::Absent);
         }

@@ -97,7 +97,10 @@ fn a_clip_where_nothing_moves_names_the_static_circles() {
     let err = track_clip(&clip, &ClipTracking::default(), |_, _| {}).unwrap_err();
     assert!(matches!(err, TrackError::NothingMoves { .. }), "{err}");
     let text = err.to_string();
-    assert!(text.contains("radius 40.0 px at (120, 91)") && text.contains("no moving ball"), "{text}");
+    assert!(
+        text.contains("radius 40.0 px at (120, 91)") && text.contains("no moving ball"),
+        "{text}"
+    );
 }
 
 /// A bright screw head and a faint ball: the ball, which moves, is tracked; the screw never is, however
@@ -122,7 +125,10 @@ fn a_faint_moving_ball_beats_a_clear_static_screw() {
     let track = track_clip(&clip, &ClipTracking::default(), |_, _| {}).unwrap();
     for f in track.fixes.iter().filter(|f| f.status.measured()) {
         let (x, y) = path(f.frame);
-        assert!((f.x_px - x).abs() < 0.5 && (f.y_px - y).abs() < 0.5, "{f:?} vs ({x}, {y})");
+        assert!(
+            (f.x_px - x).abs() < 0.5 && (f.y_px - y).abs() < 0.5,
+            "{f:?} vs ({x}, {y})"
+        );
     }
     assert!(track.fixes.iter().filter(|f| f.status.name() == "ok").count() >= 36);
 }
