@@ -72,13 +72,17 @@ pub(crate) fn session_key(session: &Session) -> String {
 const MEASUREMENT_REVISION: u32 = 3;
 
 /// Everything besides the frame files that changes a shot's track or estimate.
-fn settings_text(session: &Session, entry: &ClipEntry, gravity: f64) -> String {
+fn settings_text(entry: &ClipEntry, gravity: f64) -> String {
     format!(
-        "bouncelab {} rev {MEASUREMENT_REVISION} | fps {} | downslope {:?} | diameter {} | angle {} | gravity {} | tracker {:?}",
+        "bouncelab {} rev {MEASUREMENT_REVISION} | fps {} ({:?}) | downslope {:?} | diameter {} | scale {:?} | roi {:?} | line {:?} | angle {} | gravity {} | tracker {:?}",
         env!("CARGO_PKG_VERSION"),
         entry.fps,
+        entry.fps_source,
         entry.downslope,
-        session.ball.diameter_m,
+        entry.settings.ball_diameter_m,
+        entry.settings.scale_m_per_px,
+        entry.settings.roi,
+        entry.settings.contact_line,
         entry.angle_deg,
         gravity,
         bouncelab_track::TrackOptions::default(),
@@ -103,7 +107,7 @@ pub fn measure_session(
     };
     let mut jobs = Vec::new();
     for entry in &session.clips {
-        let hash = fingerprint_clip_dir(&entry.dir, &settings_text(session, entry, gravity), fingerprint)?;
+        let hash = fingerprint_clip_dir(&entry.dir, &settings_text(entry, gravity), fingerprint)?;
         let record = ShotRecord {
             clip: entry.name.clone(),
             surface: entry.surface.clone(),
@@ -127,7 +131,7 @@ pub fn measure_session(
         let jobs = &jobs;
         scope.spawn(move || {
             jobs.par_iter().for_each_with(tx, |tx, job| {
-                let result = measure_clip(session, job.entry, gravity);
+                let result = measure_clip(job.entry, gravity);
                 // The receiver only goes away after a store error; the remaining shots then stay pending.
                 let _ = tx.send((job.shot_id, job.entry.name.clone(), result));
             });
@@ -186,12 +190,16 @@ pub fn measure_session(
 type Measured = Result<(TrackRecord, Result<EstimateRecord, String>), String>;
 
 /// Tracks and estimates one clip on the calling thread.
-fn measure_clip(session: &Session, entry: &ClipEntry, gravity: f64) -> Measured {
+fn measure_clip(entry: &ClipEntry, gravity: f64) -> Measured {
     let clip = entry.open().map_err(|e| e.to_string())?;
+    let settings = &entry.settings;
     let opts = ClipTracking {
-        ball_diameter_m: session.ball.diameter_m,
+        ball_diameter_m: settings.ball_diameter_m,
+        scale_hint_m_per_px: settings.scale_m_per_px,
         downslope_negative_x: entry.downslope == Downslope::MinusX,
         read: ReadOptions::with_threads(1),
+        roi: settings.roi,
+        contact_line: settings.contact_line,
         ..ClipTracking::default()
     };
     let started = std::time::Instant::now();
@@ -199,7 +207,7 @@ fn measure_clip(session: &Session, entry: &ClipEntry, gravity: f64) -> Measured 
     let conditions = Conditions {
         incline_deg: entry.angle_deg,
         gravity,
-        ball_diameter_m: session.ball.diameter_m,
+        ball_diameter_m: settings.ball_diameter_m,
     };
     let estimate = estimate_with_frames(&track, &clip, &conditions);
     // The trajectory in the estimate's local frame (on the contact line it chose, along its tilt), else in

@@ -114,7 +114,7 @@ pub fn fit_free_acceleration(points: &[(f64, f64, f64, f64)]) -> Option<([f64; 2
     let sw: f64 = points.iter().map(|p| 1.0 / (p.3 * p.3)).sum();
     let t_ref = points.iter().map(|p| p.0 / (p.3 * p.3)).sum::<f64>() / sw;
     let span = points.iter().map(|p| (p.0 - t_ref).abs()).fold(0.0, f64::max);
-    if !(span > 0.0) {
+    if span.is_nan() || span <= 0.0 {
         return None;
     }
     let mut a = [0.0; 2];
@@ -160,7 +160,7 @@ fn invert3(m: [[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
         m[r1][c1] * m[r2][c2] - m[r1][c2] * m[r2][c1]
     };
     let det = m[0][0] * cof(0, 0) + m[0][1] * cof(0, 1) + m[0][2] * cof(0, 2);
-    if !(det.abs() > 1e-300) {
+    if det.is_nan() || det.abs() <= 1e-300 {
         return None;
     }
     let mut inv = [[0.0; 3]; 3];

@@ -201,7 +201,9 @@ fn onset(side: &[HeightPoint], _lowest: f64, a_px: f64, _radius_px: f64) -> Opti
     // Profile χ² over candidate touch times.
     let t_from = (t_dep - LOOK_BACK_FRAMES * dt).max(early[early.len() / 2].t);
     let steps = ((t_dep - t_from) / (GRID_FRAMES * dt)).ceil().max(1.0) as usize;
-    let profile: Vec<(f64, f64, [f64; 4], [[f64; 4]; 4])> = (0..=steps)
+    // (touch time, χ², coefficients, their covariance)
+    type ProfilePoint = (f64, f64, [f64; 4], [[f64; 4]; 4]);
+    let profile: Vec<ProfilePoint> = (0..=steps)
         .filter_map(|i| {
             let t0 = t_from + (t_dep - t_from) * i as f64 / steps as f64;
             let (c, cov, chi2) = fit_onset(&used, a_px, &clock, Some(t0))?;
@@ -356,7 +358,8 @@ fn invert(mut a: Vec<Vec<f64>>) -> Option<Vec<Vec<f64>>> {
     for col in 0..n {
         let piv = (col..n).max_by(|&x, &y| a[x][col].abs().total_cmp(&a[y][col].abs()))?;
         let scale = a.iter().map(|r| r[col].abs()).fold(0.0, f64::max);
-        if !(a[piv][col].abs() > 1e-14 * scale) {
+        let p = a[piv][col].abs();
+        if p.is_nan() || p <= 1e-14 * scale {
             return None;
         }
         a.swap(col, piv);

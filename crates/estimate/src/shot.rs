@@ -444,7 +444,7 @@ fn impossible(v_in_n: f64, v_out_n: f64, cor: f64, mu: f64, t_touch: f64, t_sep:
             "a contact of {contact_ms:.3} ms is impossible for a ball (0.1–50 ms)"
         ));
     }
-    if !(mu.abs() <= 1.5) {
+    if mu.is_nan() || mu.abs() > 1.5 {
         flags.push(format!("μ_eff {mu:.3} is implausible (|μ_eff| ≤ 1.5)"));
     }
     flags

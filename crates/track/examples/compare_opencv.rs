@@ -130,6 +130,7 @@ fn synthetic_scene(i: usize) -> Scene {
         distractors: vec![(440.0, 120.0, 9.0, 40.0), (60.0, 470.0, 25.0, 190.0)],
         noise: 5.0,
         seed: 1000 + i as u64,
+        roughness: 0.0,
     }
 }
 

@@ -27,11 +27,11 @@ fn main() {
             )
         };
         println!("{path}");
-        match find_surface_lines(&plane) {
+        match find_surface_lines(&plane, None) {
             Some(l) => {
                 println!("  chosen      {}", show(&l.line));
-                if let Some(a) = l.alternative {
-                    println!("  alternative {}", show(&a));
+                for a in &l.alternatives {
+                    println!("  alternative {}", show(a));
                 }
             }
             None => println!("  no line"),

@@ -59,7 +59,7 @@ enum Voters {
 /// lists the static circles seen. With a scale hint only radii within ±20 % of the ball's are searched.
 pub(crate) fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32, noise: f32) -> Result<Acquired, TrackError> {
     let n = clip.len();
-    let (w, h) = clip.dimensions();
+    let (w, h) = opts.roi.map_or(clip.dimensions(), |r| (r.width, r.height));
     let (min_radius, max_radius) = match opts.scale_hint_m_per_px {
         Some(scale) => {
             let r = opts.ball_diameter_m / (2.0 * scale);
@@ -79,7 +79,7 @@ pub(crate) fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32, noise: f32) -
     // voters before all significant ones (cheaper, and what a clear ball needs), moving votes before the
     // frame's; then pairs of frames through the first half of the clip.
     for threshold in [CLEAN_QUALITY, CANDIDATE_QUALITY] {
-        for band in 0..bands.len() {
+        for (band, &(lo, hi)) in bands.iter().enumerate() {
             for voters in [Voters::Strongest, Voters::AboveNoise] {
                 for votes in [Votes::Moving, Votes::Frame] {
                     if votes == Votes::Moving && background.is_none() {
@@ -89,7 +89,6 @@ pub(crate) fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32, noise: f32) -
                         if let Some(c) = found.get(&(k, band, votes, voters)) {
                             return Ok(c.clone());
                         }
-                        let (lo, hi) = bands[band];
                         let det = CircleDetection {
                             min_radius: lo,
                             max_radius: hi,
@@ -219,7 +218,10 @@ impl<'a> FrameCache<'a> {
 
     fn get(&mut self, k: usize) -> Result<&Frame, TrackError> {
         if !self.frames.contains_key(&k) {
-            let f = self.clip.read(k, self.opts.read.png_decoder).expect("index in range")?;
+            let f = crate::clip::in_region(
+                self.clip.read(k, self.opts.read.png_decoder).expect("index in range")?,
+                self.opts.roi.as_ref(),
+            );
             self.frames.insert(k, f);
         }
         Ok(&self.frames[&k])
@@ -271,7 +273,7 @@ impl<'a> FrameCache<'a> {
         votes: Votes,
         background: Option<&[f32]>,
     ) -> Result<Vec<Circle>, TrackError> {
-        let (w, h) = self.clip.dimensions();
+        let (w, h) = self.opts.roi.map_or(self.clip.dimensions(), |r| (r.width, r.height));
         let (w, h) = (w as usize, h as usize);
         let peaks = match (votes, background) {
             (Votes::Moving, Some(bg)) => {

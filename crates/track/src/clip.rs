@@ -11,7 +11,7 @@ use crate::plane::{Pixel, Plane};
 use crate::refine::{EdgeSearch, NOISY_SIGMA};
 use crate::surface::SurfaceLine;
 use crate::tracker::{BallFix, CLEAN_QUALITY, Status, TrackOptions, Tracker};
-use bouncelab_frames::{Clip, FramesError, GrayPixels, ReadOptions};
+use bouncelab_frames::{Clip, ContactLine, Frame, FramesError, GrayPixels, ReadOptions, Roi};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -49,6 +49,12 @@ pub struct ClipTracking {
     pub read: ReadOptions,
     /// Tracker settings.
     pub tracker: TrackOptions,
+    /// Only this part of each frame is searched (the ball, the surface line); results stay in the whole
+    /// frame's pixels. `None`: the whole frame.
+    pub roi: Option<Roi>,
+    /// The contact line the user gives (y at the frame's centre column, tilt): used instead of one found in
+    /// the image. `None`: found.
+    pub contact_line: Option<ContactLine>,
 }
 
 impl Default for ClipTracking {
@@ -59,6 +65,8 @@ impl Default for ClipTracking {
             downslope_negative_x: false,
             read: ReadOptions::default(),
             tracker: TrackOptions::default(),
+            roi: None,
+            contact_line: None,
         }
     }
 }
@@ -177,6 +185,20 @@ impl Track {
     }
 }
 
+/// The frame cut to `roi` (whole when `None`). Cost: a copy of the region.
+pub(crate) fn in_region(frame: Frame, roi: Option<&Roi>) -> Frame {
+    let Some(r) = roi else {
+        return frame;
+    };
+    use imageproc::image::imageops::crop_imm;
+    let pixels = match &frame.pixels {
+        GrayPixels::U8(img) => GrayPixels::U8(crop_imm(img, r.x, r.y, r.width, r.height).to_image()),
+        GrayPixels::U16(img) => GrayPixels::U16(crop_imm(img, r.x, r.y, r.width, r.height).to_image()),
+    };
+    Frame { pixels, ..frame }
+}
+
+/// Runs `f` on the frame's pixels as a plane with `gain` (see [`crate::plane::level_gain`]).
 pub(crate) fn with_plane<R>(px: &GrayPixels, gain: f32, f: impl FnOnce(PlaneRef<'_>) -> R) -> R {
     let (w, h) = (px.width() as usize, px.height() as usize);
     match px {
@@ -211,9 +233,10 @@ pub fn track_clip(
     let mut warnings = Vec::new();
     // The stream starts decoding at once, so its first frames are ready when acquisition is done.
     let frames = clip.frames_with(&opts.read)?;
+    let roi = opts.roi;
     let (gain, noise) = match clip.read(0, opts.read.png_decoder) {
         Some(first) => {
-            let first = first?;
+            let first = in_region(first?, roi.as_ref());
             let gain = with_plane(&first.pixels, 1.0, |p| on_plane!(p, p => crate::plane::level_gain(&p)));
             let noise = with_plane(
                 &first.pixels,
@@ -247,7 +270,25 @@ pub fn track_clip(
         ..opts.tracker.clone()
     });
     tracker.seed(seed.0, seed.1);
+    // A line the user gives, in the searched region's pixels.
+    let (w, _) = clip.dimensions();
+    let (ox, oy) = roi.map_or((0.0, 0.0), |r| (r.x as f64, r.y as f64));
+    let given = opts
+        .contact_line
+        .map(|l| SurfaceLine::given((w as f64 - 1.0) / 2.0 - ox, l.y_px - oy, l.tilt_deg));
+    if let Some(line) = given {
+        tracker.set_surface(line);
+    }
     let (fixes, waiting, tracking) = stream_fixes(frames, clip.len(), &mut progress, |frame| {
+        // Only a region is copied; a whole frame is read where it lies.
+        let cut;
+        let frame = match roi {
+            Some(r) => {
+                cut = in_region(frame.clone(), Some(&r));
+                &cut
+            }
+            None => frame,
+        };
         with_plane(
             &frame.pixels,
             gain,
@@ -264,7 +305,10 @@ pub fn track_clip(
         back.set_surface(*line);
     }
     let retracked = retrack_start(&mut fixes, &mut back, |tr, k, frame, t_back| {
-        let image = clip.read(k, opts.read.png_decoder).expect("index in range")?;
+        let image = in_region(
+            clip.read(k, opts.read.png_decoder).expect("index in range")?,
+            roi.as_ref(),
+        );
         Ok(with_plane(
             &image.pixels,
             gain,
@@ -306,10 +350,20 @@ pub fn track_clip(
         tracker.edge_definition_px(),
         tracker.rim_shape().map_or(0.0, |s| s.rms_px()),
     );
+    // Back to the whole frame's pixels.
+    for f in &mut fixes {
+        f.x_px += ox;
+        f.y_px += oy;
+    }
+    let whole = |l: &SurfaceLine| SurfaceLine {
+        x0: l.x0 + ox,
+        y0: l.y0 + oy,
+        ..*l
+    };
     Ok(Track {
         fixes,
-        surface: tracker.surface().copied(),
-        surface_alternatives: tracker.surface_alternatives().to_vec(),
+        surface: tracker.surface().map(whole),
+        surface_alternatives: tracker.surface_alternatives().iter().map(whole).collect(),
         scale,
         warnings,
         seconds_waiting: waiting,

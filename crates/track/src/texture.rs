@@ -111,7 +111,7 @@ fn column_steps(profile: &[f32]) -> Vec<(usize, f64)> {
     };
     let mid = abs_dev.len() / 2;
     let scale = 1.4826 * *abs_dev.select_nth_unstable_by(mid, f64::total_cmp).1;
-    if !(scale > 0.0) {
+    if scale.is_nan() || scale <= 0.0 {
         return Vec::new();
     }
     let mut peaks: Vec<(usize, f64)> = (1..d.len() - 1)

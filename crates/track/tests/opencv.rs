@@ -23,6 +23,7 @@ fn scene(ball: (f64, f64, f64), seed: u64) -> Scene {
         distractors: vec![(450.0, 80.0, 9.0, 40.0)],
         noise: 5.0,
         seed,
+        roughness: 0.0,
     }
 }
 
