@@ -25,7 +25,7 @@ pub use shots::{ShotData, load_failed_tracks, load_shots, measured_shot};
 use bouncelab_compare::{Comparison, FailureReport, ShotExtras, SpinFrame};
 use bouncelab_diagnose::{Diagnosis, SearchOptions, find_missing_effect_with};
 use bouncelab_fit::{FitOptions, FitResult, Problem, fit_problem};
-use bouncelab_frames::Session;
+use bouncelab_frames::{ClipOptions, Session};
 use bouncelab_model::{EffectKind, EffectSetting, ModelSpec, ParamRef, ParamSetting};
 use bouncelab_stats::{
     Ancova, AncovaInference, CorObservation, Dataset, PAPER_TERMS, TukeyHsd, ancova, ancova_inference, tukey_hsd_factor,
@@ -98,6 +98,9 @@ pub struct AnalyzeOptions {
     pub fingerprint: ClipFingerprint,
     /// Run the missing-effect search (the slowest stage after tracking).
     pub diagnose: bool,
+    /// Command-line overrides (fps, scale, diameter, region of interest, contact line) applied to every
+    /// clip; each beats `clip.toml`, the camera header and `session.toml`.
+    pub clip_options: ClipOptions,
 }
 
 /// What [`analyze`] did, for the summary a person reads.
@@ -239,7 +242,7 @@ pub fn analyze(
     progress: &dyn Progress,
 ) -> Result<Analysis, AnalyzeError> {
     let mut timings = Vec::new();
-    let session = Session::load(session_dir)?;
+    let session = Session::load_with(session_dir, &options.clip_options)?;
     for w in &session.warnings {
         progress.note(&w.to_string());
     }

@@ -318,6 +318,15 @@ pub(crate) fn build(a: &Analysis, p: &Predictions, description: Option<&str>, wa
     notes.extend(a.measure.failed.iter().map(|(c, m)| format!("{c}: not measured: {m}")));
     notes.extend(a.excluded.iter().map(|(c, m)| format!("{c}: left out of the fit: {m}")));
     notes.extend(p.failures.iter().cloned());
+    let tilts: Vec<_> = a.shots.iter().filter_map(|s| s.estimate.surface_tilt_deg).collect();
+    if let Some(t) = bouncelab_estimate::session_tilt_deg(&tilts) {
+        notes.push(format!(
+            "the surface lies tilted by {} ± {:.3}° in the image over {} shot(s) (counter-clockwise as seen: a camera roll, or the surface's own slope across the view); each shot is measured along its own line, so the tilt is taken out of its velocities",
+            format!("{:+.3}", t.value).replace('-', "\u{2212}"),
+            t.se,
+            tilts.len()
+        ));
+    }
     let session_name = a
         .session_dir
         .file_name()
@@ -418,6 +427,9 @@ fn shot_plot(a: &Analysis, c: &ShotComparison) -> r::ShotPlot {
         })
         .collect();
     let mut notes = data.map(|s| s.estimate.notes.clone()).unwrap_or_default();
+    if let Some(source) = data.and_then(|s| contact_source(&s.estimate)) {
+        notes.push(source);
+    }
     if let Some(level) = surface_level(a, &c.surface, &c.shot) {
         // The level is the true surface's height in the measured frame: a negative one lies below the line
         // found in the image, so the line lies above the plane the ball touches.
@@ -767,6 +779,34 @@ pub(crate) fn write_failure(
     let path = dir.join("report.html");
     bouncelab_report::write_report(&path, &report)?;
     Ok(path)
+}
+
+/// Where a shot's contact level came from, for a person: the cue, the line's tilt and how the ball's own
+/// trajectory agrees with it.
+fn contact_source(e: &bouncelab_estimate::Estimate) -> Option<String> {
+    use bouncelab_track::LineCue;
+    let line = e.contact_line?;
+    let what = match line.cue {
+        LineCue::Given => "the contact line given in the settings",
+        LineCue::Brightness => "the surface line found by its brightness step",
+        LineCue::Texture => "the surface line found by its change of texture",
+        LineCue::Trajectory => "the ball's trajectory (no surface line it agrees with was found)",
+    };
+    let mut text = format!("contact level from {what}");
+    if let Some(t) = e.surface_tilt_deg {
+        text += &format!(", tilt {:+.3} ± {:.3}°", t.value, t.se).replace('-', "\u{2212}");
+    }
+    if line.cue != LineCue::Trajectory
+        && let Some(level) = e.trajectory_level_px
+    {
+        text += &format!(
+            "; the trajectory puts it {:.2} ± {:.2} px {}",
+            level.value.abs(),
+            level.se,
+            if level.value >= 0.0 { "higher" } else { "lower" }
+        );
+    }
+    Some(text)
 }
 
 #[cfg(test)]
