@@ -465,7 +465,13 @@ pub fn analyze(
         outputs,
         timings,
     };
-    let written = report::write(&options.out_dir, &analysis, description.as_deref(), &warnings)?;
+    let written = report::write(
+        &options.out_dir,
+        &analysis,
+        &session.clips,
+        description.as_deref(),
+        &warnings,
+    )?;
     analysis.outputs.extend(written);
     if let Some((_, t)) = analysis.timings.iter_mut().find(|(s, _)| *s == Stage::Report) {
         *t += started_report.elapsed().as_secs_f64();
