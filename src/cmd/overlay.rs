@@ -125,7 +125,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         let Some(mark) = by_frame.get(&frame.index) else {
             continue;
         };
-        if !a.sheet && (k as u64 % every == 0 || is_key) {
+        if !a.sheet && ((k as u64).is_multiple_of(every) || is_key) {
             let picture = annotate_frame(&frame.pixels, mark, line.as_ref(), a.zoom, &style)
                 .with_context(|| format!("drawing {}", frame.path.display()))?;
             let png = encode_png_with(&picture, PngSpeed::Fast)?;

@@ -725,23 +725,25 @@ pub fn session_stats(shots: &[ShotData]) -> Result<SessionStats, String> {
 fn shot_extras(s: &ShotData) -> ShotExtras {
     let frames = &s.measured.frames;
     let mut spin = Vec::new();
-    if let (Some(m), Some(f)) = (s.estimate.spin_in, frames.first()) {
-        if m.se > 0.0 && m.value.is_finite() {
-            spin.push(SpinFrame {
-                t_s: f.t_s,
-                omega_rad_s: m.value,
-                sigma_rad_s: m.se,
-            });
-        }
+    if let (Some(m), Some(f)) = (s.estimate.spin_in, frames.first())
+        && m.se > 0.0
+        && m.value.is_finite()
+    {
+        spin.push(SpinFrame {
+            t_s: f.t_s,
+            omega_rad_s: m.value,
+            sigma_rad_s: m.se,
+        });
     }
-    if let (Some(m), Some(f)) = (s.estimate.spin_out, frames.last()) {
-        if m.se > 0.0 && m.value.is_finite() {
-            spin.push(SpinFrame {
-                t_s: f.t_s,
-                omega_rad_s: m.value,
-                sigma_rad_s: m.se,
-            });
-        }
+    if let (Some(m), Some(f)) = (s.estimate.spin_out, frames.last())
+        && m.se > 0.0
+        && m.value.is_finite()
+    {
+        spin.push(SpinFrame {
+            t_s: f.t_s,
+            omega_rad_s: m.value,
+            sigma_rad_s: m.se,
+        });
     }
     ShotExtras {
         drop_height_m: Some(s.drop_height_m),
