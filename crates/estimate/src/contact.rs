@@ -47,6 +47,10 @@ pub struct TrajectoryContact {
     pub lowest_px: f64,
     /// What a person should know (a separation lower than the touch, a level poorly determined).
     pub notes: Vec<String>,
+    /// False when the touch and the separation put the contact at levels more than 2σ apart: the trajectory
+    /// contradicts itself (an arc it does not follow, such as a drag-slowed flight), so it can place a contact
+    /// when nothing else does but cannot overrule a line seen in the image.
+    pub consistent: bool,
 }
 
 /// Whether the trajectory holds an impact: `Ok(index of the lowest point)` when the centre comes down and
@@ -117,6 +121,7 @@ pub fn trajectory_contact(
     let sep = onset(&reversed, lowest, a_px, radius_px);
     let mut notes = Vec::new();
     let (mut level, mut level_se) = (touch.level, touch.level_se);
+    let mut consistent = true;
     let separation = sep.as_ref().map(|s| ((-s.t0, s.t0_se), (s.level, s.level_se)));
     if let Some(s) = &sep {
         let gap = s.level - touch.level;
@@ -126,6 +131,7 @@ pub fn trajectory_contact(
             level = (wt * touch.level + ws * s.level) / (wt + ws);
             level_se = (1.0 / (wt + ws)).sqrt();
         } else {
+            consistent = false;
             notes.push(format!(
                 "the ball leaves its contact {:.2} ± {:.2} px {} where it touched (from its trajectory): the touch's level is used",
                 gap.abs(),
@@ -148,6 +154,7 @@ pub fn trajectory_contact(
         separation,
         lowest_px: lowest,
         notes,
+        consistent,
     })
 }
 

@@ -573,7 +573,23 @@ fn contact_line(
     match (found, &trajectory) {
         (Some(line), Ok(tc)) => {
             let m = relative(tc, &line);
-            if agrees(&m, &line) {
+            // A trajectory whose touch and separation disagree (an arc it does not follow, such as a
+            // drag-slowed flight) cannot overrule a line that lies between the two.
+            let between = !tc.consistent
+                && tc.separation.is_some_and(|(_, (sep, sep_se))| {
+                    let m_sep = m.value + (sep - tc.touch_level.0);
+                    let tol = 3.0 * m.se.hypot(sep_se) + (0.03 * radius_px).max(1.0);
+                    m.value.min(m_sep) - tol <= 0.0 && 0.0 <= m.value.max(m_sep) + tol
+                });
+            if agrees(&m, &line) || between {
+                if between {
+                    notes.push(format!(
+                        "the ball's touch puts the contact {:.1} ± {:.1} px from the surface line found ({} cue) and its separation on the line's other side: the trajectory contradicts itself, so the line is used",
+                        m.value,
+                        m.se,
+                        line.cue.name()
+                    ));
+                }
                 return Ok(ContactChoice {
                     line,
                     trajectory_level_px: Some(m),
