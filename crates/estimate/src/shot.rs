@@ -16,6 +16,32 @@ pub struct Conditions {
     pub ball_diameter_m: f64,
 }
 
+impl Conditions {
+    /// Refuses conditions no impact can have: an incline that is not strictly between −90° and 90°, a
+    /// gravity or ball diameter that is not a positive finite number.
+    pub fn check(&self) -> Result<(), EstimateError> {
+        let bad = |field, value, why| Err(EstimateError::BadCondition { field, value, why });
+        if self.incline_deg.is_nan() || self.incline_deg.abs() >= 90.0 {
+            return bad(
+                "incline",
+                self.incline_deg,
+                "an incline lies strictly between −90 and 90 degrees",
+            );
+        }
+        if !(self.gravity.is_finite() && self.gravity > 0.0) {
+            return bad("gravity", self.gravity, "must be a positive number of m/s²");
+        }
+        if !(self.ball_diameter_m.is_finite() && self.ball_diameter_m > 0.0) {
+            return bad(
+                "ball diameter",
+                self.ball_diameter_m,
+                "must be a positive number of metres",
+            );
+        }
+        Ok(())
+    }
+}
+
 impl Default for Conditions {
     fn default() -> Self {
         Conditions {
@@ -151,6 +177,13 @@ impl Estimate {
 #[non_exhaustive]
 pub enum EstimateError {
     /// The track has no scale (the ball was never measured clear of the surface).
+    /// A condition of the shot that no impact can have.
+    #[error("{field} = {value}: {why}")]
+    BadCondition {
+        field: &'static str,
+        value: f64,
+        why: &'static str,
+    },
     #[error("no scale: the ball was not measured in free flight in enough frames")]
     NoScale,
     /// No surface line was found and the trajectory could not tell the contact either.
@@ -212,6 +245,7 @@ struct Point {
 /// it agrees); the contact level the trajectory gives (see `contact.rs`). The local frame follows that line's
 /// tilt in the image.
 pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError> {
+    c.check()?;
     let scale = track.scale.ok_or(EstimateError::NoScale)?;
     let s = scale.m_per_px;
     let measured: Vec<&bouncelab_track::BallFix> = track

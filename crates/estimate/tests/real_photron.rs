@@ -57,3 +57,38 @@ fn a_real_free_fall_is_tracked_in_every_frame_and_has_no_impact() {
         other => panic!("expected no impact, got {other:?}"),
     }
 }
+
+#[test]
+fn conditions_no_impact_can_have_are_refused_by_name() {
+    use bouncelab_estimate::Conditions;
+    let ok = Conditions::default();
+    assert!(ok.check().is_ok());
+    for (c, field) in [
+        (
+            Conditions {
+                incline_deg: f64::NAN,
+                ..ok
+            },
+            "incline",
+        ),
+        (
+            Conditions {
+                incline_deg: 90.0,
+                ..ok
+            },
+            "incline",
+        ),
+        (Conditions { gravity: 0.0, ..ok }, "gravity"),
+        (
+            Conditions {
+                ball_diameter_m: 1e300 * 1e300,
+                ..ok
+            },
+            "ball diameter",
+        ),
+    ] {
+        let err = c.check().unwrap_err();
+        assert!(matches!(err, EstimateError::BadCondition { .. }), "{err}");
+        assert!(err.to_string().starts_with(field), "{err}");
+    }
+}

@@ -381,11 +381,26 @@ fn read_clips_csv(path: &Path) -> Result<Vec<Row>> {
             .filter(|(i, _)| !idx.contains(i))
             .map(|(_, (h, v))| (h.to_string(), v.to_string()))
             .collect();
+        let (angle_deg, drop_height_m) = (number(2)?, number(3)?);
+        let bad = |column: &str, problem: String| FramesError::BadValue {
+            path: path.into(),
+            field: format!("line {line}, {column}"),
+            problem,
+        };
+        if angle_deg.abs() >= 90.0 {
+            return Err(bad(
+                "angle_deg",
+                format!("{angle_deg} is not an incline: it must lie between −90 and 90 degrees"),
+            ));
+        }
+        if drop_height_m < 0.0 {
+            return Err(bad("drop_height_m", format!("{drop_height_m} is negative")));
+        }
         rows.push(Row {
             name,
             surface: cell(1).to_string(),
-            angle_deg: number(2)?,
-            drop_height_m: number(3)?,
+            angle_deg,
+            drop_height_m,
             metadata,
             line,
         });

@@ -278,6 +278,15 @@ pub(crate) fn check_fps(fps: f64, origin: &str, field: &str) -> Result<f64> {
 }
 
 /// Checks a value against a closed range, naming the file, key, unit and range.
+/// A number as a person reads it: plain when moderate, in e-notation when huge or tiny.
+fn short_number(x: f64) -> String {
+    if x != 0.0 && x.is_finite() && !(1e-4..1e6).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}
+
 pub(crate) fn check_range(x: f64, (lo, hi): (f64, f64), unit: &str, path: &Path, field: &str) -> Result<f64> {
     if x.is_finite() && x >= lo && x <= hi {
         Ok(x)
@@ -285,7 +294,7 @@ pub(crate) fn check_range(x: f64, (lo, hi): (f64, f64), unit: &str, path: &Path,
         Err(FramesError::BadValue {
             path: path.into(),
             field: field.into(),
-            problem: format!("{x} is outside the accepted range {lo:e}–{hi:e} {unit}"),
+            problem: format!("{} is outside the accepted range {lo:e}–{hi:e} {unit}", short_number(x)),
         })
     }
 }

@@ -189,6 +189,21 @@ fn a_bad_clip_toml_is_named() {
     assert_names(&err, &["shot_02", "clip.toml", "[camera] fps"]);
 }
 
+/// An incline of 90° or more, or a negative drop height, is no shot: the file, line and column are named.
+#[test]
+fn an_impossible_angle_or_height_in_clips_csv_is_named() {
+    for (row, parts) in [
+        ("shot_01,clay,90,1.2", ["line 2, angle_deg", "90 is not an incline"]),
+        ("shot_01,clay,-95,1.2", ["line 2, angle_deg", "-95 is not an incline"]),
+        ("shot_01,clay,10,-0.5", ["line 2, drop_height_m", "-0.5 is negative"]),
+    ] {
+        let csv = format!("clip,surface,angle_deg,drop_height_m\n{row}\n");
+        let (_tmp, s) = session_with(SESSION_TOML, &csv, &["shot_01"]);
+        let err = s.unwrap_err();
+        assert_names(&err, &["clips.csv", parts[0], parts[1]]);
+    }
+}
+
 // ---- camera files, settings keys, unfilled rows, init ------------------------------------------------------
 
 mod common;
