@@ -4,7 +4,7 @@
 use crate::VerdictKind;
 use crate::candidates::{CandidateSetup, candidate_names, library_effect, set_values, with_candidate};
 use crate::diagnosis::{
-    Baseline, Candidate, Checks, Diagnosis, Evidence, Noise, NoiseSource, PhaseResidual, Signature, Thresholds,
+    Baseline, Candidate, Checks, Diagnosis, Evidence, Floor, Noise, NoiseSource, PhaseResidual, Signature, Thresholds,
 };
 use crate::evaluate::{Evaluator, ShotSums, summarize};
 use crate::options::{Progress, SearchOptions};
@@ -34,6 +34,52 @@ fn effect_names(spec: &ModelSpec) -> Vec<String> {
     spec.effects.iter().map(|e| e.name.clone()).collect()
 }
 
+/// Factors of a candidate's start the search tries: its response need not be monotone in its switch
+/// parameter, nor separable from the others (a tangential spring's slip reversal moves with the stiffness
+/// and with μ: fitted from a start a factor 3 stiffer than the truth, it stops at 58 µm instead of the
+/// noise). So the starts are ranked on a log grid spanning 1000× (one simulation of every shot each), and
+/// a candidate whose fit removes at least half of the current model's systematic mean square but leaves
+/// more than the floor is fitted again from the next best start (at most [`MAX_STARTS`] fits in all).
+const SCAN_FACTORS: [f64; 7] = [1.0 / 30.0, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0];
+
+/// Most fits of one candidate from different starts.
+const MAX_STARTS: usize = 2;
+
+/// How a candidate's switch parameter is started: scanned on a grid, and fitted again from the next start
+/// while the fit leaves a systematic residual above `floor_m` (over the noise `noise_m`).
+struct Scan<'a> {
+    name: &'a str,
+    noise_m: f64,
+    floor_m: f64,
+    /// The current model's systematic residual, m.
+    base_systematic_m: f64,
+}
+
+/// `p0` with the parameter `name` set to each value of `p0[name] × SCAN_FACTORS` (within its bounds), best
+/// (lowest χ²) first, at most `n`; just `p0` when it is not free or every simulation fails.
+fn scan_starts(ev: &Evaluator, name: &str, p0: &[f64], n: usize) -> Vec<Vec<f64>> {
+    let Some(j) = ev.names().iter().position(|x| x == name) else {
+        return vec![p0.to_vec()];
+    };
+    let fp = &ev.problem().params()[j];
+    let mut tried: Vec<(f64, Vec<f64>)> = SCAN_FACTORS
+        .iter()
+        .filter_map(|f| {
+            let mut theta = p0.to_vec();
+            theta[j] = (p0[j] * f).clamp(fp.min, fp.max);
+            let sims = ev.simulate(&theta).ok()?;
+            let chi2: f64 = ev.per_shot(&sims).iter().map(|s| s.chi2).sum();
+            chi2.is_finite().then_some((chi2, theta))
+        })
+        .collect();
+    if tried.is_empty() {
+        return vec![p0.to_vec()];
+    }
+    tried.sort_by(|a, b| a.0.total_cmp(&b.0));
+    tried.dedup_by(|a, b| a.1 == b.1);
+    tried.into_iter().take(n).map(|(_, t)| t).collect()
+}
+
 /// Fits `spec` to every shot from the file's values, then once per fold without that fold's shots
 /// (warm-started at the full fit), predicting each left-out shot. With surface levels, the full fit
 /// profiles them from `seed` (the current model's, for a candidate); a fold's fit holds its training
@@ -47,13 +93,45 @@ fn run_model(
     k: usize,
     opts: &SearchOptions,
     seed: Option<&[f64]>,
+    scan: Option<&Scan<'_>>,
 ) -> Result<ModelRun, FitError> {
     let clock = Instant::now();
     let mut ev = Evaluator::new(spec, shots.to_vec(), opts.sim, opts.surface_levels)?;
-    let out = match ev.levels() {
-        None => ev.fit(&opts.solver, &ev.problem().initial())?,
-        Some(zero) => fit_with_levels(&mut ev, seed.unwrap_or(&zero), opts)?,
+    let p0 = ev.problem().initial();
+    let starts = match scan {
+        Some(sc) => {
+            if let Some(levels) = seed {
+                ev.set_levels(levels, false);
+            }
+            scan_starts(&ev, sc.name, &p0, MAX_STARTS)
+        }
+        None => vec![p0],
     };
+    let zero = ev.levels();
+    let fit_from = |ev: &mut Evaluator, start: &[f64]| -> Result<(SolverOutcome, f64), FitError> {
+        let out = match &zero {
+            None => ev.fit(&opts.solver, start)?,
+            Some(zero) => fit_with_levels(ev, seed.unwrap_or(zero), start, opts)?,
+        };
+        let sims = ev.simulate(&out.params)?;
+        let (sq, n) = ev
+            .per_shot(&sims)
+            .iter()
+            .fold((0.0, 0usize), |(a, n), s| (a + s.sq_m2, n + s.n));
+        Ok((out, excess(sq / n.max(1) as f64, scan.map_or(0.0, |sc| sc.noise_m))))
+    };
+    let (mut out, mut systematic) = fit_from(&mut ev, &starts[0])?;
+    for start in &starts[1..] {
+        let promising = |sc: &Scan<'_>| systematic > sc.floor_m && systematic < sc.base_systematic_m / 2f64.sqrt();
+        if !scan.is_some_and(promising) {
+            break;
+        }
+        let (next, s) = fit_from(&mut ev, start)?;
+        if next.cost < out.cost {
+            (out, systematic) = (next, s);
+        }
+    }
+    // (With profiled levels, this also leaves them at the kept fit's optimum.)
     let sims = ev.simulate(&out.params)?;
     let per_shot = ev.per_shot(&sims);
     let sq: f64 = per_shot.iter().map(|s| s.sq_m2).sum();
@@ -91,9 +169,14 @@ fn run_model(
 /// problem), warm-started where the rounds ended; from a cold start that fit took eight times longer on
 /// the benchmark (the profiled levels make the Jacobian noisy and the fit long). Every model starts from
 /// the same levels, so all are compared alike. Leaves `ev` profiling from the final levels.
-fn fit_with_levels(ev: &mut Evaluator, start: &[f64], opts: &SearchOptions) -> Result<SolverOutcome, FitError> {
+fn fit_with_levels(
+    ev: &mut Evaluator,
+    start: &[f64],
+    p0: &[f64],
+    opts: &SearchOptions,
+) -> Result<SolverOutcome, FitError> {
     let mut levels = start.to_vec();
-    let mut p = ev.problem().initial();
+    let mut p = p0.to_vec();
     for _ in 0..4 {
         ev.set_levels(&levels, false);
         let out = ev.fit(&opts.solver, &p)?;
@@ -217,7 +300,7 @@ pub fn find_missing_effect_with(
         total,
         what: "current model".into(),
     });
-    let base = run_model(spec, shots, &fold_of, k, options, None).map_err(|e| DiagnoseError::Baseline {
+    let base = run_model(spec, shots, &fold_of, k, options, None, None).map_err(|e| DiagnoseError::Baseline {
         model: spec.origin.clone(),
         source: Box::new(e),
     })?;
@@ -254,6 +337,21 @@ pub fn find_missing_effect_with(
         source,
         stated_sigma_m: stated,
         ratio: noise_m / stated,
+    };
+    let given = options;
+    // The floor the decisions are measured against; from here on `options` carries it as the tolerance.
+    let floor = if options.learn_floor {
+        crate::floor::learn(shots, &base.sims, noise_m, options.tolerance_m)
+    } else {
+        Floor {
+            floor_m: options.tolerance_m,
+            contact_allowance_m: options.tolerance_m,
+            ..Floor::default()
+        }
+    };
+    let options = &SearchOptions {
+        tolerance_m: floor.floor_m,
+        ..options.clone()
     };
 
     // The signature of the current model's residual.
@@ -317,7 +415,23 @@ pub fn find_missing_effect_with(
         let run = with_candidate(&warm, &setup)
             .map_err(|e| e.to_string())
             .and_then(|cspec| {
-                run_model(&cspec, shots, &fold_of, k, options, base.levels.as_deref()).map_err(|e| e.to_string())
+                let primary = setup.primary().map(|p| format!("{}.{p}", setup.effect));
+                let scan = primary.as_deref().map(|name| Scan {
+                    name,
+                    noise_m,
+                    floor_m: options.tolerance_m,
+                    base_systematic_m: excess(base.summary.rms_m.powi(2), noise_m),
+                });
+                run_model(
+                    &cspec,
+                    shots,
+                    &fold_of,
+                    k,
+                    options,
+                    base.levels.as_deref(),
+                    scan.as_ref(),
+                )
+                .map_err(|e| e.to_string())
             });
         runs.push((setup, run));
     }
@@ -325,7 +439,7 @@ pub fn find_missing_effect_with(
     let n_res = base.per_shot.iter().map(|s| s.n).sum::<usize>() as f64;
     let mut candidates: Vec<Candidate> = runs
         .iter()
-        .map(|(setup, run)| evidence_of(setup, run, &base, n_res, noise_m, options))
+        .map(|(setup, run)| evidence_of(setup, run, &base, n_res, noise_m, stated, options))
         .collect();
     // Holm over the candidates that have a held-out test.
     let ps: Vec<f64> = candidates
@@ -347,6 +461,7 @@ pub fn find_missing_effect_with(
     let verdict_inputs = crate::verdict::Inputs {
         options,
         noise_m,
+        floor: &floor,
         baseline,
         signature,
         heldout_chi2: heldout_pairs,
@@ -359,7 +474,93 @@ pub fn find_missing_effect_with(
             .collect(),
     };
     let (mut verdict, baseline, signature) = decide(&mut candidates, verdict_inputs);
-    let proposal = if options.propose_terms && verdict.kind == VerdictKind::NoneExplains {
+
+    // A second effect: when the named one leaves a systematic held-out error above the floor, or none is
+    // named but one explains part of the misfit, the search goes on from the model with it at its fitted
+    // values.
+    let first = match verdict.kind {
+        VerdictKind::MissingEffect => candidates.first().filter(|c| {
+            c.evidence
+                .as_ref()
+                .is_some_and(|e| excess(e.heldout_error_after.powi(2), noise_m) > options.tolerance_m)
+        }),
+        VerdictKind::NoneExplains => candidates.iter().find(|c| c.partly_explains),
+        _ => None,
+    };
+    let then = match first {
+        Some(c) if given.max_effects > 1 => {
+            let next = then_from(&warm, c, &runs).and_then(|spec| {
+                // The second search only names (a term proposal, if any, comes from this one).
+                let o = SearchOptions {
+                    max_effects: given.max_effects - 1,
+                    propose_terms: false,
+                    ..given.clone()
+                };
+                find_missing_effect_with(&spec, shots, extras, &o, progress).map_err(|e| e.to_string())
+            });
+            Some((
+                c.effect.clone(),
+                c.evidence.as_ref().map(|e| e.systematic_after_m),
+                next,
+            ))
+        }
+        _ => None,
+    };
+    let mut went_on = false;
+    let then = match then {
+        Some((a, left, Ok(next))) => {
+            let named_next = matches!(next.verdict.kind, VerdictKind::MissingEffect | VerdictKind::Ambiguous);
+            // `a` stays only if the second search's current model (with it) still holds its switch
+            // parameter clearly away from neutral.
+            let keeps = first.is_some_and(|c| {
+                next.baseline
+                    .fit
+                    .parameters
+                    .iter()
+                    .find(|p| p.effect == c.effect && p.param == c.param)
+                    .and_then(|p| p.std_error.map(|se| (p.value - c.neutral).abs() / se))
+                    .is_some_and(|z| z >= options.min_param_z)
+            });
+            if keeps && (named_next || next.verdict.kind == VerdictKind::NoMissingEffect) {
+                went_on = true;
+                verdict.sentence = format!(
+                    "{} With `{a}` added (systematic residual {} left), the search went on: {}",
+                    verdict.sentence,
+                    left.map(|m| format!("{:.1} µm", m * 1e6)).unwrap_or_else(|| "-".into()),
+                    next.verdict.sentence
+                );
+                // `a` and what the second search named (if anything) together explain the data.
+                let mut effects = vec![a.clone()];
+                effects.extend(next.verdict.effects.iter().cloned());
+                verdict.kind = if next.verdict.kind == VerdictKind::Ambiguous {
+                    VerdictKind::Ambiguous
+                } else {
+                    VerdictKind::MissingEffect
+                };
+                verdict.effect = Some(a);
+                verdict.effects = effects;
+            } else {
+                let so = if verdict.kind == VerdictKind::MissingEffect {
+                    String::new()
+                } else {
+                    format!(", so `{a}` is not named")
+                };
+                verdict.sentence = format!(
+                    "{} Going on from the model with `{a}` named nothing more ({}){so}.",
+                    verdict.sentence,
+                    next.verdict.kind.name()
+                );
+            }
+            Some(Box::new(next))
+        }
+        Some((a, _, Err(why))) => {
+            verdict.sentence = format!("{} Going on from the model with `{a}` failed: {why}", verdict.sentence);
+            None
+        }
+        None => None,
+    };
+
+    let proposal = if options.propose_terms && verdict.kind == VerdictKind::NoneExplains && !went_on {
         let levels = base.levels.as_deref();
         let search = TermSearch {
             shots,
@@ -389,6 +590,7 @@ pub fn find_missing_effect_with(
         baseline,
         signature,
         noise,
+        floor,
         shots: shots.len(),
         folds: k,
         thresholds: Thresholds {
@@ -400,8 +602,25 @@ pub fn find_missing_effect_with(
             explained_fraction: options.explained_fraction,
         },
         proposal,
+        then,
         seconds: clock.elapsed().as_secs_f64(),
     })
+}
+
+/// `spec` with candidate `c` added at its fitted values (free, so the next search refits them).
+fn then_from(
+    spec: &ModelSpec,
+    c: &Candidate,
+    runs: &[(CandidateSetup, Result<ModelRun, String>)],
+) -> Result<ModelSpec, String> {
+    let (setup, run) = runs
+        .iter()
+        .find(|(s, _)| s.effect == c.effect)
+        .ok_or_else(|| format!("no run of `{}`", c.effect))?;
+    let run = run.as_ref().map_err(Clone::clone)?;
+    let mut next = with_candidate(spec, setup).map_err(|e| e.to_string())?;
+    set_values(&mut next, &run.summary.parameters);
+    Ok(next)
 }
 
 /// What the term search needs of the missing-effect search.
@@ -442,7 +661,7 @@ impl TermSearch<'_> {
                     what: format!("term {}/{}: {target} {formula} in {phase}", j + 1, tries.len()),
                 });
                 let run = with_term(&current, &name, i, start).and_then(|spec| {
-                    run_model(&spec, self.shots, self.fold_of, self.k, self.options, self.levels)
+                    run_model(&spec, self.shots, self.fold_of, self.k, self.options, self.levels, None)
                         .map(|run| (spec, run))
                         .map_err(|e| e.to_string())
                 });
@@ -573,6 +792,7 @@ fn evidence_of(
     base: &ModelRun,
     n_res: f64,
     noise_m: f64,
+    stated_sigma_m: f64,
     opts: &SearchOptions,
 ) -> Candidate {
     let param = setup.primary().unwrap_or("-").to_string();
@@ -585,6 +805,7 @@ fn evidence_of(
         effect: setup.effect.clone(),
         rank: 0,
         explains: false,
+        partly_explains: false,
         checks: Checks::default(),
         reasons: Vec::new(),
         error_before: base.summary.rms_m,
@@ -634,6 +855,21 @@ fn evidence_of(
     let param_z = primary
         .and_then(|p| p.std_error.map(|se| (p.value - neutral).abs() / se))
         .filter(|z| z.is_finite());
+    // With σ-weighted residuals, se = √c / ‖J⊥‖ (J⊥ the parameter's Jacobian column after the others'
+    // span is taken out, c the covariance scale), so a change Δ moves the positions by an RMS of about
+    // Δ·σ̄·‖J⊥‖/√n = Δ·σ̄·√c / (se·√n) once the other parameters have absorbed what they can.
+    // Only for a one-parameter candidate: with a second parameter of its own (Hunt–Crossley's exponent),
+    // that one is not determined near neutral and the switch's standard error says nothing there.
+    let own_params = setup.free.len();
+    let detection_limit = primary
+        .and_then(|p| p.std_error)
+        .filter(|_| own_params == 1)
+        .and_then(|se| {
+            let c = s.chi2_red.max(1.0);
+            let per_unit = stated_sigma_m * c.sqrt() / (se * n_res.sqrt());
+            let limit = (opts.min_param_z * se).max(opts.tolerance_m / per_unit);
+            limit.is_finite().then_some(limit)
+        });
     cand.evidence = Some(Evidence {
         error_after: s.rms_m,
         error_fall: base.summary.rms_m / s.rms_m,
@@ -650,6 +886,7 @@ fn evidence_of(
         param_value: primary.map(|p| p.value).unwrap_or(neutral),
         param_interval: primary.and_then(|p| p.interval),
         param_z,
+        detection_limit,
         fit: run.summary.clone(),
     });
     cand
