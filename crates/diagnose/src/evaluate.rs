@@ -6,8 +6,8 @@
 //! neither, and the sums and summaries the search compares.
 
 use bouncelab_fit::{
-    FitError, LeastSquares, LevenbergMarquardt, MeasuredShot, NoObserver, Problem, SolverOutcome, Termination,
-    identified_inverse, profile_surface_level, surface_prior, weighted_residuals,
+    FitError, LeastSquares, LevenbergMarquardt, MeasuredShot, NoObserver, Observer, Problem, SolverOutcome,
+    Termination, identified_inverse, profile_surface_level, surface_prior, weighted_residuals,
 };
 use bouncelab_model::{Model, ModelSpec, SimOptions, Simulation};
 use nalgebra::{DMatrix, DVector};
@@ -239,6 +239,16 @@ impl Evaluator {
     /// Fits from `p0` (clamped into the bounds).
     pub fn fit(&self, solver: &LevenbergMarquardt, p0: &[f64]) -> Result<SolverOutcome, FitError> {
         solver.run(self, p0, &mut NoObserver)
+    }
+
+    /// [`Evaluator::fit`], reporting every solver iteration to `observer` (on the calling thread).
+    pub fn fit_observed(
+        &self,
+        solver: &LevenbergMarquardt,
+        p0: &[f64],
+        observer: &mut dyn Observer,
+    ) -> Result<SolverOutcome, FitError> {
+        solver.run(self, p0, observer)
     }
 }
 

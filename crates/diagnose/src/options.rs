@@ -175,8 +175,8 @@ impl SearchOptions {
     }
 }
 
-/// What the search is doing, reported before each fit of a model and at the end: a progress bar shows
-/// `done / total` and `what`.
+/// What the search is doing, reported before each fit of a model, after every solver iteration of each fit
+/// to all shots (`iteration`, `chi2_red`), and at the end: a progress bar shows `done / total` and `what`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Progress {
     /// Models fitted so far (each with its cross-validation).
@@ -185,4 +185,11 @@ pub struct Progress {
     pub total: usize,
     /// What comes next: "current model", "+ hertz", or "done".
     pub what: String,
+    /// The solver iteration just finished in the fit of `what` to all shots (0 is its start); `None` when
+    /// the call announces the model rather than an iteration.
+    #[serde(default)]
+    pub iteration: Option<usize>,
+    /// The reduced χ² (χ²/ν against the tracker's σ) at that iteration.
+    #[serde(default)]
+    pub chi2_red: Option<f64>,
 }

@@ -12,7 +12,7 @@ use crate::proposal::{self, ProposedTerm, TermProposal};
 use crate::verdict::decide;
 use crate::{DiagnoseError, FitSummary, stats};
 use bouncelab_compare::{Component, DiagnoseOptions, ShotExtras, compare, diagnose};
-use bouncelab_fit::{FitError, LevenbergMarquardt, MeasuredShot, SolverOutcome};
+use bouncelab_fit::{FitError, Iteration, LevenbergMarquardt, MeasuredShot, Observer, SolverOutcome};
 use bouncelab_model::{ModelSpec, Simulation};
 use rayon::prelude::*;
 use std::time::Instant;
@@ -80,6 +80,16 @@ fn scan_starts(ev: &Evaluator, name: &str, p0: &[f64], n: usize) -> Vec<Vec<f64>
     tried.into_iter().take(n).map(|(_, t)| t).collect()
 }
 
+/// Where a model's fit starts and what it reports.
+struct Start<'a> {
+    /// Each shot's surface level to start from (the current model's, for a candidate).
+    seed: Option<&'a [f64]>,
+    /// A candidate's switch parameter to scan for its start.
+    scan: Option<&'a Scan<'a>>,
+    /// Called with every solver iteration of the fit to all shots and its reduced χ².
+    on_iteration: &'a dyn Fn(usize, f64),
+}
+
 /// Fits `spec` to every shot from the file's values, then once per fold without that fold's shots
 /// (warm-started at the full fit), predicting each left-out shot. With surface levels, the full fit
 /// profiles them from `seed` (the current model's, for a candidate); a fold's fit holds its training
@@ -92,11 +102,21 @@ fn run_model(
     fold_of: &[usize],
     k: usize,
     opts: &SearchOptions,
-    seed: Option<&[f64]>,
-    scan: Option<&Scan<'_>>,
+    how: Start<'_>,
 ) -> Result<ModelRun, FitError> {
+    let Start {
+        seed,
+        scan,
+        on_iteration,
+    } = how;
     let clock = Instant::now();
     let mut ev = Evaluator::new(spec, shots.to_vec(), opts.sim, opts.surface_levels)?;
+    let dof = ev
+        .problem()
+        .n_residuals()
+        .saturating_sub(ev.problem().params().len() + ev.nuisance_per_shot() * shots.len())
+        .max(1) as f64;
+    let mut observer = |it: &Iteration<'_>| on_iteration(it.iteration, it.cost / dof);
     let p0 = ev.problem().initial();
     let starts = match scan {
         Some(sc) => {
@@ -108,10 +128,10 @@ fn run_model(
         None => vec![p0],
     };
     let zero = ev.levels();
-    let fit_from = |ev: &mut Evaluator, start: &[f64]| -> Result<(SolverOutcome, f64), FitError> {
+    let mut fit_from = |ev: &mut Evaluator, start: &[f64]| -> Result<(SolverOutcome, f64), FitError> {
         let out = match &zero {
-            None => ev.fit(&opts.solver, start)?,
-            Some(zero) => fit_with_levels(ev, seed.unwrap_or(zero), start, opts)?,
+            None => ev.fit_observed(&opts.solver, start, &mut observer)?,
+            Some(zero) => fit_with_levels(ev, seed.unwrap_or(zero), start, opts, &mut observer)?,
         };
         let sims = ev.simulate(&out.params)?;
         let (sq, n) = ev
@@ -174,12 +194,13 @@ fn fit_with_levels(
     start: &[f64],
     p0: &[f64],
     opts: &SearchOptions,
+    observer: &mut dyn Observer,
 ) -> Result<SolverOutcome, FitError> {
     let mut levels = start.to_vec();
     let mut p = p0.to_vec();
     for _ in 0..4 {
         ev.set_levels(&levels, false);
-        let out = ev.fit(&opts.solver, &p)?;
+        let out = ev.fit_observed(&opts.solver, &p, observer)?;
         p.clone_from(&out.params);
         ev.set_levels(&levels, true);
         ev.simulate(&p)?;
@@ -200,7 +221,7 @@ fn fit_with_levels(
         ftol: opts.solver.ftol.max(1e-5),
         ..opts.solver
     };
-    let mut joint = ev.fit(&solver, &p)?;
+    let mut joint = ev.fit_observed(&solver, &p, observer)?;
     // The solver's last evaluation may have been a rejected step: profile the levels at the result.
     ev.simulate(&joint.params)?;
     // Its Jacobian went through the profiled levels; the standard errors come from the smooth one.
@@ -299,8 +320,34 @@ pub fn find_missing_effect_with(
         done: 0,
         total,
         what: "current model".into(),
+        iteration: None,
+        chi2_red: None,
     });
-    let base = run_model(spec, shots, &fold_of, k, options, None, None).map_err(|e| DiagnoseError::Baseline {
+    let iterations = |done: usize, what: &str| {
+        let what = what.to_string();
+        move |i: usize, chi2_red: f64| {
+            progress(Progress {
+                done,
+                total,
+                what: what.clone(),
+                iteration: Some(i),
+                chi2_red: Some(chi2_red),
+            })
+        }
+    };
+    let base = run_model(
+        spec,
+        shots,
+        &fold_of,
+        k,
+        options,
+        Start {
+            seed: None,
+            scan: None,
+            on_iteration: &iterations(0, "current model"),
+        },
+    )
+    .map_err(|e| DiagnoseError::Baseline {
         model: spec.origin.clone(),
         source: Box::new(e),
     })?;
@@ -411,6 +458,8 @@ pub fn find_missing_effect_with(
             done: j + 1,
             total,
             what: format!("+ {}", setup.effect),
+            iteration: None,
+            chi2_red: None,
         });
         let run = with_candidate(&warm, &setup)
             .map_err(|e| e.to_string())
@@ -428,8 +477,11 @@ pub fn find_missing_effect_with(
                     &fold_of,
                     k,
                     options,
-                    base.levels.as_deref(),
-                    scan.as_ref(),
+                    Start {
+                        seed: base.levels.as_deref(),
+                        scan: scan.as_ref(),
+                        on_iteration: &iterations(j + 1, &format!("+ {}", setup.effect)),
+                    },
                 )
                 .map_err(|e| e.to_string())
             });
@@ -583,6 +635,8 @@ pub fn find_missing_effect_with(
         done: total,
         total,
         what: "done".into(),
+        iteration: None,
+        chi2_red: None,
     });
     Ok(Diagnosis {
         verdict,
@@ -659,11 +713,34 @@ impl TermSearch<'_> {
                     done: self.total.saturating_sub(1),
                     total: self.total,
                     what: format!("term {}/{}: {target} {formula} in {phase}", j + 1, tries.len()),
+                    iteration: None,
+                    chi2_red: None,
                 });
                 let run = with_term(&current, &name, i, start).and_then(|spec| {
-                    run_model(&spec, self.shots, self.fold_of, self.k, self.options, self.levels, None)
-                        .map(|run| (spec, run))
-                        .map_err(|e| e.to_string())
+                    let what = format!("term {target} {formula} in {phase}");
+                    let on_iteration = |i: usize, chi2_red: f64| {
+                        (self.progress)(Progress {
+                            done: self.total.saturating_sub(1),
+                            total: self.total,
+                            what: what.clone(),
+                            iteration: Some(i),
+                            chi2_red: Some(chi2_red),
+                        })
+                    };
+                    run_model(
+                        &spec,
+                        self.shots,
+                        self.fold_of,
+                        self.k,
+                        self.options,
+                        Start {
+                            seed: self.levels,
+                            scan: None,
+                            on_iteration: &on_iteration,
+                        },
+                    )
+                    .map(|run| (spec, run))
+                    .map_err(|e| e.to_string())
                 });
                 let (spec, run) = match run {
                     Ok(r) => r,

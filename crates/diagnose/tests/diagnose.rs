@@ -479,14 +479,26 @@ fn the_same_shots_give_the_same_diagnosis() {
 fn progress_is_reported_for_every_model() {
     let shots = session(&truth(None), 6, Tracking::default());
     let seen = std::sync::Mutex::new(Vec::new());
-    find_missing_effect(&base_spec(), &shots, &quick_options(), &|p| {
-        seen.lock().unwrap().push((p.done, p.total, p.what))
+    let iterations = std::sync::Mutex::new(Vec::new());
+    find_missing_effect(&base_spec(), &shots, &quick_options(), &|p| match p.iteration {
+        Some(i) => iterations.lock().unwrap().push((p.done, p.what, i, p.chi2_red)),
+        None => seen.lock().unwrap().push((p.done, p.total, p.what)),
     })
     .unwrap();
     let seen = seen.into_inner().unwrap();
     let what: Vec<&str> = seen.iter().map(|s| s.2.as_str()).collect();
     assert_eq!(what, ["current model", "+ hunt_crossley", "+ drag", "done"]);
     assert!(seen.iter().all(|s| s.1 == 3) && seen.last().unwrap().0 == 3);
+    // Every model's fit to all shots reports its solver iterations, from 0, with a finite reduced χ².
+    let iterations = iterations.into_inner().unwrap();
+    for (done, model) in [(0, "current model"), (1, "+ hunt_crossley"), (2, "+ drag")] {
+        let its: Vec<_> = iterations.iter().filter(|x| x.1 == model).collect();
+        assert!(its.iter().any(|x| x.2 == 0) && its.len() >= 2, "{model}: {its:?}");
+        assert!(
+            its.iter().all(|x| x.0 == done && x.3.is_some_and(f64::is_finite)),
+            "{its:?}"
+        );
+    }
 }
 
 #[test]
