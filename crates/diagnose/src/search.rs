@@ -498,7 +498,7 @@ pub fn find_missing_effect_with(
         .iter()
         .map(|c| c.evidence.as_ref().map(|e| e.heldout_p).unwrap_or(1.0))
         .collect();
-    for (c, p) in candidates.iter_mut().zip(stats::holm(&ps)) {
+    for (c, p) in candidates.iter_mut().zip(bouncelab_stats::holm(&ps)) {
         if let Some(e) = c.evidence.as_mut() {
             e.heldout_p_holm = p;
         }

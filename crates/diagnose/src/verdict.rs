@@ -5,6 +5,7 @@ use crate::options::SearchOptions;
 use crate::stats;
 use bouncelab_compare::Quantity;
 use bouncelab_model::builtin;
+use bouncelab_stats::p_text;
 
 /// What the decision needs besides the candidates.
 pub(crate) struct Inputs<'a> {
@@ -38,14 +39,6 @@ fn floor_words(f: &Floor) -> String {
             um(f.contact_allowance_m)
         ),
         None => format!("the {} floor", um(f.floor_m)),
-    }
-}
-
-fn p_text(p: f64) -> String {
-    if p < 0.001 {
-        "p < 0.001".into()
-    } else {
-        format!("p = {p:.3}")
     }
 }
 
