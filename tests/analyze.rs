@@ -138,6 +138,13 @@ fn read_csv(path: &Path) -> Vec<std::collections::HashMap<String, String>> {
 /// curves' table against model_curves.csv, the contact force's peak against contact_force.csv.
 fn report_figures_hold_the_csv_numbers(out: &Path) {
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    // Every measured shot shows its key frames, drawn from its clip with the track on them.
+    let strips = html.matches("<figcaption>key frames: approach ").count();
+    assert_eq!(
+        strips,
+        read_csv(&out.join("estimates.csv")).len(),
+        "one key-frame strip per shot"
+    );
     let num = |s: &str| s.replace('\u{2212}', "-").parse::<f64>().unwrap();
     for row in read_csv(&out.join("estimates.csv")) {
         let tip = format!("<title>{} ({}, ", row["clip"], row["surface"]);

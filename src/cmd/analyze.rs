@@ -27,6 +27,9 @@ pub struct Args {
     /// Skip the missing-effect search.
     #[arg(long)]
     pub no_diagnose: bool,
+    /// Settings for every clip of the session (each beats clip.toml, camera headers and session.toml).
+    #[command(flatten)]
+    pub settings: super::settings::Overrides,
 }
 
 impl Args {
@@ -150,6 +153,7 @@ pub fn run_quiet(a: &Args) -> anyhow::Result<Analysis> {
             ClipFingerprint::Metadata
         },
         diagnose: !a.no_diagnose,
+        clip_options: a.settings.clip_options(),
     };
     let progress = StageBars::new();
     analyze(&a.session_dir, &options, &progress).with_context(|| format!("analysing {}", a.session_dir.display()))

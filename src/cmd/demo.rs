@@ -116,6 +116,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         store: Some(dir.join("bouncelab.sqlite")),
         content_hash: false,
         no_diagnose: false,
+        settings: Default::default(),
     };
 
     eprintln!("analysing it with the paper's model …");

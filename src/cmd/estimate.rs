@@ -3,7 +3,7 @@
 
 use anyhow::Context;
 use bouncelab_estimate::{Conditions, Estimate, estimate_with_frames};
-use bouncelab_frames::{Clip, ClipOptions, Downslope, Session};
+use bouncelab_frames::{Clip, Downslope, Session};
 use bouncelab_track::{ClipTracking, track_clip};
 use std::path::{Path, PathBuf};
 
@@ -15,12 +15,8 @@ pub struct Args {
     /// Incline of the surface, degrees (default: the clip's angle_deg in the session's clips.csv).
     #[arg(long, allow_negative_numbers = true)]
     angle: Option<f64>,
-    /// Frame rate, frames/s (beats clip.toml, the camera header and session.toml).
-    #[arg(long)]
-    fps: Option<f64>,
-    /// Ball diameter, m (beats clip.toml and session.toml's [ball] diameter_m; else 0.067, with a warning).
-    #[arg(long)]
-    diameter: Option<f64>,
+    #[command(flatten)]
+    settings: super::settings::Overrides,
     /// Gravitational acceleration, m/s².
     #[arg(long, default_value_t = 9.81)]
     gravity: f64,
@@ -52,9 +48,7 @@ fn from_session(clip_dir: &Path) -> (bool, Option<f64>) {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
-    let mut options = ClipOptions::default();
-    options.fps = a.fps;
-    options.overrides.ball_diameter_m = a.diameter;
+    let options = a.settings.clip_options();
     let clip = Clip::open_with(&a.clip_dir, &options)?;
     for w in clip.warnings() {
         eprintln!("warning: {w}");
@@ -67,11 +61,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         );
     };
     let diameter = clip.settings().ball_diameter_m;
-    let opts = ClipTracking {
-        ball_diameter_m: diameter,
-        downslope_negative_x: minus_x,
-        ..ClipTracking::default()
-    };
+    let opts = ClipTracking::for_settings(clip.settings(), minus_x);
     let bar = super::progress_bar(clip.len() as u64, "tracking", "frames");
     let track = track_clip(&clip, &opts, |done, _| bar.set_position(done as u64))
         .with_context(|| format!("tracking {}", a.clip_dir.display()))?;

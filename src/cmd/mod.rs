@@ -9,6 +9,7 @@ pub mod init;
 pub mod model;
 pub mod overlay;
 pub mod render;
+pub mod settings;
 pub mod simulate;
 pub mod track;
 

@@ -3,9 +3,8 @@
 
 use anyhow::Context;
 use bouncelab_overlay::{
-    BallMark, ContactRule, Crop, KeyFrames, Levels, OverlayError, Phase, PngSpeed, SheetLayout, ShotPhases, Status,
-    StripFrame, Style, SurfaceLine, annotate_frame, encode_png, encode_png_with, key_frame_strip,
-    key_frames_from_trajectory, phases_from_trajectory,
+    BallMark, ContactRule, Crop, Levels, OverlayError, Phase, PngSpeed, SheetLayout, Status, StripFrame, Style,
+    SurfaceLine, annotate_frame, choose_key_frames, encode_png, encode_png_with, key_frame_strip,
 };
 use bouncelab_track::Track;
 use std::collections::HashMap;
@@ -72,31 +71,6 @@ fn marks_of(track: &Track) -> anyhow::Result<(Vec<BallMark>, Option<SurfaceLine>
     Ok((marks, line))
 }
 
-/// The phases (when a contact is seen) and the key frames, with a sentence on where they came from.
-fn key_frames(
-    marks: &[BallMark],
-    line: Option<&SurfaceLine>,
-    rule: &ContactRule,
-) -> Result<(Option<ShotPhases>, KeyFrames, String), OverlayError> {
-    let why = match line {
-        Some(l) => match phases_from_trajectory(marks, l, rule) {
-            Ok(p) => {
-                let how = "phases from the trajectory: contact while the ball reaches the surface line".to_string();
-                return Ok((Some(p), p.key_frames(), how));
-            }
-            Err(e @ OverlayError::NoContact { .. }) => e.to_string(),
-            Err(e) => return Err(e),
-        },
-        None => "no surface line was found".to_string(),
-    };
-    let k = key_frames_from_trajectory(marks, line, rule)?;
-    Ok((
-        None,
-        k,
-        format!("{why}: phases unknown; key frames around the lowest centre"),
-    ))
-}
-
 /// The default step: every frame up to `DEFAULT_MAX_PICTURES`, else the smallest step giving at most that many.
 fn default_every(frames: u64) -> u64 {
     frames.div_ceil(DEFAULT_MAX_PICTURES).max(1)
@@ -126,7 +100,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         radius_px: track.scale.map(|s| s.radius_px),
         ..ContactRule::default()
     };
-    let (phases, keys, how) = key_frames(&marks, line.as_ref(), &rule)
+    let (phases, keys, how) = choose_key_frames(&marks, line.as_ref(), &rule)
         .with_context(|| format!("choosing the key frames of {}", a.clip_dir.display()))?;
     if let Some(p) = &phases {
         for m in &mut marks {
@@ -151,7 +125,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         let Some(mark) = by_frame.get(&frame.index) else {
             continue;
         };
-        if !a.sheet && (k as u64 % every == 0 || is_key) {
+        if !a.sheet && ((k as u64).is_multiple_of(every) || is_key) {
             let picture = annotate_frame(&frame.pixels, mark, line.as_ref(), a.zoom, &style)
                 .with_context(|| format!("drawing {}", frame.path.display()))?;
             let png = encode_png_with(&picture, PngSpeed::Fast)?;

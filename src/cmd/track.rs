@@ -1,7 +1,7 @@
 //! `bouncelab track`: one clip (a folder of frames or a camera file) → its trajectory CSV.
 
 use anyhow::Context;
-use bouncelab_frames::{Clip, ClipOptions, Downslope, Session};
+use bouncelab_frames::{Clip, Downslope, Session};
 use bouncelab_track::{ClipTracking, Track, track_clip};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -23,15 +23,8 @@ pub struct Tracking {
     /// Detector (builds with the `opencv` feature also offer OpenCV's HoughCircles as `opencv`).
     #[arg(long, value_enum, default_value_t = Detector::Hough)]
     detector: Detector,
-    /// Frame rate, frames/s (beats clip.toml and session.toml).
-    #[arg(long, allow_negative_numbers = true)]
-    fps: Option<f64>,
-    /// Ball diameter, m (beats clip.toml and session.toml's [ball] diameter_m; else 0.067, with a warning).
-    #[arg(long)]
-    diameter: Option<f64>,
-    /// Approximate scale, m/px, if known (otherwise the ball is found by its motion).
-    #[arg(long)]
-    scale: Option<f64>,
+    #[command(flatten)]
+    settings: super::settings::Overrides,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -63,10 +56,7 @@ fn session_minus_x(clip_dir: &Path) -> bool {
 
 /// Opens the clip and tracks it as `bouncelab track` does (warnings printed, a progress bar on a terminal).
 pub fn track_clip_dir(clip_dir: &Path, a: &Tracking) -> anyhow::Result<(Clip, Track)> {
-    let mut options = ClipOptions::default();
-    options.fps = a.fps;
-    options.overrides.ball_diameter_m = a.diameter;
-    options.overrides.scale_m_per_px = a.scale;
+    let options = a.settings.clip_options();
     let clip = Clip::open_with(clip_dir, &options)?;
     for w in clip.warnings() {
         eprintln!("warning: {w}");
@@ -75,12 +65,7 @@ pub fn track_clip_dir(clip_dir: &Path, a: &Tracking) -> anyhow::Result<(Clip, Tr
         eprintln!("warning: {} dropped frame(s) in {}", clip.dropped(), clip_dir.display());
     }
     let minus_x = session_minus_x(clip_dir);
-    let opts = ClipTracking {
-        ball_diameter_m: clip.settings().ball_diameter_m,
-        scale_hint_m_per_px: clip.settings().scale_m_per_px,
-        downslope_negative_x: minus_x,
-        ..ClipTracking::default()
-    };
+    let opts = ClipTracking::for_settings(clip.settings(), minus_x);
     let bar = super::progress_bar(clip.len() as u64, "tracking", "frames");
     let progress = |done: usize, _| bar.set_position(done as u64);
     let track = match a.detector {

@@ -25,7 +25,7 @@ pub use shots::{ShotData, load_failed_tracks, load_shots, measured_shot};
 use bouncelab_compare::{Comparison, FailureReport, ShotExtras, SpinFrame};
 use bouncelab_diagnose::{Diagnosis, SearchOptions, find_missing_effect_with};
 use bouncelab_fit::{FitOptions, FitResult, Problem, fit_problem};
-use bouncelab_frames::Session;
+use bouncelab_frames::{ClipOptions, Session};
 use bouncelab_model::{EffectKind, EffectSetting, ModelSpec, ParamRef, ParamSetting};
 use bouncelab_stats::{
     Ancova, AncovaInference, CorObservation, Dataset, PAPER_TERMS, TukeyHsd, ancova, ancova_inference, tukey_hsd_factor,
@@ -98,6 +98,9 @@ pub struct AnalyzeOptions {
     pub fingerprint: ClipFingerprint,
     /// Run the missing-effect search (the slowest stage after tracking).
     pub diagnose: bool,
+    /// Command-line overrides (fps, scale, diameter, region of interest, contact line) applied to every
+    /// clip; each beats `clip.toml`, the camera header and `session.toml`.
+    pub clip_options: ClipOptions,
 }
 
 /// What [`analyze`] did, for the summary a person reads.
@@ -239,7 +242,7 @@ pub fn analyze(
     progress: &dyn Progress,
 ) -> Result<Analysis, AnalyzeError> {
     let mut timings = Vec::new();
-    let session = Session::load(session_dir)?;
+    let session = Session::load_with(session_dir, &options.clip_options)?;
     for w in &session.warnings {
         progress.note(&w.to_string());
     }
@@ -462,7 +465,13 @@ pub fn analyze(
         outputs,
         timings,
     };
-    let written = report::write(&options.out_dir, &analysis, description.as_deref(), &warnings)?;
+    let written = report::write(
+        &options.out_dir,
+        &analysis,
+        &session.clips,
+        description.as_deref(),
+        &warnings,
+    )?;
     analysis.outputs.extend(written);
     if let Some((_, t)) = analysis.timings.iter_mut().find(|(s, _)| *s == Stage::Report) {
         *t += started_report.elapsed().as_secs_f64();
@@ -721,23 +730,25 @@ pub fn session_stats(shots: &[ShotData]) -> Result<SessionStats, String> {
 fn shot_extras(s: &ShotData) -> ShotExtras {
     let frames = &s.measured.frames;
     let mut spin = Vec::new();
-    if let (Some(m), Some(f)) = (s.estimate.spin_in, frames.first()) {
-        if m.se > 0.0 && m.value.is_finite() {
-            spin.push(SpinFrame {
-                t_s: f.t_s,
-                omega_rad_s: m.value,
-                sigma_rad_s: m.se,
-            });
-        }
+    if let (Some(m), Some(f)) = (s.estimate.spin_in, frames.first())
+        && m.se > 0.0
+        && m.value.is_finite()
+    {
+        spin.push(SpinFrame {
+            t_s: f.t_s,
+            omega_rad_s: m.value,
+            sigma_rad_s: m.se,
+        });
     }
-    if let (Some(m), Some(f)) = (s.estimate.spin_out, frames.last()) {
-        if m.se > 0.0 && m.value.is_finite() {
-            spin.push(SpinFrame {
-                t_s: f.t_s,
-                omega_rad_s: m.value,
-                sigma_rad_s: m.se,
-            });
-        }
+    if let (Some(m), Some(f)) = (s.estimate.spin_out, frames.last())
+        && m.se > 0.0
+        && m.value.is_finite()
+    {
+        spin.push(SpinFrame {
+            t_s: f.t_s,
+            omega_rad_s: m.value,
+            sigma_rad_s: m.se,
+        });
     }
     ShotExtras {
         drop_height_m: Some(s.drop_height_m),

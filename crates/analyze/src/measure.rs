@@ -194,13 +194,8 @@ fn measure_clip(entry: &ClipEntry, gravity: f64) -> Measured {
     let clip = entry.open().map_err(|e| e.to_string())?;
     let settings = &entry.settings;
     let opts = ClipTracking {
-        ball_diameter_m: settings.ball_diameter_m,
-        scale_hint_m_per_px: settings.scale_m_per_px,
-        downslope_negative_x: entry.downslope == Downslope::MinusX,
         read: ReadOptions::with_threads(1),
-        roi: settings.roi,
-        contact_line: settings.contact_line,
-        ..ClipTracking::default()
+        ..ClipTracking::for_settings(settings, entry.downslope == Downslope::MinusX)
     };
     let started = std::time::Instant::now();
     let track = track_clip(&clip, &opts, |_, _| {}).map_err(|e| format!("tracking: {e}"))?;

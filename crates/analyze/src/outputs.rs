@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 /// The columns of `estimates.csv`, in order. Every name ends in its unit (`_m_s`, `_ms`, `_mm`, `_deg`,
 /// `_rad_s`, `_m_s2`, `_s`, `_m`); `cor`, `mu_eff`, their `_se` and `chi2_red_flight` are dimensionless. A
 /// standard error is `<quantity>_se_<unit>` (see `docs/outputs.md`).
-pub const ESTIMATE_COLUMNS: [&str; 38] = [
+pub const ESTIMATE_COLUMNS: [&str; 42] = [
     "clip",
     "surface",
     "angle_deg",
@@ -48,6 +48,10 @@ pub const ESTIMATE_COLUMNS: [&str; 38] = [
     "t_sep_s",
     "t_sep_se_s",
     "chi2_red_flight",
+    "contact_line",
+    "surface_tilt_deg",
+    "surface_tilt_se_deg",
+    "flags",
     "notes",
 ];
 
@@ -152,6 +156,7 @@ pub fn write_estimates_csv(
         };
         let (si, si_se) = opt(e.spin_in);
         let (so, so_se) = opt(e.spin_out);
+        let (tilt, tilt_se) = opt(e.surface_tilt_deg);
         let pair = |v: Option<r::Measured>| {
             v.map_or((String::new(), String::new()), |a| {
                 (num(a.value), a.se.map_or(String::new(), num))
@@ -199,6 +204,10 @@ pub fn write_estimates_csv(
             num(e.t_sep.value),
             num(e.t_sep.se),
             num(worst_chi2),
+            e.contact_line.map_or(String::new(), |l| l.cue.name().to_string()),
+            tilt,
+            tilt_se,
+            e.flags.join("; "),
             e.notes.join("; "),
         ])?;
     }
@@ -586,6 +595,8 @@ mod tests {
             "mu_eff",
             "mu_eff_se",
             "chi2_red_flight",
+            "contact_line",
+            "flags",
             "phase",
             "component",
             "unit",

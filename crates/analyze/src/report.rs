@@ -318,6 +318,15 @@ pub(crate) fn build(a: &Analysis, p: &Predictions, description: Option<&str>, wa
     notes.extend(a.measure.failed.iter().map(|(c, m)| format!("{c}: not measured: {m}")));
     notes.extend(a.excluded.iter().map(|(c, m)| format!("{c}: left out of the fit: {m}")));
     notes.extend(p.failures.iter().cloned());
+    let tilts: Vec<_> = a.shots.iter().filter_map(|s| s.estimate.surface_tilt_deg).collect();
+    if let Some(t) = bouncelab_estimate::session_tilt_deg(&tilts) {
+        notes.push(format!(
+            "the surface lies tilted by {} ± {:.3}° in the image over {} shot(s) (counter-clockwise as seen: a camera roll, or the surface's own slope across the view); each shot is measured along its own line, so the tilt is taken out of its velocities",
+            format!("{:+.3}", t.value).replace('-', "\u{2212}"),
+            t.se,
+            tilts.len()
+        ));
+    }
     let session_name = a
         .session_dir
         .file_name()
@@ -418,6 +427,9 @@ fn shot_plot(a: &Analysis, c: &ShotComparison) -> r::ShotPlot {
         })
         .collect();
     let mut notes = data.map(|s| s.estimate.notes.clone()).unwrap_or_default();
+    if let Some(source) = data.and_then(|s| contact_source(&s.estimate)) {
+        notes.push(source);
+    }
     if let Some(level) = surface_level(a, &c.surface, &c.shot) {
         // The level is the true surface's height in the measured frame: a negative one lies below the line
         // found in the image, so the line lies above the plane the ball touches.
@@ -707,11 +719,13 @@ fn model_change(a: &Analysis) -> r::ModelChange {
 pub(crate) fn write(
     dir: &Path,
     a: &Analysis,
+    clips: &[bouncelab_frames::ClipEntry],
     description: Option<&str>,
     warnings: &[String],
 ) -> Result<Vec<PathBuf>, crate::AnalyzeError> {
     let p = predictions(&a.model, &a.fit, &a.shots);
-    let report = build(a, &p, description, warnings);
+    let mut report = build(a, &p, description, warnings);
+    draw_key_frames(&mut report, &a.shots, clips);
     let mut written = crate::outputs::write_figure_data(dir, &report)?;
     let path = dir.join("report.html");
     bouncelab_report::write_report(&path, &report)?;
@@ -767,6 +781,106 @@ pub(crate) fn write_failure(
     let path = dir.join("report.html");
     bouncelab_report::write_report(&path, &report)?;
     Ok(path)
+}
+
+/// Where a shot's contact level came from, for a person: the cue, the line's tilt and how the ball's own
+/// trajectory agrees with it.
+fn contact_source(e: &bouncelab_estimate::Estimate) -> Option<String> {
+    use bouncelab_track::LineCue;
+    let line = e.contact_line?;
+    let what = match line.cue {
+        LineCue::Given => "the contact line given in the settings",
+        LineCue::Brightness => "the surface line found by its brightness step",
+        LineCue::Texture => "the surface line found by its change of texture",
+        LineCue::Trajectory => "the ball's trajectory (no surface line it agrees with was found)",
+    };
+    let mut text = format!("contact level from {what}");
+    if let Some(t) = e.surface_tilt_deg {
+        text += &format!(", tilt {:+.3} ± {:.3}°", t.value, t.se).replace('-', "\u{2212}");
+    }
+    if line.cue != LineCue::Trajectory
+        && let Some(level) = e.trajectory_level_px
+    {
+        text += &format!(
+            "; the trajectory puts it {:.2} ± {:.2} px {}",
+            level.value.abs(),
+            level.se,
+            if level.value >= 0.0 { "higher" } else { "lower" }
+        );
+    }
+    Some(text)
+}
+
+/// Fills each shot's strip of key frames (approach, touch, deepest, separation, leave), read back from its
+/// clip with the stored track drawn on them, so the tracking can be checked by eye. A shot whose strip cannot
+/// be drawn (the clip moved since it was measured, a frame unreadable) gets a note saying why instead.
+fn draw_key_frames(report: &mut r::Report, shots: &[ShotData], clips: &[bouncelab_frames::ClipEntry]) {
+    use rayon::prelude::*;
+    let strips: Vec<Result<r::FrameImage, String>> = report
+        .shots
+        .par_iter()
+        .map(|plot| {
+            let shot = shots.iter().find(|s| s.clip == plot.clip).ok_or("no stored track")?;
+            let entry = clips.iter().find(|c| c.name == plot.clip).ok_or("not in clips.csv")?;
+            key_frame_strip(entry, shot)
+        })
+        .collect();
+    for (plot, strip) in report.shots.iter_mut().zip(strips) {
+        match strip {
+            Ok(image) => plot.frames.push(image),
+            Err(why) => plot.notes.push(format!("key frames not drawn: {why}")),
+        }
+    }
+}
+
+/// One shot's key-frame strip as PNG, captioned with its frames.
+fn key_frame_strip(entry: &bouncelab_frames::ClipEntry, shot: &ShotData) -> Result<r::FrameImage, String> {
+    use bouncelab_overlay as o;
+    let clip = entry.open().map_err(|e| e.to_string())?;
+    let marks = shot
+        .track
+        .rows
+        .iter()
+        .map(|row| {
+            let status = o::Status::from_name(&row.status)
+                .ok_or_else(|| format!("frame {}: unknown status `{}`", row.frame, row.status))?;
+            Ok(o::BallMark {
+                frame: row.frame,
+                x_px: row.x_px,
+                y_px: row.y_px,
+                r_px: row.r_px,
+                status,
+                phase: o::Phase::Unknown,
+            })
+        })
+        .collect::<Result<Vec<_>, String>>()?;
+    let line = shot.estimate.contact_line.map(|l| o::SurfaceLine {
+        x0: l.x0,
+        y0: l.y0,
+        slope: l.slope,
+    });
+    let mut radii: Vec<f64> = marks
+        .iter()
+        .filter(|m| m.status == o::Status::Ok)
+        .map(|m| m.r_px)
+        .collect();
+    radii.sort_by(f64::total_cmp);
+    let rule = o::ContactRule {
+        radius_px: radii.get(radii.len() / 2).copied(),
+        ..o::ContactRule::default()
+    };
+    let style = o::Style {
+        levels: clip
+            .read(0, bouncelab_frames::PngDecoder::default())
+            .and_then(Result::ok)
+            .map_or(o::Levels::FULL, |f| o::Levels::stretch(&f.pixels, 0.5, 99.5)),
+        ..o::Style::default()
+    };
+    let (image, caption) = o::shot_strip(&clip, &marks, line.as_ref(), &rule, &style).map_err(|e| e.to_string())?;
+    Ok(r::FrameImage {
+        caption: format!("key frames: {caption}"),
+        png: o::encode_png(&image).map_err(|e| e.to_string())?,
+    })
 }
 
 #[cfg(test)]

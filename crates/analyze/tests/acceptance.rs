@@ -12,6 +12,7 @@
 
 use bouncelab_analyze::{Analysis, AnalyzeOptions, Silent, analyze};
 use bouncelab_diagnose::{VerdictKind, add_effect_to_model_toml};
+use bouncelab_frames::ClipOptions;
 use bouncelab_render::{RenderOptions, Scenario, render_with};
 use bouncelab_store::ClipFingerprint;
 use std::path::{Path, PathBuf};
@@ -35,6 +36,7 @@ fn run(session: &Path, root: &Path, model: Option<PathBuf>) -> Analysis {
         model_path: model,
         fingerprint: ClipFingerprint::Metadata,
         diagnose: true,
+        clip_options: ClipOptions::default(),
     };
     let a = analyze(session, &options, &Silent).unwrap_or_else(|e| panic!("analysing {}: {e}", session.display()));
     assert!(a.measure.failed.is_empty(), "shots failed: {:?}", a.measure.failed);

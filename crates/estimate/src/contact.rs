@@ -98,11 +98,15 @@ pub fn trajectory_contact(
     radius_px: f64,
 ) -> Result<TrajectoryContact, EstimateError> {
     let lowest = points[low].h;
-    let touch = onset(&points[..=low], lowest, a_px, radius_px).ok_or(EstimateError::FlightTooShort {
-        phase: "incoming",
-        frames: low,
-        needed: MIN_FLIGHT_FRAMES,
-        which: "starts",
+    let touch = onset(&points[..=low], lowest, a_px, radius_px).ok_or(if low < 2 * MIN_FLIGHT_FRAMES {
+        EstimateError::FlightTooShort {
+            phase: "incoming",
+            frames: low,
+            needed: 2 * MIN_FLIGHT_FRAMES,
+            which: "starts",
+        }
+    } else {
+        EstimateError::NoDeparture { frames: low }
     })?;
     // The outgoing side, time reversed: the ball rejoining its arc is, backwards, the ball leaving it.
     let reversed: Vec<HeightPoint> = points[low..]

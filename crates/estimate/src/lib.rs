@@ -10,11 +10,13 @@
 
 mod ballistic;
 mod contact;
+mod roll;
 mod shot;
 mod spin;
 
 pub use ballistic::{BallisticFit, fit_ballistic, fit_free_acceleration};
 pub use contact::{HeightPoint, TrajectoryContact, find_impact, trajectory_contact};
+pub use roll::session_tilt_deg;
 pub use shot::{
     Conditions, Estimate, EstimateError, GravityCheck, MIN_FLIGHT_FRAMES, MIN_SIGMA_PX, Measured, PhaseFrames, estimate,
 };

@@ -177,6 +177,12 @@ pub enum EstimateError {
         needed: usize,
         which: &'static str,
     },
+    /// The ball's heights before its lowest point never leave a free-flight arc clearly enough to tell when
+    /// it touched (a track that wanders, or one on something other than the ball).
+    #[error(
+        "the track's {frames} frames before its lowest point never leave a free-flight arc clearly: the trajectory cannot tell when the ball touched"
+    )]
+    NoDeparture { frames: usize },
     /// A fit failed (degenerate times).
     #[error("the {phase} flight could not be fitted")]
     FitFailed { phase: &'static str },

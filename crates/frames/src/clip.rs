@@ -142,10 +142,11 @@ impl Frames {
                 other => other?,
             };
             // A folder holding one multi-page TIFF is that stack.
-            if let [only] = &files[..] {
-                if FrameFormat::from_path(&only.path) == Some(FrameFormat::Tiff) && tiff_is_stack(&only.path)? {
-                    return Self::camera(&only.path, Kind::Tiff, max_pixels);
-                }
+            if let [only] = &files[..]
+                && FrameFormat::from_path(&only.path) == Some(FrameFormat::Tiff)
+                && tiff_is_stack(&only.path)?
+            {
+                return Self::camera(&only.path, Kind::Tiff, max_pixels);
             }
             let first = &files[0].path;
             let size = image::ImageReader::open(first)

@@ -59,10 +59,10 @@ pub fn guess_from_name(name: &str) -> NameGuess {
             g.drop_height_m.get_or_insert(h / 100.0);
         } else if let Some(h) = num("m") {
             g.drop_height_m.get_or_insert(h);
-        } else if let Some(word) = surface_word(&t) {
-            if !words.contains(&word) {
-                words.push(word);
-            }
+        } else if let Some(word) = surface_word(&t)
+            && !words.contains(&word)
+        {
+            words.push(word);
         }
     }
     if (g.angle_deg.is_some() || g.drop_height_m.is_some()) && !words.is_empty() {
@@ -303,20 +303,20 @@ impl Draft {
         if let Some(d) = o.diameter_m {
             check_range(d, DIAMETER_RANGE_M, "m", Path::new("command line"), "--diameter")?;
         }
-        if let Some(m) = o.mass_kg {
-            if !(m.is_finite() && m > 0.0) {
-                return Err(FramesError::BadValue {
-                    path: "command line".into(),
-                    field: "--mass".into(),
-                    problem: format!("{m} must be a positive number of kilograms"),
-                });
-            }
+        if let Some(m) = o.mass_kg
+            && !(m.is_finite() && m > 0.0)
+        {
+            return Err(FramesError::BadValue {
+                path: "command line".into(),
+                field: "--mass".into(),
+                problem: format!("{m} must be a positive number of kilograms"),
+            });
         }
         let paths: Vec<PathBuf> = SETTINGS_FILES.iter().map(|n| self.dir.join(n)).collect();
-        if !o.force {
-            if let Some(p) = paths.iter().find(|p| p.exists()) {
-                return Err(FramesError::WouldOverwrite { path: p.clone() });
-            }
+        if !o.force
+            && let Some(p) = paths.iter().find(|p| p.exists())
+        {
+            return Err(FramesError::WouldOverwrite { path: p.clone() });
         }
         for (path, text) in paths.iter().zip([self.session_toml(o), self.clips_csv()]) {
             std::fs::write(path, text).map_err(|source| FramesError::Io {

@@ -5,10 +5,10 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use crate::camera::{CameraFile, DEFAULT_MAX_FRAME_PIXELS, Kind};
-use crate::clip::Clip;
+use crate::clip::{Clip, ClipOptions};
 use crate::error::{FramesError, Result, UnfilledRow};
 use crate::settings::{
-    ClipSettings, DIAMETER_RANGE_M, Downslope, FpsSource, SettingOverrides, Warning, camera_keys, camera_keys_at,
+    ClipSettings, DIAMETER_RANGE_M, Downslope, FpsSource, Warning, camera_keys, camera_keys_at, check_overrides,
     check_range, choose_fps, choose_settings, clip_toml_path, number, read_toml,
 };
 
@@ -103,6 +103,16 @@ impl Session {
     /// row. Lines starting with `#` are comments. Rows whose `surface`, `angle_deg` or `drop_height_m` cell
     /// is empty (as `bouncelab init` leaves them) are all listed in one [`FramesError::UnfilledColumns`].
     pub fn load(dir: impl AsRef<Path>) -> Result<Self> {
+        Self::load_with(dir, &ClipOptions::default())
+    }
+
+    /// [`Session::load`] with command-line overrides applied to every clip: `options.fps` and
+    /// `options.overrides` beat each clip's `clip.toml`, its camera header and `session.toml`.
+    pub fn load_with(dir: impl AsRef<Path>, options: &ClipOptions) -> Result<Self> {
+        if let Some(fps) = options.fps {
+            crate::settings::check_fps(fps, "command line", "--fps")?;
+        }
+        check_overrides(&options.overrides)?;
         let dir = dir.as_ref().to_path_buf();
         let toml_path = dir.join("session.toml");
         if !toml_path.is_file() {
@@ -147,7 +157,7 @@ impl Session {
                 .and_then(|c| c.info.fps.map(|f| (f, c.path)));
             let (fps, fps_source, warning) = choose_fps(
                 &clip_dir,
-                None,
+                options.fps,
                 own.as_ref(),
                 header_fps.as_ref().map(|(f, p)| (*f, p.as_path())),
                 fps.map(|f| (f, toml_path.as_path())),
@@ -155,7 +165,7 @@ impl Session {
             warnings.extend(warning);
             let settings = choose_settings(
                 &clip_dir,
-                &SettingOverrides::default(),
+                &options.overrides,
                 own.as_ref(),
                 Some(&session_keys),
                 &mut warnings,

@@ -213,25 +213,25 @@ impl Default for ClipSettings {
 impl ClipSettings {
     /// Checks the region of interest and the contact line against the frames' size.
     pub fn check_against(&self, clip: &Path, size: (u32, u32)) -> Result<()> {
-        if let Some(roi) = self.roi {
-            if !roi.fits(size) {
-                return Err(FramesError::RoiOutsideImage {
-                    clip: clip.into(),
-                    roi,
-                    origin: origin_of(self.roi_source.as_ref()),
-                    size,
-                });
-            }
+        if let Some(roi) = self.roi
+            && !roi.fits(size)
+        {
+            return Err(FramesError::RoiOutsideImage {
+                clip: clip.into(),
+                roi,
+                origin: origin_of(self.roi_source.as_ref()),
+                size,
+            });
         }
-        if let Some(line) = self.contact_line {
-            if !(line.y_px >= 0.0 && line.y_px <= f64::from(size.1.saturating_sub(1))) {
-                return Err(FramesError::LineOutsideImage {
-                    clip: clip.into(),
-                    line_y_px: line.y_px,
-                    origin: origin_of(self.contact_line_source.as_ref()),
-                    size,
-                });
-            }
+        if let Some(line) = self.contact_line
+            && !(line.y_px >= 0.0 && line.y_px <= f64::from(size.1.saturating_sub(1)))
+        {
+            return Err(FramesError::LineOutsideImage {
+                clip: clip.into(),
+                line_y_px: line.y_px,
+                origin: origin_of(self.contact_line_source.as_ref()),
+                size,
+            });
         }
         Ok(())
     }
@@ -390,17 +390,17 @@ pub(crate) fn camera_keys(path: &Path, doc: &toml::Table) -> Result<CameraKeys> 
             keys.roi = Some(roi(path, v)?);
         }
     }
-    if let Some(ball) = table(path, doc, "ball")? {
-        if let Some(v) = ball.get("diameter_m") {
-            let field = "[ball] diameter_m";
-            keys.diameter_m = Some(check_range(
-                number(path, field, v)?,
-                DIAMETER_RANGE_M,
-                "m",
-                path,
-                field,
-            )?);
-        }
+    if let Some(ball) = table(path, doc, "ball")?
+        && let Some(v) = ball.get("diameter_m")
+    {
+        let field = "[ball] diameter_m";
+        keys.diameter_m = Some(check_range(
+            number(path, field, v)?,
+            DIAMETER_RANGE_M,
+            "m",
+            path,
+            field,
+        )?);
     }
     if let Some(surface) = table(path, doc, "surface")? {
         let y = surface
@@ -519,10 +519,10 @@ pub(crate) fn choose_settings(
         if let Some(v) = over {
             return Some((v, SettingSource::CommandLine));
         }
-        if let Some((p, k)) = own {
-            if let Some(v) = get(k) {
-                return Some((v, SettingSource::ClipToml(p.clone())));
-            }
+        if let Some((p, k)) = own
+            && let Some(v) = get(k)
+        {
+            return Some((v, SettingSource::ClipToml(p.clone())));
         }
         session.and_then(|(p, k)| get(k).map(|v| (v, SettingSource::SessionToml(p.clone()))))
     }
@@ -577,14 +577,14 @@ pub(crate) fn check_overrides(o: &SettingOverrides) -> Result<()> {
             "--line-tilt",
         )?;
     }
-    if let Some(r) = o.roi {
-        if r.width == 0 || r.height == 0 {
-            return Err(FramesError::BadValue {
-                path: cl.into(),
-                field: "--roi".into(),
-                problem: "width and height must be at least 1 pixel".into(),
-            });
-        }
+    if let Some(r) = o.roi
+        && (r.width == 0 || r.height == 0)
+    {
+        return Err(FramesError::BadValue {
+            path: cl.into(),
+            field: "--roi".into(),
+            problem: "width and height must be at least 1 pixel".into(),
+        });
     }
     Ok(())
 }

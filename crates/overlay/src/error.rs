@@ -4,6 +4,20 @@
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum OverlayError {
+    /// A key frame the clip does not hold (a trajectory from another version of the clip).
+    #[error("frame {frame} is not in the clip")]
+    FrameNotInClip {
+        /// Frame index.
+        frame: u64,
+    },
+    /// A frame that could not be read back to draw it.
+    #[error("reading frame {frame} to draw it: {source}")]
+    Read {
+        /// Frame index.
+        frame: u64,
+        /// Why.
+        source: Box<bouncelab_frames::FramesError>,
+    },
     /// A status name that is none of the tracker's.
     #[error("frame {frame}: unknown status `{name}` (expected ok, occluded, cut_by_border, absent or ambiguous)")]
     UnknownStatus {

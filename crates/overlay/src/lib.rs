@@ -30,6 +30,7 @@ mod keyframes;
 mod marks;
 mod paint;
 mod sheet;
+mod shot;
 mod view;
 
 pub use annotate::{Crop, Style, annotate_frame, ball_crop, crop_at, draw_annotations};
@@ -39,6 +40,7 @@ pub use keyframes::{ContactRule, KeyFrames, KeyRole, ShotPhases, key_frames_from
 pub use marks::{BallMark, Phase, Status, SurfaceLine};
 pub use paint::{Dash, draw_line_across, draw_ring, draw_segment};
 pub use sheet::{SheetLayout, StripFrame, Tile, contact_sheet, key_frame_strip};
+pub use shot::{choose_key_frames, shot_strip};
 pub use view::{Levels, MAX_CANVAS_PIXELS, OUTSIDE, View, render_gray};
 
 use image::RgbImage;

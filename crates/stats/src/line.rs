@@ -67,10 +67,10 @@ pub fn fit_line(x: &[f64], y: &[f64], w: Option<&[f64]>) -> Result<LineFit, Stat
             });
         }
     }
-    if let Some(w) = w {
-        if let Some(row) = w.iter().position(|v| !(v.is_finite() && *v > 0.0)) {
-            return Err(StatsError::InvalidWeight { row, value: w[row] });
-        }
+    if let Some(w) = w
+        && let Some(row) = w.iter().position(|v| !(v.is_finite() && *v > 0.0))
+    {
+        return Err(StatsError::InvalidWeight { row, value: w[row] });
     }
     if n < 3 {
         return Err(StatsError::TooFewObservations {

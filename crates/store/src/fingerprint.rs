@@ -116,10 +116,10 @@ pub fn fingerprint_clip_dir(dir: &Path, settings: &str, mode: ClipFingerprint) -
     let mut files = Vec::new();
     for entry in fs::read_dir(folder).map_err(io(dir))? {
         let entry = entry.map_err(io(dir))?;
-        if let Some(prefix) = &prefix {
-            if !entry.file_name().as_encoded_bytes().starts_with(prefix.as_bytes()) {
-                continue;
-            }
+        if let Some(prefix) = &prefix
+            && !entry.file_name().as_encoded_bytes().starts_with(prefix.as_bytes())
+        {
+            continue;
         }
         let meta = entry.metadata().map_err(io(&entry.path()))?;
         if meta.is_file() {

@@ -10,7 +10,7 @@
 
 use crate::clip::{ClipTracking, TrackError, on_plane, with_plane};
 use crate::hough::{Circle, CircleDetection, detect_circles, radius_bands};
-use crate::plane::Plane;
+use crate::plane::{Pixel, Plane};
 use crate::refine::refine_candidates;
 use crate::tracker::CLEAN_QUALITY;
 use bouncelab_frames::{Clip, Frame};
@@ -71,7 +71,7 @@ pub(crate) fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32, noise: f32) -
     let bands = radius_bands(min_radius, max_radius);
     let mut frames = FrameCache::new(clip, opts, gain);
     let background = frames.background()?;
-    let mut found: HashMap<(usize, usize, Votes, Voters), Vec<Circle>> = HashMap::new();
+    let mut found: HashMap<(usize, usize, Votes, Voters), Vec<Seen>> = HashMap::new();
     // The clearest circles that did not move, for the error: (x, y, r, quality).
     let mut still: Vec<(f64, f64, f64, f64)> = Vec::new();
     // Clean circles before doubtful ones; then an octave of radii at a time, largest first, so the ball's rim
@@ -85,7 +85,7 @@ pub(crate) fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32, noise: f32) -
                     if votes == Votes::Moving && background.is_none() {
                         continue;
                     }
-                    let mut circles = |k: usize| -> Result<Vec<Circle>, TrackError> {
+                    let mut circles = |k: usize| -> Result<Vec<Seen>, TrackError> {
                         if let Some(c) = found.get(&(k, band, votes, voters)) {
                             return Ok(c.clone());
                         }
@@ -104,13 +104,13 @@ pub(crate) fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32, noise: f32) -
                     };
                     let mut k = 0;
                     while k + gap < n && k <= n / 2 {
-                        let good = |c: &Circle| c.support > threshold;
-                        let a: Vec<Circle> = circles(k)?.into_iter().filter(good).collect();
-                        let b: Vec<Circle> = circles(k + gap)?.into_iter().filter(good).collect();
+                        let good = |s: &Seen| s.circle.support > threshold;
+                        let a: Vec<Seen> = circles(k)?.into_iter().filter(good).collect();
+                        let b: Vec<Seen> = circles(k + gap)?.into_iter().filter(good).collect();
                         let (a_moved, a_static) = split_static(&a, &b);
                         let (b_moved, _) = split_static(&b, &a);
                         if threshold == CLEAN_QUALITY && votes == Votes::Frame && voters == Voters::Strongest {
-                            for c in &a_static {
+                            for c in a_static.iter().map(|s| &s.circle) {
                                 if !still.iter().any(|s| (s.0 - c.x).hypot(s.1 - c.y) < 0.5 * c.r) {
                                     still.push((c.x, c.y, c.r, c.support));
                                 }
@@ -118,7 +118,7 @@ pub(crate) fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32, noise: f32) -
                         }
                         if let Some((ca, cb)) = moving_pair(&a_moved, &b_moved, w as f64, |mx, my, r, reach| {
                             Ok(gap < 2
-                                || circles(k + gap / 2)?.iter().any(|c| {
+                                || circles(k + gap / 2)?.iter().map(|s| &s.circle).any(|c| {
                                     c.support > threshold
                                         && (c.x - mx).hypot(c.y - my) <= reach
                                         && (c.r - r).abs() <= 0.05 * r + 1.0
@@ -158,23 +158,28 @@ pub(crate) fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32, noise: f32) -
     })
 }
 
-/// The clearest pair (circle in the first frame, in the second) of the same size that moved by more than a
-/// pixel and a half and less than half the frame's width, and that `halfway(x, y, r, reach)` finds again
-/// within `reach` of its middle: half-way, the ball is near the middle of its two sightings (a quarter of the
-/// distance covered allows for gravity and for a bounce between them).
+/// The clearest pair (circle in the first frame, in the second) of the same size and of one ball (the same
+/// look, see [`look_correlation`], or, for a plain disc, one that stands out from its surroundings in both,
+/// see [`disc_contrast`]) that moved by more than a pixel and a half and less than half the frame's width, and
+/// that `halfway(x, y, r, reach)` finds again within `reach` of its middle: half-way, the ball is near the
+/// middle of its two sightings (a quarter of the distance covered allows for gravity and for a bounce between
+/// them).
 fn moving_pair(
-    a: &[Circle],
-    b: &[Circle],
+    a: &[Seen],
+    b: &[Seen],
     width: f64,
     mut halfway: impl FnMut(f64, f64, f64, f64) -> Result<bool, TrackError>,
 ) -> Result<Option<(Circle, Circle)>, TrackError> {
     let mut moving: Vec<(Circle, Circle)> = Vec::new();
-    for ca in a {
-        for cb in b {
+    for sa in a {
+        for sb in b {
+            let (ca, cb) = (sa.circle, sb.circle);
             let same_size = (ca.r - cb.r).abs() <= 0.05 * ca.r + 1.0;
             let moved = (ca.x - cb.x).hypot(ca.y - cb.y);
-            if same_size && moved > 1.5 && moved < 0.5 * width {
-                moving.push((*ca, *cb));
+            let same_ball = look_correlation(&sa.look, &sb.look) >= MIN_LOOK_CORRELATION
+                || sa.contrast.min(sb.contrast) >= MIN_DISC_CONTRAST;
+            if same_size && moved > 1.5 && moved < 0.5 * width && same_ball {
+                moving.push((ca, cb));
             }
         }
     }
@@ -188,14 +193,128 @@ fn moving_pair(
     Ok(None)
 }
 
-/// The circles of `here` that are not in `there` at the same place and size (within a pixel and a half or 5 %
-/// of the radius), and those that are (static things).
-fn split_static(here: &[Circle], there: &[Circle]) -> (Vec<Circle>, Vec<Circle>) {
-    here.iter().partition(|c| {
+/// The sightings of `here` that are not in `there` at the same place and size (within a pixel and a half or
+/// 5 % of the radius), and those that are (static things).
+fn split_static(here: &[Seen], there: &[Seen]) -> (Vec<Seen>, Vec<Seen>) {
+    here.iter().cloned().partition(|s| {
+        let c = &s.circle;
         !there
             .iter()
+            .map(|o| &o.circle)
             .any(|o| (o.x - c.x).hypot(o.y - c.y) <= 1.5_f64.max(0.05 * c.r) && (o.r - c.r).abs() <= 0.05 * c.r + 1.0)
     })
+}
+
+/// A circle seen in a frame, with what its disc looks like there.
+#[derive(Clone)]
+struct Seen {
+    circle: Circle,
+    /// The frame's levels on a grid over the disc (see [`disc_look`]).
+    look: Vec<f32>,
+    /// How far the disc stands out from its surroundings (see [`disc_contrast`]), on the frame or on its
+    /// difference from the background, whichever shows it more.
+    contrast: f64,
+}
+
+/// The least [`look_correlation`] of two sightings of one ball.
+const MIN_LOOK_CORRELATION: f64 = 0.3;
+
+/// Points across the disc's diameter of the grid [`disc_look`] samples.
+const LOOK_GRID: usize = 15;
+
+/// What a disc looks like: the image's levels (bilinear) on a [`LOOK_GRID`]² grid over the square of side
+/// 1.6 r about its centre, those within 0.8 r of it, in a fixed order (NaN where outside the image). Cost:
+/// ~180 samples.
+fn disc_look<P: Pixel>(img: &Plane<P>, c: &Circle) -> Vec<f32> {
+    let half = (LOOK_GRID / 2) as f64;
+    let mut out = Vec::with_capacity(LOOK_GRID * LOOK_GRID);
+    for j in 0..LOOK_GRID {
+        for i in 0..LOOK_GRID {
+            let (u, v) = ((i as f64 - half) / half, (j as f64 - half) / half);
+            if u.hypot(v) > 1.0 {
+                continue;
+            }
+            let (x, y) = (c.x + 0.8 * c.r * u, c.y + 0.8 * c.r * v);
+            out.push(img.sample(x as f32, y as f32).unwrap_or(f32::NAN));
+        }
+    }
+    out
+}
+
+/// The least [`disc_contrast`] of a ball without a look of its own (a silhouette, a plain disc): it stands
+/// out from what surrounds it by at least the surroundings' own scatter.
+const MIN_DISC_CONTRAST: f64 = 1.0;
+
+/// How far the disc of radius `r` at (x, y) stands out from a ring around it: |median inside 0.8 r − median
+/// of the ring 1.2 r … 1.6 r| over the ring's robust scatter (1.4826 × MAD), floored at one gray level. A
+/// plain ball or a silhouette is a disc of its own; a circle that rim votes find in grains or noise has the
+/// same texture inside as outside (contrast well below 1). Pixels outside the image are skipped; 0 when
+/// fewer than 16 remain on either side. Cost: O(r²) pixel reads on a grid of step r / 12.
+fn disc_contrast<P: Pixel>(img: &Plane<P>, x: f64, y: f64, r: f64) -> f64 {
+    let step = (r / 12.0).max(1.0);
+    let reach = 1.6 * r;
+    let (mut inside, mut ring) = (Vec::new(), Vec::new());
+    let n = (reach / step).ceil() as i64;
+    for j in -n..=n {
+        for i in -n..=n {
+            let (dx, dy) = (i as f64 * step, j as f64 * step);
+            let d = dx.hypot(dy);
+            let (px, py) = ((x + dx).round(), (y + dy).round());
+            if px < 0.0 || py < 0.0 || px >= img.width as f64 || py >= img.height as f64 {
+                continue;
+            }
+            let v = f64::from(img.at(px as usize, py as usize));
+            if d <= 0.8 * r {
+                inside.push(v);
+            } else if (1.2 * r..=reach).contains(&d) {
+                ring.push(v);
+            }
+        }
+    }
+    if inside.len() < 16 || ring.len() < 16 {
+        return 0.0;
+    }
+    let m_in = median(&mut inside);
+    let m_out = median(&mut ring);
+    let mut dev: Vec<f64> = ring.iter().map(|v| (v - m_out).abs()).collect();
+    (m_in - m_out).abs() / (1.4826 * median(&mut dev)).max(1.0)
+}
+
+fn median(v: &mut [f64]) -> f64 {
+    let mid = v.len() / 2;
+    *v.select_nth_unstable_by(mid, f64::total_cmp).1
+}
+
+/// The correlation of two discs' looks (see [`disc_look`]) over the points both have: one ball seen twice
+/// a few frames apart has the same shading, print and seam (≈ 1 less what noise and spin take); two
+/// unrelated patches of grains or noise, which vote for circles where they happen to line up, ≈ 0. A plain
+/// disc's look is flat but for noise: such a ball is told by its [`disc_contrast`] instead. 0 when
+/// fewer than 16 points are shared or either look is flat.
+fn look_correlation(a: &[f32], b: &[f32]) -> f64 {
+    let pairs: Vec<(f64, f64)> = a
+        .iter()
+        .zip(b)
+        .filter(|(x, y)| x.is_finite() && y.is_finite())
+        .map(|(&x, &y)| (x as f64, y as f64))
+        .collect();
+    if pairs.len() < 16 {
+        return 0.0;
+    }
+    let n = pairs.len() as f64;
+    let (ma, mb) = (
+        pairs.iter().map(|p| p.0).sum::<f64>() / n,
+        pairs.iter().map(|p| p.1).sum::<f64>() / n,
+    );
+    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
+    for (x, y) in &pairs {
+        sab += (x - ma) * (y - mb);
+        saa += (x - ma).powi(2);
+        sbb += (y - mb).powi(2);
+    }
+    if saa <= 0.0 || sbb <= 0.0 {
+        return 0.0;
+    }
+    sab / (saa * sbb).sqrt()
 }
 
 /// Frames decoded once each, by file position.
@@ -272,14 +391,15 @@ impl<'a> FrameCache<'a> {
         det: &CircleDetection,
         votes: Votes,
         background: Option<&[f32]>,
-    ) -> Result<Vec<Circle>, TrackError> {
+    ) -> Result<Vec<Seen>, TrackError> {
         let (w, h) = self.opts.roi.map_or(self.clip.dimensions(), |r| (r.width, r.height));
         let (w, h) = (w as usize, h as usize);
-        let peaks = match (votes, background) {
-            (Votes::Moving, Some(bg)) => {
-                let moving: Vec<f32> = self.levels(k)?.iter().zip(bg).map(|(a, b)| (a - b).abs()).collect();
-                detect_circles(&Plane::new(&moving, w, h), det)
-            }
+        let moving: Option<Vec<f32>> = match background {
+            Some(bg) => Some(self.levels(k)?.iter().zip(bg).map(|(a, b)| (a - b).abs()).collect()),
+            None => None,
+        };
+        let peaks = match (votes, &moving) {
+            (Votes::Moving, Some(m)) => detect_circles(&Plane::new(m, w, h), det),
             _ => {
                 let gain = self.gain;
                 let f = self.get(k)?;
@@ -289,11 +409,95 @@ impl<'a> FrameCache<'a> {
         let gain = self.gain;
         let search = &self.opts.tracker.search;
         let f = self.get(k)?;
-        let refined = with_plane(
-            &f.pixels,
-            gain,
-            |p| on_plane!(p, p => refine_candidates(&p, peaks, det, search, None, CANDIDATE_QUALITY)),
+        let moving = moving.as_ref().map(|m| Plane::new(m, w, h));
+        Ok(with_plane(&f.pixels, gain, |p| {
+            on_plane!(p, p => refine_candidates(&p, peaks, det, search, None, CANDIDATE_QUALITY)
+                .into_iter()
+                .map(|(circle, _)| {
+                    let (x, y, r) = (circle.x, circle.y, circle.r);
+                    let on_moving = moving.as_ref().map_or(0.0, |m| disc_contrast(m, x, y, r));
+                    Seen {
+                        look: disc_look(&p, &circle),
+                        contrast: disc_contrast(&p, x, y, r).max(on_moving),
+                        circle,
+                    }
+                })
+                .collect())
+        }))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testutil::{Scene, render};
+
+    fn look_of(scene: &Scene, c: (f64, f64, f64)) -> Vec<f32> {
+        let px = render(scene);
+        let circle = Circle {
+            x: c.0,
+            y: c.1,
+            r: c.2,
+            support: 1.0,
+        };
+        disc_look(&Plane::new(&px, scene.size.0, scene.size.1), &circle)
+    }
+
+    /// One ball seen twice, moved and with fresh noise, looks alike; two patches of the same grains drawn
+    /// afresh do not, nor two places of one band.
+    #[test]
+    fn a_ball_looks_like_itself_and_grains_do_not() {
+        let ball = |x: f64, seed: u64| Scene {
+            ball: (x, 90.7, 40.0),
+            noise: 6.0,
+            seed,
+            ..Scene::default()
+        };
+        let same = look_correlation(
+            &look_of(&ball(120.3, 1), (120.3, 90.7, 40.0)),
+            &look_of(&ball(131.8, 2), (131.8, 90.7, 40.0)),
         );
-        Ok(refined.into_iter().map(|(c, _)| c).collect())
+        assert!(same > 0.9, "ball {same}");
+        let grains = |seed: u64| Scene {
+            ball: (-500.0, -500.0, 1.0),
+            surface: Some((0.0, 0.0)),
+            band: (120.0, 25.0),
+            seed,
+            ..Scene::default()
+        };
+        for (a, b) in [((1, 128.0), (2, 128.0)), ((1, 100.0), (1, 160.0))] {
+            let r = look_correlation(
+                &look_of(&grains(a.0), (a.1, 128.0, 30.0)),
+                &look_of(&grains(b.0), (b.1, 128.0, 30.0)),
+            );
+            assert!(r.abs() < MIN_LOOK_CORRELATION, "grains {r}");
+        }
+    }
+
+    /// A plain ball stands out from its surroundings; a circle drawn in grains does not, however they are lit.
+    #[test]
+    fn a_ball_has_disc_contrast_and_grains_have_none() {
+        let ball = render(&Scene {
+            noise: 6.0,
+            ..Scene::default()
+        });
+        let c = disc_contrast(&Plane::new(&ball, 256, 256), 120.3, 90.7, 40.0);
+        assert!(c > 2.0 * MIN_DISC_CONTRAST, "ball {c}");
+        for (level, grain) in [(90.0, 25.0), (160.0, 40.0)] {
+            let grains = render(&Scene {
+                ball: (-500.0, -500.0, 1.0),
+                surface: Some((0.0, 0.0)),
+                band: (level, grain),
+                ..Scene::default()
+            });
+            let c = disc_contrast(&Plane::new(&grains, 256, 256), 128.0, 128.0, 30.0);
+            assert!(c < 0.5 * MIN_DISC_CONTRAST, "grains {level}/{grain}: {c}");
+        }
+    }
+
+    #[test]
+    fn a_flat_or_unseen_look_correlates_with_nothing() {
+        assert_eq!(look_correlation(&[1.0; 40], &[2.0; 40]), 0.0);
+        assert_eq!(look_correlation(&[f32::NAN; 40], &[2.0; 40]), 0.0);
     }
 }

@@ -11,7 +11,7 @@ use crate::plane::{Pixel, Plane};
 use crate::refine::{EdgeSearch, NOISY_SIGMA};
 use crate::surface::SurfaceLine;
 use crate::tracker::{BallFix, CLEAN_QUALITY, Status, TrackOptions, Tracker};
-use bouncelab_frames::{Clip, ContactLine, Frame, FramesError, GrayPixels, ReadOptions, Roi};
+use bouncelab_frames::{Clip, ClipSettings, ContactLine, Frame, FramesError, GrayPixels, ReadOptions, Roi};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -43,7 +43,7 @@ pub struct ClipTracking {
     pub ball_diameter_m: f64,
     /// Approximate scale, m/px, if known (narrows the search); found from the ball's motion otherwise.
     pub scale_hint_m_per_px: Option<f64>,
-    /// True if down-slope is −x in the image (SPEC §2.7 `downslope = "-x"`).
+    /// True if down-slope is −x in the image (`downslope = "-x"`, `docs/session.md`).
     pub downslope_negative_x: bool,
     /// Frame decoding.
     pub read: ReadOptions,
@@ -67,6 +67,21 @@ impl Default for ClipTracking {
             tracker: TrackOptions::default(),
             roi: None,
             contact_line: None,
+        }
+    }
+}
+
+impl ClipTracking {
+    /// Options that follow a clip's resolved settings (diameter, scale, region of interest, contact line;
+    /// `docs/session.md`), everything else default.
+    pub fn for_settings(settings: &ClipSettings, downslope_negative_x: bool) -> Self {
+        ClipTracking {
+            ball_diameter_m: settings.ball_diameter_m,
+            scale_hint_m_per_px: settings.scale_m_per_px,
+            downslope_negative_x,
+            roi: settings.roi,
+            contact_line: settings.contact_line,
+            ..ClipTracking::default()
         }
     }
 }

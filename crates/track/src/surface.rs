@@ -234,8 +234,9 @@ fn brightness_lines<P: Pixel>(img: &Plane<P>) -> Vec<SurfaceLine> {
 /// order), topmost first: RANSAC over pairs from distant columns (deterministic sampling), lines within `tol`
 /// px of at least half of the `columns` sampled (and half the best line's support: a hand or a fixture may
 /// hide part of the band's top where a ruler crosses the whole frame), strong = mean strength at least
-/// `relative_strength` × the strongest such line's and at least `min_strength`; lines closer than 2 × `tol` to
-/// a higher one are the same line; each refined by least squares on its inliers. `leans[i]` is candidate i's
+/// `relative_strength` × the strongest such line's and at least `min_strength`; of lines closer than 2 × `tol`
+/// the best supported stands for them all (one edge seen through the tolerance band), and a line crossing a
+/// better supported one inside the frame is dropped; each refined by least squares on its inliers. `leans[i]` is candidate i's
 /// edge definition (see [`SurfaceLine::edge_definition_px`]).
 pub(crate) fn lines_through(
     cands: &[(f64, f64, f64)],
@@ -285,8 +286,9 @@ pub(crate) fn lines_through(
         .into_iter()
         .filter(|l| supported(l) && l.3 >= relative_strength * strongest && l.3 >= min_strength)
         .collect();
-    // Topmost first (y smallest at the centre).
-    good.sort_by(|a, b| (a.1 + a.2 * xc).total_cmp(&(b.1 + b.2 * xc)));
+    // Of hypotheses within a tolerance band of each other (one edge seen through ±tol), the best supported
+    // stands for them all: a weaker one a few px off would otherwise win by being higher.
+    good.sort_by(|a, b| b.0.total_cmp(&a.0));
     let wf = w as f64;
     let mut kept: Vec<(f64, f64)> = Vec::new();
     let mut out: Vec<SurfaceLine> = Vec::new();
@@ -297,14 +299,22 @@ pub(crate) fn lines_through(
             continue;
         }
         kept.push((c, slope));
+        // Two edges of a scene (a band's top, a tape on it) do not cross inside the frame: a line that crosses a
+        // better supported one there is made of its points and stray ones.
+        let crosses = |o: &SurfaceLine, l: &SurfaceLine| {
+            let gap = |x: f64| l.y_at(x) - o.y_at(x);
+            gap(0.0) * gap(wf - 1.0) <= 0.0
+        };
         if let Some(line) = refine_line(cands, leans, c, slope, tol, xc)
-            && !out
-                .iter()
-                .any(|o| (o.y0 - line.y0).abs() <= tol && (o.slope - line.slope).abs() * wf <= tol)
+            && !out.iter().any(|o| {
+                ((o.y0 - line.y0).abs() <= tol && (o.slope - line.slope).abs() * wf <= tol) || crosses(o, &line)
+            })
         {
             out.push(line);
         }
     }
+    // Topmost first.
+    out.sort_by(|a, b| a.y0.total_cmp(&b.y0));
     out
 }
 

@@ -248,13 +248,15 @@ impl Tracker {
 
     /// Measures the ball in one frame. Frames must come in time order.
     pub fn observe<P: Pixel>(&mut self, frame: usize, t_s: f64, img: &Plane<P>) -> BallFix {
-        if self.surface.is_none() && self.surface_tries < 5 {
+        // Where the ball is expected, a line above it is not the surface; until the ball is known (a tracker
+        // never seeded, before its first fix) no line is looked for, as the rims of round things side by
+        // side can pass for the top of a band.
+        let ball = self
+            .predict(t_s)
+            .zip(self.expected_radius())
+            .map(|((x, y), r)| (x, y, r));
+        if self.surface.is_none() && self.surface_tries < 5 && ball.is_some() {
             self.surface_tries += 1;
-            // Where the ball is expected, a line above it is not the surface.
-            let ball = self
-                .predict(t_s)
-                .zip(self.expected_radius())
-                .map(|((x, y), r)| (x, y, r));
             if let Some(lines) = find_surface_lines(img, ball) {
                 self.surface = Some(lines.line);
                 self.surface_alternatives = lines.alternatives;

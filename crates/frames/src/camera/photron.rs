@@ -235,23 +235,23 @@ pub(crate) fn open(path: &Path, max_pixels: u64) -> Result<CameraFile> {
         }
     };
     let missing = |f: String| header_error(&header_path, &f, "missing from the header");
-    if let Some(ff) = &h.file_format {
-        if !ff.eq_ignore_ascii_case("mraw") {
-            return Err(header_error(
-                &header_path,
-                &name("<imageFileInfo><fileFormat>", "File Format"),
-                format!("`{ff}`: this header describes {ff} files, not a .mraw"),
-            ));
-        }
+    if let Some(ff) = &h.file_format
+        && !ff.eq_ignore_ascii_case("mraw")
+    {
+        return Err(header_error(
+            &header_path,
+            &name("<imageFileInfo><fileFormat>", "File Format"),
+            format!("`{ff}`: this header describes {ff} files, not a .mraw"),
+        ));
     }
-    if let Some(c) = &h.colour {
-        if c.to_ascii_lowercase().contains("color") || c.to_ascii_lowercase().contains("colour") {
-            return Err(header_error(
-                &header_path,
-                &name("<imageDataInfo><colorInfo><type>", "Color Type"),
-                format!("`{c}`: colour MRAW (a Bayer mosaic) is not supported; record or save monochrome"),
-            ));
-        }
+    if let Some(c) = &h.colour
+        && (c.to_ascii_lowercase().contains("color") || c.to_ascii_lowercase().contains("colour"))
+    {
+        return Err(header_error(
+            &header_path,
+            &name("<imageDataInfo><colorInfo><type>", "Color Type"),
+            format!("`{c}`: colour MRAW (a Bayer mosaic) is not supported; record or save monochrome"),
+        ));
     }
     let width = h
         .width

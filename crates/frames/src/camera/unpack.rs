@@ -64,8 +64,8 @@ impl Packing {
         match self {
             Self::U8 => Some(pixels),
             Self::U16Le(_) => pixels.checked_mul(2),
-            Self::P10 => (pixels % 4 == 0).then(|| pixels / 4 * 5),
-            Self::P12 => (pixels % 2 == 0).then(|| pixels / 2 * 3),
+            Self::P10 => pixels.is_multiple_of(4).then(|| pixels / 4 * 5),
+            Self::P12 => pixels.is_multiple_of(2).then(|| pixels / 2 * 3),
         }
     }
 

@@ -837,11 +837,10 @@ mod tests {
             )
         ) {
             let s: String = parts.concat();
-            if let Ok(ast) = parse(&s) {
-                if let Ok(p) = Program::compile(&ast, &mut |n: &str| (n == "x" || n == "delta").then_some(0usize)) {
+            if let Ok(ast) = parse(&s)
+                && let Ok(p) = Program::compile(&ast, &mut |n: &str| (n == "x" || n == "delta").then_some(0usize)) {
                     let _ = p.eval(|_| 0.25);
                 }
-            }
         }
 
         #[test]
