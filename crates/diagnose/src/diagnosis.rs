@@ -113,7 +113,8 @@ pub struct Evidence {
     /// BIC(with candidate) − BIC(current), with the noise variance estimated from the residuals
     /// (`n·ln(RSS/n) + p·ln n`, σ-weighted RSS); negative favours the candidate.
     pub delta_bic: f64,
-    /// Held-out position RMS with the candidate, m.
+    /// Held-out position RMS with the candidate, m; without cross-validation (`cross_validated` false),
+    /// the fit's own RMS, a lower bound of it.
     pub heldout_error_after: f64,
     /// Mean over shots of ln(held-out χ² before / after): > 0 when the candidate predicts unseen shots
     /// better; σ cancels in the ratio.
@@ -147,6 +148,11 @@ pub struct Evidence {
     /// or the candidate frees more than one parameter of its own (Hunt–Crossley).
     #[serde(default)]
     pub detection_limit: Option<f64>,
+    /// False when the candidate was not cross-validated: its fit to all shots already failed the BIC check,
+    /// so it could be neither named nor said to explain part (the folds would cost six fits and decide
+    /// nothing); its held-out test then counts as failed.
+    #[serde(default = "yes")]
+    pub cross_validated: bool,
     /// The fit with the candidate (every parameter, base ones refitted too, with intervals).
     pub fit: FitSummary,
 }
@@ -239,6 +245,10 @@ pub struct Thresholds {
     pub phase_tolerance_m: f64,
     /// Least fraction of the systematic error a named candidate removes.
     pub explained_fraction: f64,
+}
+
+fn yes() -> bool {
+    true
 }
 
 /// The measurement floor: the systematic residual below which a misfit is "no missing effect", learned

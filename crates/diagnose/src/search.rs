@@ -24,6 +24,8 @@ struct ModelRun {
     per_shot: Vec<ShotSums>,
     /// Per shot (input order): its residual sums when predicted by the model fitted without its fold.
     heldout: Vec<Option<ShotSums>>,
+    /// False when its BIC fall was too small for the folds to decide anything (`heldout` is then empty).
+    cross_validated: bool,
     n_params: usize,
     /// Each shot's surface level at the full fit, m (with surface levels).
     levels: Option<Vec<f64>>,
@@ -88,6 +90,27 @@ struct Start<'a> {
     scan: Option<&'a Scan<'a>>,
     /// Called with every solver iteration of the fit to all shots and its reduced χ².
     on_iteration: &'a dyn Fn(usize, f64),
+    /// Cross-validate only when the fit to all shots lowers BIC enough to count (a candidate that fails
+    /// the BIC check can be neither named nor said to explain part, so its folds would decide nothing).
+    gate: Option<BicGate>,
+}
+
+/// The current model's χ², parameter count and residual count, and the least BIC fall that counts.
+#[derive(Clone, Copy)]
+struct BicGate {
+    chi2: f64,
+    n_params: usize,
+    n_res: f64,
+    min_delta_bic: f64,
+}
+
+impl BicGate {
+    /// ΔBIC of a fit with χ² `chi2` and `n_params` parameters against the current model.
+    fn delta_bic(&self, chi2: f64, n_params: usize) -> f64 {
+        let tiny = f64::MIN_POSITIVE;
+        self.n_res * (chi2.max(tiny) / self.chi2.max(tiny)).ln()
+            + (n_params as f64 - self.n_params as f64) * self.n_res.ln()
+    }
 }
 
 /// Fits `spec` to every shot from the file's values, then once per fold without that fold's shots
@@ -108,6 +131,7 @@ fn run_model(
         seed,
         scan,
         on_iteration,
+        gate,
     } = how;
     let clock = Instant::now();
     let mut ev = Evaluator::new(spec, shots.to_vec(), opts.sim, opts.surface_levels)?;
@@ -158,11 +182,17 @@ fn run_model(
     let summary = summarize(&ev, effect_names(spec), &out, sq);
     let fitted: Vec<(String, f64)> = ev.names().into_iter().zip(out.params.iter().copied()).collect();
     let levels = ev.levels();
+    let n_params = out.params.len() + ev.nuisance_per_shot() * shots.len();
+    let cross_validated = gate.is_none_or(|g| g.delta_bic(out.cost, n_params) <= -g.min_delta_bic);
     // Folds in parallel (each fit also simulates its shots in parallel); collected in fold order.
-    let per_fold: Vec<Vec<(usize, Option<ShotSums>)>> = (0..k)
-        .into_par_iter()
-        .map(|f| heldout_fold(spec, shots, fold_of, f, &fitted, levels.as_deref(), opts))
-        .collect();
+    let per_fold: Vec<Vec<(usize, Option<ShotSums>)>> = if cross_validated {
+        (0..k)
+            .into_par_iter()
+            .map(|f| heldout_fold(spec, shots, fold_of, f, &fitted, levels.as_deref(), opts))
+            .collect()
+    } else {
+        Vec::new()
+    };
     let mut heldout = vec![None; shots.len()];
     for (i, sums) in per_fold.into_iter().flatten() {
         heldout[i] = sums;
@@ -172,7 +202,8 @@ fn run_model(
         sims,
         per_shot,
         heldout,
-        n_params: out.params.len() + ev.nuisance_per_shot() * shots.len(),
+        cross_validated,
+        n_params,
         levels,
         seconds: clock.elapsed().as_secs_f64(),
     })
@@ -345,6 +376,7 @@ pub fn find_missing_effect_with(
             seed: None,
             scan: None,
             on_iteration: &iterations(0, "current model"),
+            gate: None,
         },
     )
     .map_err(|e| DiagnoseError::Baseline {
@@ -449,6 +481,12 @@ pub fn find_missing_effect_with(
         seconds: base.seconds,
     };
 
+    let gate = BicGate {
+        chi2: base.summary.chi2,
+        n_params: base.n_params,
+        n_res: base.per_shot.iter().map(|s| s.n).sum::<usize>() as f64,
+        min_delta_bic: options.min_delta_bic,
+    };
     // Every candidate, started from the current model's fitted values.
     let mut warm = spec.clone();
     set_values(&mut warm, &base.summary.parameters);
@@ -481,6 +519,7 @@ pub fn find_missing_effect_with(
                         seed: base.levels.as_deref(),
                         scan: scan.as_ref(),
                         on_iteration: &iterations(j + 1, &format!("+ {}", setup.effect)),
+                        gate: Some(gate),
                     },
                 )
                 .map_err(|e| e.to_string())
@@ -737,6 +776,7 @@ impl TermSearch<'_> {
                             seed: self.levels,
                             scan: None,
                             on_iteration: &on_iteration,
+                            gate: None,
                         },
                     )
                     .map(|run| (spec, run))
@@ -916,8 +956,15 @@ fn evidence_of(
         .map(|(a, b)| (a.chi2.max(tiny) / b.chi2.max(tiny)).ln())
         .collect();
     let (log_ratio, p) = stats::one_sided_t(&d);
-    let before_ho = rms_of(pairs.iter().map(|(a, _)| *a));
-    let after_ho = rms_of(pairs.iter().map(|(_, b)| *b));
+    // Without folds, the fit's own RMS stands in for the held-out error (its lower bound).
+    let (before_ho, after_ho) = if run.cross_validated {
+        (
+            rms_of(pairs.iter().map(|(a, _)| *a)),
+            rms_of(pairs.iter().map(|(_, b)| *b)),
+        )
+    } else {
+        (rms_of(base.heldout.iter().flatten()), run.summary.rms_m)
+    };
     cand.heldout_error_before = before_ho;
     let ms0 = before_ho * before_ho;
     let ms1 = after_ho * after_ho;
@@ -964,6 +1011,7 @@ fn evidence_of(
         param_interval: primary.and_then(|p| p.interval),
         param_z,
         detection_limit,
+        cross_validated: run.cross_validated,
         fit: run.summary.clone(),
     });
     cand

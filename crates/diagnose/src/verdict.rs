@@ -223,8 +223,11 @@ fn check(c: &mut Candidate, o: &SearchOptions, noise: f64) {
     if !c.checks.bic {
         reasons.push(format!("ΔBIC = {:.1}, not below −{}", e.delta_bic, o.min_delta_bic));
     }
-    c.checks.heldout = e.heldout_p_holm < o.alpha && e.heldout_error_after < c.heldout_error_before;
-    if !c.checks.heldout {
+    c.checks.heldout =
+        e.cross_validated && e.heldout_p_holm < o.alpha && e.heldout_error_after < c.heldout_error_before;
+    if !e.cross_validated {
+        reasons.push("not cross-validated: its fit to all shots already fails the BIC check".to_string());
+    } else if !c.checks.heldout {
         reasons.push(format!(
             "held-out error {} → {} on {} of {} shots better, {} after Holm's correction (needs < {})",
             um(c.heldout_error_before),
@@ -294,6 +297,7 @@ fn check(c: &mut Candidate, o: &SearchOptions, noise: f64) {
     // Part of a misfit: the held-out test before Holm's correction (the search then goes on from the model
     // with it, where the next effect must pass every test and this one keep its parameter).
     c.partly_explains = !c.explains
+        && e.cross_validated
         && c.checks.bic
         && e.heldout_p < o.alpha
         && e.heldout_error_after < c.heldout_error_before
