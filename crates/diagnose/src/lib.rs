@@ -17,7 +17,9 @@
 //! When none explains it, a formula term is looked for in a small library of forces in δ, δ̇, the slip and
 //! the contact's history (the patch's tangential displacement u_t, ∫δ dt) (forward selection, each term
 //! fitted through the simulator: [`TermProposal`]). The thresholds are measured against a floor learned
-//! from the session's free flight ([`Floor`]).
+//! from the session's free flight ([`Floor`]). When the named effect leaves a misfit above the floor, or one
+//! explains only part of it, the search goes on from the model with it and may name a second
+//! ([`Diagnosis::then`]).
 //!
 //! [`find_missing_effect`] returns a [`Diagnosis`] (`diagnosis.json`); [`add_effect_to_model_toml`] adds the
 //! named effect to the user's `model.toml`, comments kept. See `docs/diagnosis.md`.
