@@ -1,5 +1,5 @@
 //! `bouncelab analyze` end to end on the rendered `smoke` session: the output files, incremental re-runs, a
-//! run killed with SIGKILL and resumed, and the session faults of SPEC §6 (clear line, exit 1, nothing lost).
+//! run killed with SIGKILL and resumed, and the session faults (clear line, exit 1, nothing lost).
 
 use assert_cmd::Command;
 use predicates::prelude::*;

@@ -118,5 +118,22 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         );
     }
     eprintln!("{summary}");
+    let c = &track.camera;
+    if c.format != bouncelab_frames::SourceFormat::Folder {
+        let mut line = format!("camera: {}", c.format.label());
+        if let Some(m) = &c.camera_model {
+            line += &format!(" {m}");
+        }
+        if let Some(e) = c.exposure_s {
+            line += &format!(", exposure {} µs", e * 1e6);
+        }
+        if let Some(b) = c.effective_bit_depth.or(c.bit_depth) {
+            line += &format!(", {b}-bit");
+        }
+        if let Some(t) = c.trigger_frame {
+            line += &format!(", trigger at file frame {t}");
+        }
+        eprintln!("{line}");
+    }
     Ok(())
 }

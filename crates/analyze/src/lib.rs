@@ -1,7 +1,7 @@
 //! The pipeline over a session folder: frames → track → estimate → fit → compare → diagnose → stats → report,
 //! incremental through the results store.
 //!
-//! This crate owns no science: it runs each stage's library in order and writes the files of SPEC §5. Its one
+//! This crate owns no science: it runs each stage's library in order and writes the files of `docs/outputs.md`. Its one
 //! design choice is that the SQLite store sits between measuring and everything after it: shots are tracked in
 //! parallel and each one is committed on its own, the later stages read every shot back from the store, so an
 //! unchanged shot is never tracked again and a run killed at any instant resumes where it stopped. Progress is
@@ -665,7 +665,7 @@ fn diagnose_stage(
     Ok(d)
 }
 
-/// The paper's statistics of a session (SPEC §2.6).
+/// The paper's statistics of a session (`docs/stats.md`).
 #[derive(Debug, Clone)]
 pub struct SessionStats {
     /// The terms fitted, in order (those with a single level are left out).

@@ -209,13 +209,27 @@ fn measure_clip(entry: &ClipEntry, gravity: f64) -> Measured {
     // the frame of the line the tracker found.
     let frame = estimate.as_ref().ok().and_then(|e| e.frame);
     let line = estimate.as_ref().ok().and_then(|e| e.contact_line).or(track.surface);
-    let record = track_record(&track, frame.as_ref(), line.as_ref(), started.elapsed().as_secs_f64());
+    let mut record = track_record(&track, frame.as_ref(), line.as_ref(), started.elapsed().as_secs_f64());
+    record.camera = camera_record(clip.camera());
     Ok((
         record,
         estimate
             .map(|e| estimate_record(&e))
             .map_err(|e| format!("estimating: {e}")),
     ))
+}
+
+/// What a camera file's header says, as stored with the track; `None` for a folder of images, whose files say
+/// none of it.
+fn camera_record(info: &bouncelab_frames::CameraInfo) -> Option<bouncelab_store::CameraRecord> {
+    (info.format != bouncelab_frames::SourceFormat::Folder).then(|| bouncelab_store::CameraRecord {
+        format: info.format.label().to_string(),
+        model: info.camera_model.clone(),
+        fps: info.fps,
+        exposure_s: info.exposure_s,
+        bit_depth: info.effective_bit_depth.or(info.bit_depth),
+        trigger_frame: info.trigger_frame,
+    })
 }
 
 fn track_record(
@@ -237,6 +251,7 @@ fn track_record(
         surface_tilt_deg: line.map(|l| l.tilt_deg()),
         warnings: track.warnings.clone(),
         seconds,
+        camera: None,
         rows: rows
             .into_iter()
             .map(|r| TrajectoryRecord {

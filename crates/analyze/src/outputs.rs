@@ -215,7 +215,7 @@ pub fn write_estimates_csv(
     Ok(())
 }
 
-/// `trajectories/<clip>.csv`: the SPEC §5 columns of every frame.
+/// `trajectories/<clip>.csv`: the `docs/outputs.md` columns of every frame.
 fn write_trajectory(out: &mut dyn Write, s: &ShotData) -> Result<(), csv::Error> {
     write_track_rows(out, &s.track)
 }

@@ -318,6 +318,7 @@ pub(crate) fn build(a: &Analysis, p: &Predictions, description: Option<&str>, wa
     notes.extend(a.measure.failed.iter().map(|(c, m)| format!("{c}: not measured: {m}")));
     notes.extend(a.excluded.iter().map(|(c, m)| format!("{c}: left out of the fit: {m}")));
     notes.extend(p.failures.iter().cloned());
+    notes.extend(camera_notes(&a.shots));
     let tilts: Vec<_> = a.shots.iter().filter_map(|s| s.estimate.surface_tilt_deg).collect();
     if let Some(t) = bouncelab_estimate::session_tilt_deg(&tilts) {
         notes.push(format!(
@@ -809,6 +810,49 @@ fn contact_source(e: &bouncelab_estimate::Estimate) -> Option<String> {
         );
     }
     Some(text)
+}
+
+/// One line per distinct camera (as its files' headers describe it) with the shots it recorded: model,
+/// format, rate, exposure, bit depth and where the trigger fell. Nothing for folders of images.
+fn camera_notes(shots: &[ShotData]) -> Vec<String> {
+    let mut cameras: Vec<(String, Vec<&str>)> = Vec::new();
+    for s in shots {
+        let Some(c) = &s.track.camera else { continue };
+        let mut text = format!(
+            "{} ({})",
+            c.model.as_deref().unwrap_or("camera model not stated"),
+            c.format
+        );
+        if let Some(fps) = c.fps {
+            text += &format!(", {fps} frames/s");
+        }
+        if let Some(e) = c.exposure_s {
+            text += &format!(", exposure {} µs", e * 1e6);
+        }
+        if let Some(b) = c.bit_depth {
+            text += &format!(", {b}-bit");
+        }
+        match cameras.iter_mut().find(|(t, _)| *t == text) {
+            Some((_, clips)) => clips.push(&s.clip),
+            None => cameras.push((text, vec![&s.clip])),
+        }
+    }
+    cameras
+        .into_iter()
+        .map(|(text, clips)| {
+            let trigger = shots
+                .iter()
+                .filter(|s| clips.contains(&s.clip.as_str()))
+                .filter_map(|s| s.track.camera.as_ref()?.trigger_frame.map(|t| (s.clip.as_str(), t)))
+                .map(|(clip, t)| format!("{clip} {t}"))
+                .collect::<Vec<_>>();
+            let mut line = format!("camera: {text}; {} shot(s)", clips.len());
+            if !trigger.is_empty() {
+                line += &format!("; trigger at file frame {}", trigger.join(", "));
+            }
+            line
+        })
+        .collect()
 }
 
 /// Fills each shot's strip of key frames (approach, touch, deepest, separation, leave), read back from its

@@ -18,7 +18,7 @@ pub struct ShotData {
     pub drop_height_m: f64,
     /// Extra `clips.csv` columns.
     pub metadata: Vec<(String, String)>,
-    /// The stored track (per-frame rows with SPEC §5 columns).
+    /// The stored track (per-frame rows with `docs/outputs.md` columns).
     pub track: TrackRecord,
     /// The estimator's output.
     pub estimate: Estimate,

@@ -54,7 +54,7 @@ pub struct PhaseFrames {
     pub fitted: (usize, usize),
 }
 
-/// The per-shot results (local frame of SPEC §3: t along the surface down-slope, n along the normal).
+/// The per-shot results (local frame of `docs/outputs.md`: t along the surface down-slope, n along the normal).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Estimate {
     /// Velocity at contact start (tangential, normal), m/s.

@@ -12,7 +12,7 @@
 //!
 //! Angles on the polar grid run counter-clockwise as seen (image y points down, so a point at angle φ is at
 //! (x, y) = (cx + ρ cos φ, cy − ρ sin φ)): a positive angle is a counter-clockwise turn in the image. The
-//! estimate reports ω in the local frame of SPEC §3 (x down-slope, y the outward normal), which is
+//! estimate reports ω in the local frame of `docs/outputs.md` (x down-slope, y the outward normal), which is
 //! counter-clockwise as seen in the image when down-slope is +x, and clockwise as seen when the image is
 //! mirrored (`downslope = "-x"`), so that the slip v_t + ω·R holds either way.
 
@@ -85,7 +85,7 @@ pub struct Rotation {
     pub peak: f64,
 }
 
-/// Spin of both flight phases, in the local frame of SPEC §3, with what went wrong.
+/// Spin of both flight phases, in the local frame of `docs/outputs.md`, with what went wrong.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Spin {
     /// Spin before the impact, rad/s.
@@ -362,7 +362,7 @@ pub fn spin_from_frames(frames: &[SpinFrame], o: &SpinOptions) -> Result<Measure
 
 /// Spin before and after the impact of a tracked clip: reads the flight phases' frames (at most
 /// `max_frames` per phase, evenly spaced) and follows the texture's rotation. Values are in the local frame
-/// of SPEC §3 (counter-clockwise as seen when down-slope is +x).
+/// of `docs/outputs.md` (counter-clockwise as seen when down-slope is +x).
 pub fn measure_spin(clip: &Clip, track: &Track, phases: &PhaseFrames, o: &SpinOptions) -> Spin {
     let position: HashMap<usize, usize> = clip
         .files()

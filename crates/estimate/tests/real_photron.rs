@@ -20,6 +20,15 @@ fn a_real_free_fall_is_tracked_in_every_frame_and_has_no_impact() {
     assert_eq!(clip.fps(), 30_000.0, "the header's record rate");
     let track = track_clip(&clip, &ClipTracking::for_settings(clip.settings(), false), |_, _| {}).unwrap();
     assert_eq!(track.fixes.len(), 15);
+    // The header's metadata is carried with the track (README: shutter 1/50,000 s, startFrame 52).
+    assert_eq!(track.camera.fps, Some(30_000.0));
+    assert!(
+        (track.camera.exposure_s.unwrap() - 2e-5).abs() < 1e-9,
+        "{:?}",
+        track.camera
+    );
+    assert_eq!(track.camera.start_frame, Some(52));
+    assert_eq!(track.camera.trigger_frame, Some(-52));
     assert!(track.fixes.iter().all(|f| f.status.measured()), "{:?}", track.fixes);
     // Hand measurement (README): radius ≈ 63.7 px.
     let scale = track.scale.unwrap();

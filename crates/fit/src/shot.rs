@@ -3,7 +3,7 @@
 use bouncelab_model::State;
 use serde::{Deserialize, Serialize};
 
-/// One tracked frame in the local frame of SPEC §3.
+/// One tracked frame in the local frame of `docs/outputs.md`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct MeasuredFrame {
     /// Time, s (t = 0 at the clip's first frame).

@@ -33,7 +33,7 @@ impl Default for Ball {
     }
 }
 
-/// The ball's planar state in the local frame (SPEC §3).
+/// The ball's planar state in the local frame (`docs/outputs.md`).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct State {
     /// Centre position along the surface (down-slope), m.

@@ -11,7 +11,7 @@
 //! trajectory sampled at the camera's frame times. Models are written by hand in `model.toml`
 //! ([`ModelSpec`]), which also says which parameters a fit may move.
 //!
-//! Conventions (SPEC §3): local frame with x along the surface pointing down-slope, y along the outward
+//! Conventions (`docs/outputs.md`): local frame with x along the surface pointing down-slope, y along the outward
 //! normal, origin on the surface; the ball's centre is at height `y`, so the penetration is `δ = R − y`.
 //! Spin ω is positive counter-clockwise as seen by the camera; the contact point slips at `v_t + ω·R`.
 

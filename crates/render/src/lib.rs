@@ -1,7 +1,7 @@
 //! Synthetic high-speed drop clips with exact ground truth: the project's test bench.
 //!
 //! A [`Scenario`] (a TOML file or a built-in preset) describes a session — camera, ball, surfaces with their
-//! physics in `model.toml` syntax, shots — and [`render`] writes it in the layout of SPEC §2.7 with the
+//! physics in `model.toml` syntax, shots — and [`render`] writes it in the layout of `docs/session.md` with the
 //! truth in a `truth/` folder beside the session, never inside it. The physics is not re-implemented: every
 //! shot is simulated by `bouncelab-model` at the frames' mid-exposure times (the truth) and at sub-exposure
 //! times (motion blur), so the truth is the model's own output. The main design choice is that the

@@ -42,7 +42,7 @@ pub enum Format {
     Tiff,
 }
 
-/// Which image direction is down the slope (SPEC §2.7).
+/// Which image direction is down the slope (`docs/session.md`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 pub enum Downslope {
     /// Down-slope is +x_px (to the right); the default.

@@ -1,4 +1,4 @@
-//! Writing a session (SPEC §2.7) and its truth beside it.
+//! Writing a session (`docs/session.md`) and its truth beside it.
 
 use crate::scene::{Frame, Pixels};
 use crate::shot::{ShotPlan, ShotTruth};

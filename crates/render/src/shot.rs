@@ -43,7 +43,7 @@ pub struct FrameTruth {
     pub y_px: f64,
     /// Ball radius, pixels.
     pub r_px: f64,
-    /// Ball centre along the surface (down-slope), m, local frame (SPEC §3).
+    /// Ball centre along the surface (down-slope), m, local frame (`docs/outputs.md`).
     pub x_m: f64,
     /// Ball centre height above the surface line, m, local frame.
     pub y_m: f64,

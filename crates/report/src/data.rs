@@ -153,7 +153,7 @@ impl Phase {
     }
 }
 
-/// One tracked frame of a shot, in the local frame of SPEC §3 (x down-slope, y the outward normal, origin
+/// One tracked frame of a shot, in the local frame of `docs/outputs.md` (x down-slope, y the outward normal, origin
 /// on the surface line).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct MeasuredPoint {

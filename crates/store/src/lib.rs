@@ -18,7 +18,7 @@ mod store;
 pub use error::{Result, StoreError};
 pub use fingerprint::{ClipFingerprint, Fingerprint, fingerprint_clip_dir};
 pub use records::{
-    EstimateRecord, EstimateRow, FitRecord, FitRow, ModelHistoryRow, ModelVersionRecord, ModelVersionRow,
+    CameraRecord, EstimateRecord, EstimateRow, FitRecord, FitRow, ModelHistoryRow, ModelVersionRecord, ModelVersionRow,
     SessionRecord, SessionRow, ShotRecord, ShotRow, ShotStatus, ShotUpsert, TrackRecord, TrajectoryRecord, ValueSe,
 };
 pub use schema::{MIGRATIONS, Migration, Table, latest_version};

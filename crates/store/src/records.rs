@@ -148,11 +148,32 @@ pub struct TrackRecord {
     pub warnings: Vec<String>,
     /// Wall time spent tracking, seconds.
     pub seconds: f64,
-    /// Per-frame trajectory (SPEC §5 columns); frames unique.
+    /// Per-frame trajectory (`docs/outputs.md` columns); frames unique.
     pub rows: Vec<TrajectoryRecord>,
+    /// What the camera file's header says (model, rate, exposure, bit depth, trigger), when the clip is a
+    /// camera file; `None` for a folder of images or a track stored before it was kept.
+    #[serde(default)]
+    pub camera: Option<CameraRecord>,
 }
 
-/// One frame of a trajectory (SPEC §5 `trajectories/<clip>.csv`).
+/// A camera file's header as stored with its track.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct CameraRecord {
+    /// The file format (e.g. "Photron MRAW", "Phantom CINE").
+    pub format: String,
+    /// Camera model, as the header names it.
+    pub model: Option<String>,
+    /// Record rate from the header, frames/s.
+    pub fps: Option<f64>,
+    /// Exposure (shutter) time of one frame, s.
+    pub exposure_s: Option<f64>,
+    /// Bits per pixel the sensor filled (the effective depth, else the stored one).
+    pub bit_depth: Option<u8>,
+    /// Position in the file (0-based) of the trigger frame; may lie outside the stored frames.
+    pub trigger_frame: Option<i64>,
+}
+
+/// One frame of a trajectory (`docs/outputs.md` `trajectories/<clip>.csv`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TrajectoryRecord {
     /// Frame index (0-based, dropped frames counted).
@@ -193,7 +214,7 @@ impl ValueSe {
     }
 }
 
-/// A shot's estimates (SPEC §5 `estimates.csv`), each with its standard error.
+/// A shot's estimates (`docs/outputs.md` `estimates.csv`), each with its standard error.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct EstimateRecord {
     /// Incoming tangential velocity, m/s.

@@ -140,6 +140,11 @@ CREATE INDEX fits_by_model ON fits(model_version_id, id);
         description: "estimates.detail: the estimator's full output as JSON (phases, flight arcs)",
         sql: "ALTER TABLE estimates ADD COLUMN detail TEXT CHECK (detail IS NULL OR json_valid(detail));",
     },
+    Migration {
+        version: 3,
+        description: "tracks.camera: the camera file's header (model, rate, exposure, bit depth, trigger) as JSON",
+        sql: "ALTER TABLE tracks ADD COLUMN camera TEXT CHECK (camera IS NULL OR json_valid(camera));",
+    },
 ];
 
 /// The newest schema version this build knows.
@@ -159,9 +164,9 @@ pub enum Table {
     Shots,
     /// One row per tracked shot: summary of its track.
     Tracks,
-    /// One row per frame of a tracked shot (SPEC §5 trajectory columns).
+    /// One row per frame of a tracked shot (`docs/outputs.md` trajectory columns).
     Trajectory,
-    /// One row per estimated shot (SPEC §5 estimates columns).
+    /// One row per estimated shot (`docs/outputs.md` estimates columns).
     Estimates,
     /// Model files, each version once.
     ModelVersions,
@@ -234,6 +239,7 @@ impl Table {
                 "warnings",
                 "seconds",
                 "created_at",
+                "camera",
             ],
             Table::Trajectory => &[
                 "shot_id", "frame", "t_s", "x_px", "y_px", "r_px", "sigma_px", "quality", "status", "x_m", "y_m",

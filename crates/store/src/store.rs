@@ -550,12 +550,17 @@ impl Tx<'_> {
         let frames = to_i64(self.path, "tracks", "frames", r.frames)?;
         let measured = to_i64(self.path, "tracks", "measured", r.measured)?;
         let warnings = to_json(self.path, "tracks", "warnings", &r.warnings)?;
+        let camera = r
+            .camera
+            .as_ref()
+            .map(|c| to_json(self.path, "tracks", "camera", c))
+            .transpose()?;
         self.drop_results(shot_id)?;
         self.tx
             .execute(
                 "INSERT INTO tracks (shot_id, frames, measured, scale_m_per_px, scale_se, surface_y_px,
-                                     surface_tilt_deg, warnings, seconds)
-                 VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9)",
+                                     surface_tilt_deg, warnings, seconds, camera)
+                 VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10)",
                 params![
                     shot_id,
                     frames,
@@ -565,7 +570,8 @@ impl Tx<'_> {
                     r.surface_y_px.and_then(nn),
                     r.surface_tilt_deg.and_then(nn),
                     warnings,
-                    nn(r.seconds)
+                    nn(r.seconds),
+                    camera
                 ],
             )
             .map_err(sql(self.path, "tracks"))?;
@@ -780,7 +786,8 @@ fn q_track(conn: &Connection, path: &Path, shot_id: i64) -> Result<Option<TrackR
     let err = || sql(path, "tracks");
     let head = conn
         .query_row(
-            "SELECT frames, measured, scale_m_per_px, scale_se, surface_y_px, surface_tilt_deg, warnings, seconds
+            "SELECT frames, measured, scale_m_per_px, scale_se, surface_y_px, surface_tilt_deg, warnings, seconds,
+                    camera
              FROM tracks WHERE shot_id = ?1",
             [shot_id],
             |r| {
@@ -795,17 +802,20 @@ fn q_track(conn: &Connection, path: &Path, shot_id: i64) -> Result<Option<TrackR
                         warnings: Vec::new(),
                         seconds: get_f64(r, 7)?,
                         rows: Vec::new(),
+                        camera: None,
                     },
                     r.get::<_, String>(6)?,
+                    r.get::<_, Option<String>>(8)?,
                 ))
             },
         )
         .optional()
         .map_err(err())?;
-    let Some((mut track, warnings)) = head else {
+    let Some((mut track, warnings, camera)) = head else {
         return Ok(None);
     };
     track.warnings = json_field(path, "tracks", "warnings", &warnings)?;
+    track.camera = camera.map(|c| json_field(path, "tracks", "camera", &c)).transpose()?;
     let err = || sql(path, "trajectory");
     let mut stmt = conn
         .prepare(

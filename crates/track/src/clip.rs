@@ -1,5 +1,5 @@
 //! A whole clip: find the ball, track it through every frame, measure the scale and the surface line, and
-//! put the centres in the local frame (SPEC §3).
+//! put the centres in the local frame (`docs/outputs.md`).
 //!
 //! Frames are decoded in parallel by the frames crate's stream while this thread tracks them in order, so
 //! tracking hides behind decoding. When the ball's size in pixels is not known, the ball is told from other
@@ -11,7 +11,7 @@ use crate::plane::{Pixel, Plane};
 use crate::refine::{EdgeSearch, NOISY_SIGMA};
 use crate::surface::SurfaceLine;
 use crate::tracker::{BallFix, CLEAN_QUALITY, Status, TrackOptions, Tracker};
-use bouncelab_frames::{Clip, ClipSettings, ContactLine, Frame, FramesError, GrayPixels, ReadOptions, Roi};
+use bouncelab_frames::{CameraInfo, Clip, ClipSettings, ContactLine, Frame, FramesError, GrayPixels, ReadOptions, Roi};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -148,6 +148,9 @@ pub struct Track {
     pub seconds_tracking: f64,
     /// True if down-slope is −x in the image.
     pub downslope_negative_x: bool,
+    /// What the clip's camera file header says (model, rate, exposure, bit depth, trigger); for a folder of
+    /// images only its format.
+    pub camera: CameraInfo,
 }
 
 impl Track {
@@ -384,6 +387,7 @@ pub fn track_clip(
         seconds_waiting: waiting,
         seconds_tracking: tracking,
         downslope_negative_x: opts.downslope_negative_x,
+        camera: clip.camera().clone(),
     })
 }
 

@@ -403,6 +403,7 @@ pub fn track_clip_opencv(
         seconds_waiting: waiting,
         seconds_tracking: tracking,
         downslope_negative_x: opts.downslope_negative_x,
+        camera: clip.camera().clone(),
     })
 }
 

@@ -132,3 +132,37 @@ fn a_faint_moving_ball_beats_a_clear_static_screw() {
     }
     assert!(track.fixes.iter().filter(|f| f.status.name() == "ok").count() >= 36);
 }
+
+/// Bit depth never changes the track: the same clip as 8-bit files and as 12-bit values shifted into 16-bit
+/// files (as many high-speed cameras write them) gives the same centres within 0.01 px.
+#[test]
+fn twelve_bits_in_sixteen_and_eight_bits_give_the_same_track() {
+    let (eight, wide) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    write_clip(eight.path(), 30, bounce);
+    for i in 0..30 {
+        let s = bounce(i);
+        let px: Vec<u16> = render(&s)
+            .iter()
+            .map(|&v| ((u32::from(v) * 4095 / 255) as u16) << 4)
+            .collect();
+        let img = image::ImageBuffer::<image::Luma<u16>, _>::from_raw(s.size.0 as u32, s.size.1 as u32, px).unwrap();
+        img.save(wide.path().join(format!("C001H001S0001{:06}.png", 1000 + i)))
+            .unwrap();
+    }
+    let track = |dir: &Path| {
+        let clip = Clip::open(dir).unwrap();
+        track_clip(&clip, &ClipTracking::default(), |_, _| {}).unwrap()
+    };
+    let (a, b) = (track(eight.path()), track(wide.path()));
+    assert_eq!(a.fixes.len(), b.fixes.len());
+    for (p, q) in a.fixes.iter().zip(&b.fixes) {
+        assert_eq!(p.status, q.status, "frame {}", p.frame);
+        if p.status.measured() {
+            assert!(
+                (p.x_px - q.x_px).abs() < 0.01 && (p.y_px - q.y_px).abs() < 0.01,
+                "frame {}: {p:?} vs {q:?}",
+                p.frame
+            );
+        }
+    }
+}

@@ -47,6 +47,19 @@ pub enum SourceFormat {
     Video,
 }
 
+impl SourceFormat {
+    /// The format's name for a person ("Photron MRAW", "folder of images", …).
+    pub fn label(self) -> &'static str {
+        match self {
+            SourceFormat::Folder => "folder of images",
+            SourceFormat::PhotronMraw => "Photron MRAW",
+            SourceFormat::PhantomCine => "Phantom CINE",
+            SourceFormat::TiffStack => "multi-page TIFF",
+            SourceFormat::Video => "video",
+        }
+    }
+}
+
 /// Which bits of a 16-bit sample hold a narrower camera's value (Photron `EffectiveBit Side`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]

@@ -265,7 +265,7 @@ pub struct EffectInfo {
     pub name: &'static str,
     /// One line on the physics.
     pub doc: &'static str,
-    /// Which group of SPEC §4 it belongs to ("normal", "tangential", "flight", "measurement"), or
+    /// Which group of `docs/effects.md` it belongs to ("normal", "tangential", "flight", "measurement"), or
     /// "nuisance" for a property of the measurement fitted with the base model (the surface level).
     pub group: &'static str,
     /// True for the effects of the paper's base model.

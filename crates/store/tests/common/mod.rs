@@ -34,6 +34,14 @@ pub fn track(frames: u64) -> TrackRecord {
         surface_tilt_deg: None,
         warnings: vec!["frame 3: ball cut by the border".into()],
         seconds: 0.125,
+        camera: Some(CameraRecord {
+            format: "Photron MRAW".into(),
+            model: Some("FASTCAM SA-Z".into()),
+            fps: Some(20_000.0),
+            exposure_s: Some(2e-5),
+            bit_depth: Some(12),
+            trigger_frame: Some(-52),
+        }),
         rows: (0..frames)
             .map(|i| TrajectoryRecord {
                 frame: i,
