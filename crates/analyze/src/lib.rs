@@ -642,6 +642,11 @@ fn diagnose_stage(
     progress.start(Stage::Diagnose, total as u64);
     let last = std::sync::atomic::AtomicUsize::new(0);
     let report = |p: bouncelab_diagnose::Progress| {
+        if let Some(i) = p.iteration {
+            // A solver iteration of the model being fitted.
+            progress.iteration(Stage::Diagnose, i, p.chi2_red.unwrap_or(f64::NAN));
+            return;
+        }
         let before = last.swap(p.done, std::sync::atomic::Ordering::Relaxed);
         progress.advance(Stage::Diagnose, p.done.saturating_sub(before) as u64);
         progress.doing(Stage::Diagnose, &p.what);

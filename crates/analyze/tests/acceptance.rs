@@ -1,12 +1,14 @@
-//! Issue 6's acceptance, through the whole chain: sessions rendered by our renderer with a hidden effect (or
-//! none, or one outside the library) are tracked, estimated, fitted with the paper's model and diagnosed;
-//! nothing inside the pipeline sees the truth. Slow (12 sessions): run in release,
+//! Issues 6 and 16's acceptance, through the whole chain: sessions rendered by our renderer with a hidden
+//! effect (or none, or two at once, or one outside the library) are tracked, estimated, fitted with the
+//! paper's model (μ per surface) and diagnosed; nothing inside the pipeline sees the truth. Slow (19
+//! sessions, one seed each): run in release,
 //!
 //! ```text
 //! cargo test --release -p bouncelab-analyze --test acceptance -- --ignored --nocapture
 //! ```
 //!
-//! (CI runs it). Each test prints the verdict and the figures recorded in `docs/accuracy.md`.
+//! (CI runs it). Each test prints the verdict and the figures recorded in `docs/accuracy.md`, and the rows
+//! of the verdict table (`| preset | verdict | magnitude recovered | interval covers truth | time |`).
 
 use bouncelab_analyze::{Analysis, AnalyzeOptions, Silent, analyze};
 use bouncelab_diagnose::{VerdictKind, add_effect_to_model_toml};
@@ -41,10 +43,18 @@ fn run(session: &Path, root: &Path, model: Option<PathBuf>) -> Analysis {
     a
 }
 
-/// The effect preset `effect-<name>`: named first (alone, or first of an ambiguous few), and once added the error falls ≥ 3× to χ²_red ≤ 1.5.
+/// The effect preset `effect-<name>`: named first (alone, or first of an ambiguous few), and once added the
+/// error falls ≥ 3× to χ²_red ≤ 1.5. Prints the verdict table's row (magnitude recovered, interval covers
+/// the truth, time).
 fn hidden(effect: &str) {
+    hidden_in(effect, &Scenario::preset(&format!("effect-{effect}")).unwrap());
+}
+
+/// [`hidden`] on a given scenario with `effect` hidden; returns the fitted switch parameter's value, its
+/// interval and its truth (from the scenario text).
+fn hidden_in(effect: &str, scenario: &Scenario) -> (f64, Option<[f64; 2]>, f64) {
     let dir = tempfile::tempdir().unwrap();
-    let session = render(&Scenario::preset(&format!("effect-{effect}")).unwrap(), dir.path());
+    let session = render(scenario, dir.path());
     let first = run(&session, dir.path(), None);
     let d = first.diagnosis.as_ref().expect("the diagnosis ran");
     eprintln!("{effect}: {}", d.verdict.sentence);
@@ -74,6 +84,30 @@ fn hidden(effect: &str) {
                 .collect()
         })
         .unwrap_or_default();
+    let c = d.candidate(effect).expect("the hidden effect was tried");
+    let e = c.evidence.as_ref().expect("its fit ran");
+    let truth = scenario_truth(scenario, effect, &c.param);
+    let covers = e.param_interval.map(|[lo, hi]| lo <= truth && truth <= hi);
+    eprintln!(
+        "{effect}: systematic part removed {:.1} %",
+        e.explained_fraction * 100.0
+    );
+    if effect == "tangential_spring" {
+        assert!(e.explained_fraction >= 0.9, "{effect}: {}", e.explained_fraction);
+    }
+    eprintln!(
+        "| effect-{effect} | {} | {} = {:.4e} ({:+.1} % of {truth:e}) | {} | {:.1} s |",
+        d.verdict.kind.name(),
+        c.param,
+        e.param_value,
+        (e.param_value - truth) / truth * 100.0,
+        match covers {
+            Some(true) => "yes",
+            Some(false) => "no",
+            None => "no interval",
+        },
+        d.seconds
+    );
     let text = add_effect_to_model_toml(bouncelab_model::PAPER_MODEL_TOML, effect, &values).unwrap();
     let model = dir.path().join("model.toml");
     std::fs::write(&model, text).unwrap();
@@ -93,6 +127,20 @@ fn hidden(effect: &str) {
         "{effect}: reduced χ² {}",
         second.fit.reduced_chi2
     );
+    (e.param_value, e.param_interval, truth)
+}
+
+/// The hidden value of `effect`'s parameter `param` in the scenario's model (its `[extra_effects]` table).
+fn scenario_truth(scenario: &Scenario, effect: &str, param: &str) -> f64 {
+    let spec = scenario
+        .model_spec(&[effect.to_string()])
+        .expect("the scenario's model");
+    spec.settings(None)
+        .expect("the scenario's model has values")
+        .iter()
+        .find(|(r, _)| r.effect == effect && r.param == param)
+        .map(|(_, s)| s.value)
+        .unwrap_or(f64::NAN)
 }
 
 #[test]
@@ -137,10 +185,75 @@ fn hidden_drag_is_named() {
     hidden("drag");
 }
 
+/// A rolled camera whose surface line is seen: the estimator measures the line's tilt and takes it out, so
+/// (a) the session's measured roll (the mean of the shots' `surface_tilt_deg`; the renderer's truth is
+/// `surface_tilt_deg = −roll` for down-slope +x) matches the hidden 3° within its error, and (b) nothing is
+/// left for the fit's `camera_roll` to explain: the verdict is `no_missing_effect`. (The fit's
+/// `camera_roll` remains for what the line cannot tell; it is named on synthetic tracks without a line,
+/// `crates/diagnose/tests/diagnose.rs`.)
 #[test]
 #[ignore]
-fn hidden_camera_roll_is_named() {
-    hidden("camera_roll");
+fn hidden_camera_roll_is_measured_and_taken_out() {
+    let scenario = Scenario::preset("effect-camera_roll").unwrap();
+    let roll = scenario_truth(&scenario, "camera_roll", "roll_deg");
+    let dir = tempfile::tempdir().unwrap();
+    let session = render(&scenario, dir.path());
+    let a = run(&session, dir.path(), None);
+    let tilts: Vec<(f64, f64)> = a
+        .shots
+        .iter()
+        .filter_map(|s| s.estimate.surface_tilt_deg.map(|m| (m.value, m.se)))
+        .collect();
+    assert_eq!(tilts.len(), a.shots.len(), "every shot's line seen: {tilts:?}");
+    let n = tilts.len() as f64;
+    let mean = tilts.iter().map(|t| t.0).sum::<f64>() / n;
+    // The mean's error: the larger of the stated errors' and the scatter's.
+    let stated = (tilts.iter().map(|t| t.1 * t.1).sum::<f64>()).sqrt() / n;
+    let scatter = (tilts.iter().map(|t| (t.0 - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt() / n.sqrt();
+    let se = stated.max(scatter);
+    let measured_roll = -mean;
+    eprintln!(
+        "camera_roll: measured roll {measured_roll:.4}° ± {se:.4}° (stated {stated:.4}, scatter {scatter:.4}) over {} shots, hidden {roll}°",
+        tilts.len()
+    );
+    assert!(
+        (measured_roll - roll).abs() <= 3.0 * se,
+        "measured roll {measured_roll} ± {se} vs hidden {roll}"
+    );
+    let d = a.diagnosis.as_ref().expect("the diagnosis ran");
+    eprintln!("camera_roll: {}", d.verdict.sentence);
+    eprintln!(
+        "| effect-camera_roll | {} | roll {measured_roll:.3}° ± {se:.3}° measured from the line (hidden {roll}°) | {} | {:.1} s |",
+        d.verdict.kind.name(),
+        if (measured_roll - roll).abs() <= 1.96 * se {
+            "yes"
+        } else {
+            "no"
+        },
+        d.seconds
+    );
+    assert_eq!(d.verdict.kind, VerdictKind::NoMissingEffect, "{}", d.verdict.sentence);
+}
+
+/// A compliant contact patch (the slip reverses), at the preset's compliance 1e-5 m/N and a factor 3
+/// stiffer: `tangential_spring` is named, removes ≥ 90 % of the systematic misfit, and its compliance is
+/// recovered within 10 %.
+#[test]
+#[ignore]
+fn hidden_tangential_spring_is_named_at_two_magnitudes() {
+    for compliance in ["1e-5", "3e-6"] {
+        let text = bouncelab_render::preset_toml("effect-tangential_spring")
+            .unwrap()
+            .replace("compliance = 1e-5", &format!("compliance = {compliance}"));
+        let scenario = Scenario::parse(&text, &format!("tangential spring λ = {compliance}")).unwrap();
+        let (value, _, truth) = hidden_in("tangential_spring", &scenario);
+        let err = (value - truth) / truth;
+        assert!(
+            err.abs() <= 0.1,
+            "compliance {value} vs {truth} ({:+.1} %)",
+            err * 100.0
+        );
+    }
 }
 
 /// No hidden effect, three seeds: no false alarm; and k, b within 2 % of the truth with 95 % intervals
@@ -162,6 +275,19 @@ fn no_hidden_effect_no_false_alarm_and_k_b_recovered() {
             "seed {seed}: {}",
             d.verdict.sentence
         );
+        // μ is fitted per surface: determined by the oblique shots, and near the hidden 0.5.
+        let mu = a.fit.param("clay:coulomb.mu").expect("μ fitted per surface");
+        eprintln!(
+            "  clay:coulomb.mu = {:.4} {:?} (truth 0.5){}",
+            mu.value,
+            mu.interval,
+            mu.not_identified
+                .as_deref()
+                .map(|w| format!(", not identified: {w}"))
+                .unwrap_or_default()
+        );
+        assert!(mu.not_identified.is_none(), "seed {seed}: {:?}", mu.not_identified);
+        assert!((mu.value - 0.5).abs() < 0.05 * 0.5, "seed {seed}: μ {}", mu.value);
         for (name, truth) in [("clay:spring.k", 25650.0), ("clay:damping.b", 14.0)] {
             let p = a.fit.param(name).unwrap();
             let [lo, hi] = p.interval.expect("an interval");
@@ -202,4 +328,126 @@ fn an_effect_outside_the_library_is_not_named() {
     let t = &p.terms[0];
     assert!(t.target == "normal" && t.phase == "restitution" && t.c < 0.0, "{p:?}");
     assert!(p.systematic_after_m < 0.5 * p.systematic_before_m, "{p:?}");
+}
+
+/// The pair preset `pair-A+B`: both effects named (one after the other: the search goes on from the model
+/// with the first), each magnitude within 10 % of the truth. Prints the verdict table's rows.
+fn pair(a: &str, b: &str) {
+    let scenario = Scenario::preset(&format!("pair-{a}+{b}")).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let session = render(&scenario, dir.path());
+    let run = run(&session, dir.path(), None);
+    let d = run.diagnosis.as_ref().expect("the diagnosis ran");
+    eprintln!("{a} + {b}: {}", d.verdict.sentence);
+    let mut named = d.verdict.effects.clone();
+    named.sort();
+    let mut want = vec![a.to_string(), b.to_string()];
+    want.sort();
+    assert_eq!(named, want, "{}", d.verdict.sentence);
+    // The last search's named candidate carries every parameter, both effects' refitted together.
+    let last = d.then.as_deref().unwrap_or(d);
+    let c = last
+        .candidate(last.verdict.effect.as_deref().expect("a named effect"))
+        .unwrap();
+    let fit = &c.evidence.as_ref().expect("its fit").fit;
+    for effect in [a, b] {
+        let info = bouncelab_model::builtin(effect).unwrap();
+        let param = info.params[0].name;
+        let truth = scenario_truth(&scenario, effect, param);
+        let p = fit
+            .parameters
+            .iter()
+            .find(|p| p.effect == effect && p.param == param)
+            .unwrap_or_else(|| panic!("{effect}.{param} not fitted: {:?}", fit.parameters));
+        let (mut value, mut truth, mut interval) = (p.value, truth, p.interval);
+        let mut label = format!("{effect}.{param}");
+        if effect == "hunt_crossley" {
+            // λ and n trade along a valley (a larger n with a larger λ fits as well): the magnitude that
+            // the shots determine is the damping force λ·δⁿ·δ̇, compared at δ = 2 mm, δ̇ = 1 m/s.
+            let n_of = |v: Option<f64>| v.unwrap_or(1.0);
+            let n_fit = n_of(
+                fit.parameters
+                    .iter()
+                    .find(|p| p.effect == effect && p.param == "n")
+                    .map(|p| p.value),
+            );
+            let n_true = scenario_truth(&scenario, effect, "n");
+            let force = |lambda: f64, n: f64| lambda * 0.002f64.powf(n);
+            eprintln!("hunt_crossley: λ = {value:.4e}, n = {n_fit:.3} (truth λ = {truth}, n = {n_true})");
+            (value, truth, interval) = (force(value, n_fit), force(truth, n_true), None);
+            label = "hunt_crossley λ·δⁿ at δ = 2 mm (N·s/m)".into();
+        }
+        let err = (value - truth) / truth;
+        let covers = interval.map(|[lo, hi]| lo <= truth && truth <= hi);
+        eprintln!(
+            "| pair-{a}+{b} | {} | {label} = {:.4e} ({:+.1} % of {truth:e}) | {} | {:.1} s |",
+            d.verdict.kind.name(),
+            value,
+            err * 100.0,
+            match covers {
+                Some(true) => "yes",
+                Some(false) => "no",
+                None => "no interval",
+            },
+            d.seconds
+        );
+        assert!(err.abs() <= 0.1, "{label} = {value} vs {truth}");
+    }
+}
+
+#[test]
+#[ignore]
+fn hidden_pair_hertz_and_drag_both_named() {
+    pair("hertz", "drag");
+}
+
+#[test]
+#[ignore]
+fn hidden_pair_hunt_crossley_and_rolling_resistance_both_named() {
+    pair("hunt_crossley", "rolling_resistance");
+}
+
+/// Inertia and a rolled camera whose line is seen: the roll is measured from the line and taken out (see
+/// `hidden_camera_roll_is_measured_and_taken_out`), so the search names the inertia change alone.
+#[test]
+#[ignore]
+fn hidden_pair_inertia_and_camera_roll_inertia_named_roll_measured() {
+    let scenario = Scenario::preset("pair-inertia_factor+camera_roll").unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let session = render(&scenario, dir.path());
+    let a = run(&session, dir.path(), None);
+    let d = a.diagnosis.as_ref().expect("the diagnosis ran");
+    eprintln!("inertia + roll: {}", d.verdict.sentence);
+    assert_eq!(d.verdict.effects, ["inertia_factor"], "{}", d.verdict.sentence);
+    let c = d.candidate("inertia_factor").unwrap();
+    let e = c.evidence.as_ref().unwrap();
+    let truth = scenario_truth(&scenario, "inertia_factor", "dc");
+    let roll = scenario_truth(&scenario, "camera_roll", "roll_deg");
+    let tilts: Vec<f64> = a
+        .shots
+        .iter()
+        .filter_map(|s| s.estimate.surface_tilt_deg.map(|m| m.value))
+        .collect();
+    let measured_roll = -tilts.iter().sum::<f64>() / tilts.len() as f64;
+    eprintln!(
+        "| pair-inertia_factor+camera_roll | {} | dc = {:.4} ({:+.1} % of {truth}); roll {measured_roll:.3}° measured from the line (hidden {roll}°) | {} | {:.1} s |",
+        d.verdict.kind.name(),
+        e.param_value,
+        (e.param_value - truth) / truth * 100.0,
+        match e.param_interval {
+            Some([lo, hi]) if lo <= truth && truth <= hi => "yes",
+            Some(_) => "no",
+            None => "no interval",
+        },
+        d.seconds
+    );
+    assert!(
+        ((e.param_value - truth) / truth).abs() <= 0.1,
+        "dc {} vs {truth}",
+        e.param_value
+    );
+    assert!(
+        (measured_roll - roll).abs() <= 0.1 * roll,
+        "roll {measured_roll} vs {roll}"
+    );
 }

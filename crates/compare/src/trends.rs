@@ -1,6 +1,7 @@
 //! Where the model fails: χ² shares by phase and component, and per-shot errors against the conditions.
 
 use crate::{Comparison, Component, ImpactPhase, ShotComparison};
+use bouncelab_stats::{holm, p_text};
 use serde::{Deserialize, Serialize};
 use statrs::distribution::{ContinuousCDF, FisherSnedecor, StudentsT};
 
@@ -254,15 +255,6 @@ fn signed(v: f64, decimals: usize) -> String {
     s.replacen('-', "−", 1)
 }
 
-/// `p < 0.001` or `p = 0.003`.
-fn p_text(p: f64) -> String {
-    if p < 0.001 {
-        "p < 0.001".into()
-    } else {
-        format!("p = {p:.3}")
-    }
-}
-
 struct Line {
     slope: f64,
     se: f64,
@@ -502,11 +494,10 @@ pub fn diagnose(comparison: &Comparison, opts: &DiagnoseOptions) -> FailureRepor
     trends.sort_by(|a, b| a.p.total_cmp(&b.p));
     // Holm's step-down adjustment over the whole family.
     let m = trends.len();
-    let mut running = 0.0f64;
-    for (i, t) in trends.iter_mut().enumerate() {
-        running = running.max(((m - i) as f64 * t.p).min(1.0));
-        t.p_holm = running;
-        t.significant = running < opts.alpha;
+    let ps: Vec<f64> = trends.iter().map(|t| t.p).collect();
+    for (t, p) in trends.iter_mut().zip(holm(&ps)) {
+        t.p_holm = p;
+        t.significant = p < opts.alpha;
     }
 
     let mut sentences = Vec::new();

@@ -33,6 +33,8 @@ const STARTS: &[(&str, &[(&str, f64)])] = &[
     ("inertia_factor", &[("dc", -0.05)]),
     ("drag", &[("cd", 0.3)]),
     ("camera_roll", &[("roll_deg", 0.5)]),
+    // k_t ≈ 3e5 N/m: a stiff patch, near the rigid contact but with a Jacobian that is not zero.
+    ("tangential_spring", &[("compliance", 3e-6)]),
 ];
 
 impl CandidateSetup {

@@ -76,6 +76,12 @@ pub struct Candidate {
     pub rank: usize,
     /// True if it passed every check.
     pub explains: bool,
+    /// True if it passed every check but completeness (its held-out test before Holm's correction):
+    /// significant, with a clear parameter, removing at least the floor of held-out error, but leaving more
+    /// than the floor (and more than `1 − explained_fraction` of the systematic part): part of what is
+    /// missing, not all.
+    #[serde(default)]
+    pub partly_explains: bool,
     /// The checks.
     pub checks: Checks,
     /// Why it did not pass, one phrase per failed check (empty when it explains).
@@ -107,7 +113,8 @@ pub struct Evidence {
     /// BIC(with candidate) − BIC(current), with the noise variance estimated from the residuals
     /// (`n·ln(RSS/n) + p·ln n`, σ-weighted RSS); negative favours the candidate.
     pub delta_bic: f64,
-    /// Held-out position RMS with the candidate, m.
+    /// Held-out position RMS with the candidate, m; without cross-validation (`cross_validated` false),
+    /// the fit's own RMS, a lower bound of it.
     pub heldout_error_after: f64,
     /// Mean over shots of ln(held-out χ² before / after): > 0 when the candidate predicts unseen shots
     /// better; σ cancels in the ratio.
@@ -134,6 +141,18 @@ pub struct Evidence {
     pub param_interval: Option<[f64; 2]>,
     /// Its distance from the neutral value in standard errors (`None` when not determined).
     pub param_z: Option<f64>,
+    /// The detection limit: the smallest distance of the switch parameter from its neutral value (in its
+    /// unit) at which this session would have named the effect, linearised at the fit: the larger of
+    /// `min_param_z` standard errors and the size whose change of the trajectories, after the other
+    /// parameters are refitted, has an RMS equal to the floor. `None` when the parameter is not determined
+    /// or the candidate frees more than one parameter of its own (Hunt–Crossley).
+    #[serde(default)]
+    pub detection_limit: Option<f64>,
+    /// False when the candidate was not cross-validated: its fit to all shots already failed the BIC check,
+    /// so it could be neither named nor said to explain part (the folds would cost six fits and decide
+    /// nothing); its held-out test then counts as failed.
+    #[serde(default = "yes")]
+    pub cross_validated: bool,
     /// The fit with the candidate (every parameter, base ones refitted too, with intervals).
     pub fit: FitSummary,
 }
@@ -220,12 +239,33 @@ pub struct Thresholds {
     pub min_delta_bic: f64,
     /// Least parameter distance from neutral, standard errors.
     pub min_param_z: f64,
-    /// Systematic residual tolerated, m.
+    /// Systematic residual tolerated, m: the session's floor ([`Diagnosis::floor`]).
     pub tolerance_m: f64,
     /// Systematic residual tolerated per phase and component, m.
     pub phase_tolerance_m: f64,
     /// Least fraction of the systematic error a named candidate removes.
     pub explained_fraction: f64,
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// The measurement floor: the systematic residual below which a misfit is "no missing effect", learned
+/// from the session's free flight (see `docs/diagnosis.md`).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct Floor {
+    /// The floor the decisions use, m: `flight_systematic_m` and `contact_allowance_m` in quadrature.
+    pub floor_m: f64,
+    /// Systematic part of the flight residuals after each arc's own fit (exact physics), pooled over every
+    /// shot, m: the tracker's own structure; `None` when no arc was long enough or the floor was given.
+    pub flight_systematic_m: Option<f64>,
+    /// The tracker's extra error in contact, which the flight cannot show (the option `tolerance_m`), m.
+    pub contact_allowance_m: f64,
+    /// Per shot (input order): the systematic part of its flight residuals, m (`None`: no arc long enough).
+    pub per_shot_m: Vec<Option<f64>>,
+    /// Flight frames measured.
+    pub flight_frames: usize,
 }
 
 /// Everything the search found; `diagnosis.json` is its serde serialisation.
@@ -241,6 +281,9 @@ pub struct Diagnosis {
     pub signature: Signature,
     /// The noise level.
     pub noise: Noise,
+    /// The measurement floor the decisions used.
+    #[serde(default)]
+    pub floor: Floor,
     /// Shots used.
     pub shots: usize,
     /// Folds of the cross-validation.
@@ -251,6 +294,12 @@ pub struct Diagnosis {
     /// when one removes a material part of it).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub proposal: Option<crate::TermProposal>,
+    /// The search continued from the model with the first effect added (at its fitted values), when that
+    /// effect left a systematic misfit above the floor or explained only part of it: the second search's
+    /// diagnosis. The verdict's `effects` then lists both (`[a, b]`), each with its evidence in its own
+    /// search's candidates.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub then: Option<Box<Diagnosis>>,
     /// Wall time of the search, s.
     pub seconds: f64,
 }

@@ -6,8 +6,8 @@
 //! neither, and the sums and summaries the search compares.
 
 use bouncelab_fit::{
-    FitError, LeastSquares, LevenbergMarquardt, MeasuredShot, NoObserver, Problem, SolverOutcome, Termination,
-    normal_inverse, profile_surface_level, surface_prior, weighted_residuals,
+    FitError, LeastSquares, LevenbergMarquardt, MeasuredShot, NoObserver, Observer, Problem, SolverOutcome,
+    Termination, identified_inverse, profile_surface_level, surface_prior, weighted_residuals,
 };
 use bouncelab_model::{Model, ModelSpec, SimOptions, Simulation};
 use nalgebra::{DMatrix, DVector};
@@ -240,6 +240,16 @@ impl Evaluator {
     pub fn fit(&self, solver: &LevenbergMarquardt, p0: &[f64]) -> Result<SolverOutcome, FitError> {
         solver.run(self, p0, &mut NoObserver)
     }
+
+    /// [`Evaluator::fit`], reporting every solver iteration to `observer` (on the calling thread).
+    pub fn fit_observed(
+        &self,
+        solver: &LevenbergMarquardt,
+        p0: &[f64],
+        observer: &mut dyn Observer,
+    ) -> Result<SolverOutcome, FitError> {
+        solver.run(self, p0, observer)
+    }
 }
 
 impl LeastSquares for Evaluator {
@@ -396,10 +406,12 @@ pub(crate) fn summarize(ev: &Evaluator, effects: Vec<String>, out: &SolverOutcom
     let t = StudentsT::new(0.0, 1.0, dof as f64)
         .map(|t| t.inverse_cdf(0.975))
         .unwrap_or(1.96);
+    // A parameter the shots do not determine (μ of a surface with only normal impacts) has no standard
+    // error; the others keep theirs.
     let cov = out
         .jacobian
         .as_ref()
-        .and_then(normal_inverse)
+        .and_then(|j| identified_inverse(j).0)
         .map(|c| c * chi2_red.max(1.0));
     let parameters = ev
         .problem

@@ -14,8 +14,12 @@
 //! (default 6 folds, each fit warm-started at the full fit), which costs a fixed number of refits however
 //! many shots a session has: leave-one-shot-out would cost one refit per shot per candidate.
 //!
-//! When none explains it, a formula term is looked for in a small library of normal forces in δ and δ̇
-//! (forward selection, each term fitted through the simulator: [`TermProposal`]).
+//! When none explains it, a formula term is looked for in a small library of forces in δ, δ̇, the slip and
+//! the contact's history (the patch's tangential displacement u_t, ∫δ dt) (forward selection, each term
+//! fitted through the simulator: [`TermProposal`]). The thresholds are measured against a floor learned
+//! from the session's free flight ([`Floor`]). When the named effect leaves a misfit above the floor, or one
+//! explains only part of it, the search goes on from the model with it and may name a second
+//! ([`Diagnosis::then`]).
 //!
 //! [`find_missing_effect`] returns a [`Diagnosis`] (`diagnosis.json`); [`add_effect_to_model_toml`] adds the
 //! named effect to the user's `model.toml`, comments kept. See `docs/diagnosis.md`.
@@ -24,6 +28,7 @@ mod candidates;
 mod diagnosis;
 mod error;
 mod evaluate;
+mod floor;
 mod model_file;
 mod options;
 mod proposal;
@@ -33,7 +38,7 @@ mod verdict;
 
 pub use candidates::CandidateSetup;
 pub use diagnosis::{
-    Baseline, Candidate, Checks, Diagnosis, Evidence, Noise, NoiseSource, PhaseResidual, Signature, Thresholds,
+    Baseline, Candidate, Checks, Diagnosis, Evidence, Floor, Noise, NoiseSource, PhaseResidual, Signature, Thresholds,
     Verdict, VerdictKind,
 };
 pub use error::DiagnoseError;

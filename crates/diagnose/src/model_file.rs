@@ -144,7 +144,7 @@ mod tests {
                 .unwrap_or_else(|| panic!("lost line {line:?} in\n{out}"));
             rest = &rest[at + line.len()..];
         }
-        assert!(out.contains("# 0.5 is a typical felt-on-court figure"), "{out}");
+        assert!(out.contains("# Friction differs between surfaces"), "{out}");
         let hc = out.find("[effects.hunt_crossley]").unwrap();
         assert!(
             hc > out.find("[effects.coulomb]").unwrap() && hc < out.find("[surfaces.clay]").unwrap(),

@@ -29,13 +29,17 @@ pub struct SearchOptions {
     /// Least distance of the candidate's switch parameter from its neutral value, in standard errors
     /// (default 4).
     pub min_param_z: f64,
-    /// Systematic residual the search does not try to explain, m (default 8e-6, 0.02 px at 4e-4 m/px).
-    /// Tracked positions carry systematic errors: the flattened ball in contact (about 0.05 px there, which
-    /// is about 4 µm over a whole trajectory), the start state taken from a ballistic fit. A model whose
-    /// residual RMS exceeds the noise by less than this (in quadrature) fits; a candidate must remove at
-    /// least this much held-out error; two candidates whose held-out errors differ by less than this
-    /// cannot be told apart. Raise it when the tracking or the start states are worse.
+    /// The tracker's extra systematic error in contact, m (default 8e-6, 0.02 px at 4e-4 m/px), which the
+    /// free flight cannot show: the ball flattened and partly hidden by the surface (about 5–9 µm per phase
+    /// and component on a clean rendered session, against 2–3 µm in the incoming flight). With
+    /// [`SearchOptions::learn_floor`] the floor is the flight's measured structure and this in quadrature;
+    /// without, this is the floor. A model whose systematic residual is within the floor fits; a candidate
+    /// must remove at least the floor of held-out error; two candidates whose held-out errors differ by less
+    /// cannot be told apart. Raise it when the tracking in contact is worse.
     pub tolerance_m: f64,
+    /// Learn the floor from the session's free flight (default true): see `docs/diagnosis.md` and
+    /// [`Floor`](crate::Floor).
+    pub learn_floor: bool,
     /// Systematic residual allowed in one phase and component, m (default 30e-6, 0.075 px): above it the
     /// current model misfits there even if the total is within [`SearchOptions::tolerance_m`] (a
     /// 0.05 px tracking error in contact stays below it).
@@ -73,10 +77,15 @@ pub struct SearchOptions {
     /// Integration settings of every simulation.
     pub sim: SimOptions,
     /// When no library effect explains a misfit, look for a formula term that does (default true): forward
-    /// selection over a small library of normal-force terms in δ and δ̇ ([`TermProposal`](crate::TermProposal)),
+    /// selection over a small library of force terms in δ, δ̇, the slip and the contact's history
+    /// ([`TermProposal`](crate::TermProposal)),
     /// each fitted and judged by held-out error like a candidate. Costs one candidate's fit per term tried
-    /// (10 for the first term, 9 for a second).
+    /// (14 for the first term, 13 for a second).
     pub propose_terms: bool,
+    /// Most effects one diagnosis names one after the other (default 2): when the first leaves a systematic
+    /// misfit above the floor, or explains only part of it, the search goes on from the model with it.
+    /// 1 stops after the first.
+    pub max_effects: usize,
 }
 
 impl Default for SearchOptions {
@@ -90,6 +99,7 @@ impl Default for SearchOptions {
             min_delta_bic: 10.0,
             min_param_z: 4.0,
             tolerance_m: 8e-6,
+            learn_floor: true,
             phase_tolerance_m: 30e-6,
             explained_fraction: 0.9,
             noise_m: None,
@@ -104,6 +114,7 @@ impl Default for SearchOptions {
             fold_max_iterations: 15,
             sim: SimOptions::default(),
             propose_terms: true,
+            max_effects: 2,
         }
     }
 }
@@ -126,6 +137,9 @@ impl SearchOptions {
                 format!("{} (solver: {})", self.fold_max_iterations, self.solver.max_iterations),
                 "at least 1 iteration",
             );
+        }
+        if self.max_effects == 0 {
+            return bad("max_effects", self.max_effects.to_string(), "at least 1");
         }
         if self.min_shots < 3 {
             return bad("min_shots", self.min_shots.to_string(), "at least 3");
@@ -161,8 +175,8 @@ impl SearchOptions {
     }
 }
 
-/// What the search is doing, reported before each fit of a model and at the end: a progress bar shows
-/// `done / total` and `what`.
+/// What the search is doing, reported before each fit of a model, after every solver iteration of each fit
+/// to all shots (`iteration`, `chi2_red`), and at the end: a progress bar shows `done / total` and `what`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Progress {
     /// Models fitted so far (each with its cross-validation).
@@ -171,4 +185,11 @@ pub struct Progress {
     pub total: usize,
     /// What comes next: "current model", "+ hertz", or "done".
     pub what: String,
+    /// The solver iteration just finished in the fit of `what` to all shots (0 is its start); `None` when
+    /// the call announces the model rather than an iteration.
+    #[serde(default)]
+    pub iteration: Option<usize>,
+    /// The reduced χ² (χ²/ν against the tracker's σ) at that iteration.
+    #[serde(default)]
+    pub chi2_red: Option<f64>,
 }

@@ -1,5 +1,5 @@
 //! A formula term proposed for a residual that no library effect explains: forward selection over a small
-//! library of force terms in δ, δ̇ and the slip, each acting in one contact phase with one free coefficient.
+//! library of force terms in δ, δ̇, the slip and the contact's history (u_t, ∫δ dt), each acting in one contact phase with one free coefficient.
 //!
 //! This is the sparse regression of SINDy done on trajectories: SINDy regresses a derivative on a library
 //! of terms, but the second derivative of a tracked position at 10 kHz is all noise (0.02 px of jitter is
@@ -97,6 +97,21 @@ const TERMS: &[TermShape] = &[
         formula: "c * v_t",
         start: -0.1,
     },
+    // State-carrying terms: the contact patch's tangential displacement u_t = ∫ slip dt since touch (a
+    // tangential spring −u_t/λ; with `c * slip` chosen beside it, a damped one), and the normal history
+    // ∫ δ dt (a force that remembers how long and how deep the ball pressed).
+    TermShape {
+        target: "tangential",
+        phase: "contact",
+        formula: "c * u_t",
+        start: -1e3,
+    },
+    TermShape {
+        target: "normal",
+        phase: "restitution",
+        formula: "c * delta_int",
+        start: -1e4,
+    },
 ];
 
 /// Most terms a proposal holds.
@@ -178,7 +193,7 @@ pub(crate) fn sentence(p: &TermProposal) -> String {
         })
         .collect();
     format!(
-        "Of {} formula terms in δ, δ̇ and the slip tried as an extra force, {} lower{} the held-out error from {:.1} µm to {:.1} µm (systematic part {:.1} → {:.1} µm); to try {}, add the `custom` section{} of `diagnosis.json`'s `proposal.model_toml` to model.toml and analyse again.",
+        "Of {} formula terms in δ, δ̇, the slip and the contact's history tried as an extra force, {} lower{} the held-out error from {:.1} µm to {:.1} µm (systematic part {:.1} → {:.1} µm); to try {}, add the `custom` section{} of `diagnosis.json`'s `proposal.model_toml` to model.toml and analyse again.",
         p.library_size,
         terms.join(" and "),
         if p.terms.len() == 1 { "s" } else { "" },

@@ -4,7 +4,7 @@
 use crate::VerdictKind;
 use crate::candidates::{CandidateSetup, candidate_names, library_effect, set_values, with_candidate};
 use crate::diagnosis::{
-    Baseline, Candidate, Checks, Diagnosis, Evidence, Noise, NoiseSource, PhaseResidual, Signature, Thresholds,
+    Baseline, Candidate, Checks, Diagnosis, Evidence, Floor, Noise, NoiseSource, PhaseResidual, Signature, Thresholds,
 };
 use crate::evaluate::{Evaluator, ShotSums, summarize};
 use crate::options::{Progress, SearchOptions};
@@ -12,7 +12,7 @@ use crate::proposal::{self, ProposedTerm, TermProposal};
 use crate::verdict::decide;
 use crate::{DiagnoseError, FitSummary, stats};
 use bouncelab_compare::{Component, DiagnoseOptions, ShotExtras, compare, diagnose};
-use bouncelab_fit::{FitError, LevenbergMarquardt, MeasuredShot, SolverOutcome};
+use bouncelab_fit::{FitError, Iteration, LevenbergMarquardt, MeasuredShot, Observer, SolverOutcome};
 use bouncelab_model::{ModelSpec, Simulation};
 use rayon::prelude::*;
 use std::time::Instant;
@@ -24,6 +24,8 @@ struct ModelRun {
     per_shot: Vec<ShotSums>,
     /// Per shot (input order): its residual sums when predicted by the model fitted without its fold.
     heldout: Vec<Option<ShotSums>>,
+    /// False when its BIC fall was too small for the folds to decide anything (`heldout` is then empty).
+    cross_validated: bool,
     n_params: usize,
     /// Each shot's surface level at the full fit, m (with surface levels).
     levels: Option<Vec<f64>>,
@@ -32,6 +34,83 @@ struct ModelRun {
 
 fn effect_names(spec: &ModelSpec) -> Vec<String> {
     spec.effects.iter().map(|e| e.name.clone()).collect()
+}
+
+/// Factors of a candidate's start the search tries: its response need not be monotone in its switch
+/// parameter, nor separable from the others (a tangential spring's slip reversal moves with the stiffness
+/// and with μ: fitted from a start a factor 3 stiffer than the truth, it stops at 58 µm instead of the
+/// noise). So the starts are ranked on a log grid spanning 1000× (one simulation of every shot each), and
+/// a candidate whose fit removes at least half of the current model's systematic mean square but leaves
+/// more than the floor is fitted again from the next best start (at most [`MAX_STARTS`] fits in all).
+const SCAN_FACTORS: [f64; 7] = [1.0 / 30.0, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0];
+
+/// Most fits of one candidate from different starts.
+const MAX_STARTS: usize = 2;
+
+/// How a candidate's switch parameter is started: scanned on a grid, and fitted again from the next start
+/// while the fit leaves a systematic residual above `floor_m` (over the noise `noise_m`).
+struct Scan<'a> {
+    name: &'a str,
+    noise_m: f64,
+    floor_m: f64,
+    /// The current model's systematic residual, m.
+    base_systematic_m: f64,
+}
+
+/// `p0` with the parameter `name` set to each value of `p0[name] × SCAN_FACTORS` (within its bounds), best
+/// (lowest χ²) first, at most `n`; just `p0` when it is not free or every simulation fails.
+fn scan_starts(ev: &Evaluator, name: &str, p0: &[f64], n: usize) -> Vec<Vec<f64>> {
+    let Some(j) = ev.names().iter().position(|x| x == name) else {
+        return vec![p0.to_vec()];
+    };
+    let fp = &ev.problem().params()[j];
+    let mut tried: Vec<(f64, Vec<f64>)> = SCAN_FACTORS
+        .iter()
+        .filter_map(|f| {
+            let mut theta = p0.to_vec();
+            theta[j] = (p0[j] * f).clamp(fp.min, fp.max);
+            let sims = ev.simulate(&theta).ok()?;
+            let chi2: f64 = ev.per_shot(&sims).iter().map(|s| s.chi2).sum();
+            chi2.is_finite().then_some((chi2, theta))
+        })
+        .collect();
+    if tried.is_empty() {
+        return vec![p0.to_vec()];
+    }
+    tried.sort_by(|a, b| a.0.total_cmp(&b.0));
+    tried.dedup_by(|a, b| a.1 == b.1);
+    tried.into_iter().take(n).map(|(_, t)| t).collect()
+}
+
+/// Where a model's fit starts and what it reports.
+struct Start<'a> {
+    /// Each shot's surface level to start from (the current model's, for a candidate).
+    seed: Option<&'a [f64]>,
+    /// A candidate's switch parameter to scan for its start.
+    scan: Option<&'a Scan<'a>>,
+    /// Called with every solver iteration of the fit to all shots and its reduced χ².
+    on_iteration: &'a dyn Fn(usize, f64),
+    /// Cross-validate only when the fit to all shots lowers BIC enough to count (a candidate that fails
+    /// the BIC check can be neither named nor said to explain part, so its folds would decide nothing).
+    gate: Option<BicGate>,
+}
+
+/// The current model's χ², parameter count and residual count, and the least BIC fall that counts.
+#[derive(Clone, Copy)]
+struct BicGate {
+    chi2: f64,
+    n_params: usize,
+    n_res: f64,
+    min_delta_bic: f64,
+}
+
+impl BicGate {
+    /// ΔBIC of a fit with χ² `chi2` and `n_params` parameters against the current model.
+    fn delta_bic(&self, chi2: f64, n_params: usize) -> f64 {
+        let tiny = f64::MIN_POSITIVE;
+        self.n_res * (chi2.max(tiny) / self.chi2.max(tiny)).ln()
+            + (n_params as f64 - self.n_params as f64) * self.n_res.ln()
+    }
 }
 
 /// Fits `spec` to every shot from the file's values, then once per fold without that fold's shots
@@ -46,25 +125,74 @@ fn run_model(
     fold_of: &[usize],
     k: usize,
     opts: &SearchOptions,
-    seed: Option<&[f64]>,
+    how: Start<'_>,
 ) -> Result<ModelRun, FitError> {
+    let Start {
+        seed,
+        scan,
+        on_iteration,
+        gate,
+    } = how;
     let clock = Instant::now();
     let mut ev = Evaluator::new(spec, shots.to_vec(), opts.sim, opts.surface_levels)?;
-    let out = match ev.levels() {
-        None => ev.fit(&opts.solver, &ev.problem().initial())?,
-        Some(zero) => fit_with_levels(&mut ev, seed.unwrap_or(&zero), opts)?,
+    let dof = ev
+        .problem()
+        .n_residuals()
+        .saturating_sub(ev.problem().params().len() + ev.nuisance_per_shot() * shots.len())
+        .max(1) as f64;
+    let mut observer = |it: &Iteration<'_>| on_iteration(it.iteration, it.cost / dof);
+    let p0 = ev.problem().initial();
+    let starts = match scan {
+        Some(sc) => {
+            if let Some(levels) = seed {
+                ev.set_levels(levels, false);
+            }
+            scan_starts(&ev, sc.name, &p0, MAX_STARTS)
+        }
+        None => vec![p0],
     };
+    let zero = ev.levels();
+    let mut fit_from = |ev: &mut Evaluator, start: &[f64]| -> Result<(SolverOutcome, f64), FitError> {
+        let out = match &zero {
+            None => ev.fit_observed(&opts.solver, start, &mut observer)?,
+            Some(zero) => fit_with_levels(ev, seed.unwrap_or(zero), start, opts, &mut observer)?,
+        };
+        let sims = ev.simulate(&out.params)?;
+        let (sq, n) = ev
+            .per_shot(&sims)
+            .iter()
+            .fold((0.0, 0usize), |(a, n), s| (a + s.sq_m2, n + s.n));
+        Ok((out, excess(sq / n.max(1) as f64, scan.map_or(0.0, |sc| sc.noise_m))))
+    };
+    let (mut out, mut systematic) = fit_from(&mut ev, &starts[0])?;
+    for start in &starts[1..] {
+        let promising = |sc: &Scan<'_>| systematic > sc.floor_m && systematic < sc.base_systematic_m / 2f64.sqrt();
+        if !scan.is_some_and(promising) {
+            break;
+        }
+        let (next, s) = fit_from(&mut ev, start)?;
+        if next.cost < out.cost {
+            (out, systematic) = (next, s);
+        }
+    }
+    // (With profiled levels, this also leaves them at the kept fit's optimum.)
     let sims = ev.simulate(&out.params)?;
     let per_shot = ev.per_shot(&sims);
     let sq: f64 = per_shot.iter().map(|s| s.sq_m2).sum();
     let summary = summarize(&ev, effect_names(spec), &out, sq);
     let fitted: Vec<(String, f64)> = ev.names().into_iter().zip(out.params.iter().copied()).collect();
     let levels = ev.levels();
+    let n_params = out.params.len() + ev.nuisance_per_shot() * shots.len();
+    let cross_validated = gate.is_none_or(|g| g.delta_bic(out.cost, n_params) <= -g.min_delta_bic);
     // Folds in parallel (each fit also simulates its shots in parallel); collected in fold order.
-    let per_fold: Vec<Vec<(usize, Option<ShotSums>)>> = (0..k)
-        .into_par_iter()
-        .map(|f| heldout_fold(spec, shots, fold_of, f, &fitted, levels.as_deref(), opts))
-        .collect();
+    let per_fold: Vec<Vec<(usize, Option<ShotSums>)>> = if cross_validated {
+        (0..k)
+            .into_par_iter()
+            .map(|f| heldout_fold(spec, shots, fold_of, f, &fitted, levels.as_deref(), opts))
+            .collect()
+    } else {
+        Vec::new()
+    };
     let mut heldout = vec![None; shots.len()];
     for (i, sums) in per_fold.into_iter().flatten() {
         heldout[i] = sums;
@@ -74,7 +202,8 @@ fn run_model(
         sims,
         per_shot,
         heldout,
-        n_params: out.params.len() + ev.nuisance_per_shot() * shots.len(),
+        cross_validated,
+        n_params,
         levels,
         seconds: clock.elapsed().as_secs_f64(),
     })
@@ -91,12 +220,18 @@ fn run_model(
 /// problem), warm-started where the rounds ended; from a cold start that fit took eight times longer on
 /// the benchmark (the profiled levels make the Jacobian noisy and the fit long). Every model starts from
 /// the same levels, so all are compared alike. Leaves `ev` profiling from the final levels.
-fn fit_with_levels(ev: &mut Evaluator, start: &[f64], opts: &SearchOptions) -> Result<SolverOutcome, FitError> {
+fn fit_with_levels(
+    ev: &mut Evaluator,
+    start: &[f64],
+    p0: &[f64],
+    opts: &SearchOptions,
+    observer: &mut dyn Observer,
+) -> Result<SolverOutcome, FitError> {
     let mut levels = start.to_vec();
-    let mut p = ev.problem().initial();
+    let mut p = p0.to_vec();
     for _ in 0..4 {
         ev.set_levels(&levels, false);
-        let out = ev.fit(&opts.solver, &p)?;
+        let out = ev.fit_observed(&opts.solver, &p, observer)?;
         p.clone_from(&out.params);
         ev.set_levels(&levels, true);
         ev.simulate(&p)?;
@@ -117,7 +252,7 @@ fn fit_with_levels(ev: &mut Evaluator, start: &[f64], opts: &SearchOptions) -> R
         ftol: opts.solver.ftol.max(1e-5),
         ..opts.solver
     };
-    let mut joint = ev.fit(&solver, &p)?;
+    let mut joint = ev.fit_observed(&solver, &p, observer)?;
     // The solver's last evaluation may have been a rejected step: profile the levels at the result.
     ev.simulate(&joint.params)?;
     // Its Jacobian went through the profiled levels; the standard errors come from the smooth one.
@@ -216,8 +351,35 @@ pub fn find_missing_effect_with(
         done: 0,
         total,
         what: "current model".into(),
+        iteration: None,
+        chi2_red: None,
     });
-    let base = run_model(spec, shots, &fold_of, k, options, None).map_err(|e| DiagnoseError::Baseline {
+    let iterations = |done: usize, what: &str| {
+        let what = what.to_string();
+        move |i: usize, chi2_red: f64| {
+            progress(Progress {
+                done,
+                total,
+                what: what.clone(),
+                iteration: Some(i),
+                chi2_red: Some(chi2_red),
+            })
+        }
+    };
+    let base = run_model(
+        spec,
+        shots,
+        &fold_of,
+        k,
+        options,
+        Start {
+            seed: None,
+            scan: None,
+            on_iteration: &iterations(0, "current model"),
+            gate: None,
+        },
+    )
+    .map_err(|e| DiagnoseError::Baseline {
         model: spec.origin.clone(),
         source: Box::new(e),
     })?;
@@ -254,6 +416,21 @@ pub fn find_missing_effect_with(
         source,
         stated_sigma_m: stated,
         ratio: noise_m / stated,
+    };
+    let given = options;
+    // The floor the decisions are measured against; from here on `options` carries it as the tolerance.
+    let floor = if options.learn_floor {
+        crate::floor::learn(shots, &base.sims, noise_m, options.tolerance_m)
+    } else {
+        Floor {
+            floor_m: options.tolerance_m,
+            contact_allowance_m: options.tolerance_m,
+            ..Floor::default()
+        }
+    };
+    let options = &SearchOptions {
+        tolerance_m: floor.floor_m,
+        ..options.clone()
     };
 
     // The signature of the current model's residual.
@@ -304,6 +481,12 @@ pub fn find_missing_effect_with(
         seconds: base.seconds,
     };
 
+    let gate = BicGate {
+        chi2: base.summary.chi2,
+        n_params: base.n_params,
+        n_res: base.per_shot.iter().map(|s| s.n).sum::<usize>() as f64,
+        min_delta_bic: options.min_delta_bic,
+    };
     // Every candidate, started from the current model's fitted values.
     let mut warm = spec.clone();
     set_values(&mut warm, &base.summary.parameters);
@@ -313,11 +496,33 @@ pub fn find_missing_effect_with(
             done: j + 1,
             total,
             what: format!("+ {}", setup.effect),
+            iteration: None,
+            chi2_red: None,
         });
         let run = with_candidate(&warm, &setup)
             .map_err(|e| e.to_string())
             .and_then(|cspec| {
-                run_model(&cspec, shots, &fold_of, k, options, base.levels.as_deref()).map_err(|e| e.to_string())
+                let primary = setup.primary().map(|p| format!("{}.{p}", setup.effect));
+                let scan = primary.as_deref().map(|name| Scan {
+                    name,
+                    noise_m,
+                    floor_m: options.tolerance_m,
+                    base_systematic_m: excess(base.summary.rms_m.powi(2), noise_m),
+                });
+                run_model(
+                    &cspec,
+                    shots,
+                    &fold_of,
+                    k,
+                    options,
+                    Start {
+                        seed: base.levels.as_deref(),
+                        scan: scan.as_ref(),
+                        on_iteration: &iterations(j + 1, &format!("+ {}", setup.effect)),
+                        gate: Some(gate),
+                    },
+                )
+                .map_err(|e| e.to_string())
             });
         runs.push((setup, run));
     }
@@ -325,14 +530,14 @@ pub fn find_missing_effect_with(
     let n_res = base.per_shot.iter().map(|s| s.n).sum::<usize>() as f64;
     let mut candidates: Vec<Candidate> = runs
         .iter()
-        .map(|(setup, run)| evidence_of(setup, run, &base, n_res, noise_m, options))
+        .map(|(setup, run)| evidence_of(setup, run, &base, n_res, noise_m, stated, options))
         .collect();
     // Holm over the candidates that have a held-out test.
     let ps: Vec<f64> = candidates
         .iter()
         .map(|c| c.evidence.as_ref().map(|e| e.heldout_p).unwrap_or(1.0))
         .collect();
-    for (c, p) in candidates.iter_mut().zip(stats::holm(&ps)) {
+    for (c, p) in candidates.iter_mut().zip(bouncelab_stats::holm(&ps)) {
         if let Some(e) = c.evidence.as_mut() {
             e.heldout_p_holm = p;
         }
@@ -347,6 +552,7 @@ pub fn find_missing_effect_with(
     let verdict_inputs = crate::verdict::Inputs {
         options,
         noise_m,
+        floor: &floor,
         baseline,
         signature,
         heldout_chi2: heldout_pairs,
@@ -359,7 +565,93 @@ pub fn find_missing_effect_with(
             .collect(),
     };
     let (mut verdict, baseline, signature) = decide(&mut candidates, verdict_inputs);
-    let proposal = if options.propose_terms && verdict.kind == VerdictKind::NoneExplains {
+
+    // A second effect: when the named one leaves a systematic held-out error above the floor, or none is
+    // named but one explains part of the misfit, the search goes on from the model with it at its fitted
+    // values.
+    let first = match verdict.kind {
+        VerdictKind::MissingEffect => candidates.first().filter(|c| {
+            c.evidence
+                .as_ref()
+                .is_some_and(|e| excess(e.heldout_error_after.powi(2), noise_m) > options.tolerance_m)
+        }),
+        VerdictKind::NoneExplains => candidates.iter().find(|c| c.partly_explains),
+        _ => None,
+    };
+    let then = match first {
+        Some(c) if given.max_effects > 1 => {
+            let next = then_from(&warm, c, &runs).and_then(|spec| {
+                // The second search only names (a term proposal, if any, comes from this one).
+                let o = SearchOptions {
+                    max_effects: given.max_effects - 1,
+                    propose_terms: false,
+                    ..given.clone()
+                };
+                find_missing_effect_with(&spec, shots, extras, &o, progress).map_err(|e| e.to_string())
+            });
+            Some((
+                c.effect.clone(),
+                c.evidence.as_ref().map(|e| e.systematic_after_m),
+                next,
+            ))
+        }
+        _ => None,
+    };
+    let mut went_on = false;
+    let then = match then {
+        Some((a, left, Ok(next))) => {
+            let named_next = matches!(next.verdict.kind, VerdictKind::MissingEffect | VerdictKind::Ambiguous);
+            // `a` stays only if the second search's current model (with it) still holds its switch
+            // parameter clearly away from neutral.
+            let keeps = first.is_some_and(|c| {
+                next.baseline
+                    .fit
+                    .parameters
+                    .iter()
+                    .find(|p| p.effect == c.effect && p.param == c.param)
+                    .and_then(|p| p.std_error.map(|se| (p.value - c.neutral).abs() / se))
+                    .is_some_and(|z| z >= options.min_param_z)
+            });
+            if keeps && (named_next || next.verdict.kind == VerdictKind::NoMissingEffect) {
+                went_on = true;
+                verdict.sentence = format!(
+                    "{} With `{a}` added (systematic residual {} left), the search went on: {}",
+                    verdict.sentence,
+                    left.map(|m| format!("{:.1} µm", m * 1e6)).unwrap_or_else(|| "-".into()),
+                    next.verdict.sentence
+                );
+                // `a` and what the second search named (if anything) together explain the data.
+                let mut effects = vec![a.clone()];
+                effects.extend(next.verdict.effects.iter().cloned());
+                verdict.kind = if next.verdict.kind == VerdictKind::Ambiguous {
+                    VerdictKind::Ambiguous
+                } else {
+                    VerdictKind::MissingEffect
+                };
+                verdict.effect = Some(a);
+                verdict.effects = effects;
+            } else {
+                let so = if verdict.kind == VerdictKind::MissingEffect {
+                    String::new()
+                } else {
+                    format!(", so `{a}` is not named")
+                };
+                verdict.sentence = format!(
+                    "{} Going on from the model with `{a}` named nothing more ({}){so}.",
+                    verdict.sentence,
+                    next.verdict.kind.name()
+                );
+            }
+            Some(Box::new(next))
+        }
+        Some((a, _, Err(why))) => {
+            verdict.sentence = format!("{} Going on from the model with `{a}` failed: {why}", verdict.sentence);
+            None
+        }
+        None => None,
+    };
+
+    let proposal = if options.propose_terms && verdict.kind == VerdictKind::NoneExplains && !went_on {
         let levels = base.levels.as_deref();
         let search = TermSearch {
             shots,
@@ -382,6 +674,8 @@ pub fn find_missing_effect_with(
         done: total,
         total,
         what: "done".into(),
+        iteration: None,
+        chi2_red: None,
     });
     Ok(Diagnosis {
         verdict,
@@ -389,6 +683,7 @@ pub fn find_missing_effect_with(
         baseline,
         signature,
         noise,
+        floor,
         shots: shots.len(),
         folds: k,
         thresholds: Thresholds {
@@ -400,8 +695,25 @@ pub fn find_missing_effect_with(
             explained_fraction: options.explained_fraction,
         },
         proposal,
+        then,
         seconds: clock.elapsed().as_secs_f64(),
     })
+}
+
+/// `spec` with candidate `c` added at its fitted values (free, so the next search refits them).
+fn then_from(
+    spec: &ModelSpec,
+    c: &Candidate,
+    runs: &[(CandidateSetup, Result<ModelRun, String>)],
+) -> Result<ModelSpec, String> {
+    let (setup, run) = runs
+        .iter()
+        .find(|(s, _)| s.effect == c.effect)
+        .ok_or_else(|| format!("no run of `{}`", c.effect))?;
+    let run = run.as_ref().map_err(Clone::clone)?;
+    let mut next = with_candidate(spec, setup).map_err(|e| e.to_string())?;
+    set_values(&mut next, &run.summary.parameters);
+    Ok(next)
 }
 
 /// What the term search needs of the missing-effect search.
@@ -440,11 +752,35 @@ impl TermSearch<'_> {
                     done: self.total.saturating_sub(1),
                     total: self.total,
                     what: format!("term {}/{}: {target} {formula} in {phase}", j + 1, tries.len()),
+                    iteration: None,
+                    chi2_red: None,
                 });
                 let run = with_term(&current, &name, i, start).and_then(|spec| {
-                    run_model(&spec, self.shots, self.fold_of, self.k, self.options, self.levels)
-                        .map(|run| (spec, run))
-                        .map_err(|e| e.to_string())
+                    let what = format!("term {target} {formula} in {phase}");
+                    let on_iteration = |i: usize, chi2_red: f64| {
+                        (self.progress)(Progress {
+                            done: self.total.saturating_sub(1),
+                            total: self.total,
+                            what: what.clone(),
+                            iteration: Some(i),
+                            chi2_red: Some(chi2_red),
+                        })
+                    };
+                    run_model(
+                        &spec,
+                        self.shots,
+                        self.fold_of,
+                        self.k,
+                        self.options,
+                        Start {
+                            seed: self.levels,
+                            scan: None,
+                            on_iteration: &on_iteration,
+                            gate: None,
+                        },
+                    )
+                    .map(|run| (spec, run))
+                    .map_err(|e| e.to_string())
                 });
                 let (spec, run) = match run {
                     Ok(r) => r,
@@ -573,6 +909,7 @@ fn evidence_of(
     base: &ModelRun,
     n_res: f64,
     noise_m: f64,
+    stated_sigma_m: f64,
     opts: &SearchOptions,
 ) -> Candidate {
     let param = setup.primary().unwrap_or("-").to_string();
@@ -585,6 +922,7 @@ fn evidence_of(
         effect: setup.effect.clone(),
         rank: 0,
         explains: false,
+        partly_explains: false,
         checks: Checks::default(),
         reasons: Vec::new(),
         error_before: base.summary.rms_m,
@@ -618,8 +956,15 @@ fn evidence_of(
         .map(|(a, b)| (a.chi2.max(tiny) / b.chi2.max(tiny)).ln())
         .collect();
     let (log_ratio, p) = stats::one_sided_t(&d);
-    let before_ho = rms_of(pairs.iter().map(|(a, _)| *a));
-    let after_ho = rms_of(pairs.iter().map(|(_, b)| *b));
+    // Without folds, the fit's own RMS stands in for the held-out error (its lower bound).
+    let (before_ho, after_ho) = if run.cross_validated {
+        (
+            rms_of(pairs.iter().map(|(a, _)| *a)),
+            rms_of(pairs.iter().map(|(_, b)| *b)),
+        )
+    } else {
+        (rms_of(base.heldout.iter().flatten()), run.summary.rms_m)
+    };
     cand.heldout_error_before = before_ho;
     let ms0 = before_ho * before_ho;
     let ms1 = after_ho * after_ho;
@@ -634,6 +979,21 @@ fn evidence_of(
     let param_z = primary
         .and_then(|p| p.std_error.map(|se| (p.value - neutral).abs() / se))
         .filter(|z| z.is_finite());
+    // With σ-weighted residuals, se = √c / ‖J⊥‖ (J⊥ the parameter's Jacobian column after the others'
+    // span is taken out, c the covariance scale), so a change Δ moves the positions by an RMS of about
+    // Δ·σ̄·‖J⊥‖/√n = Δ·σ̄·√c / (se·√n) once the other parameters have absorbed what they can.
+    // Only for a one-parameter candidate: with a second parameter of its own (Hunt–Crossley's exponent),
+    // that one is not determined near neutral and the switch's standard error says nothing there.
+    let own_params = setup.free.len();
+    let detection_limit = primary
+        .and_then(|p| p.std_error)
+        .filter(|_| own_params == 1)
+        .and_then(|se| {
+            let c = s.chi2_red.max(1.0);
+            let per_unit = stated_sigma_m * c.sqrt() / (se * n_res.sqrt());
+            let limit = (opts.min_param_z * se).max(opts.tolerance_m / per_unit);
+            limit.is_finite().then_some(limit)
+        });
     cand.evidence = Some(Evidence {
         error_after: s.rms_m,
         error_fall: base.summary.rms_m / s.rms_m,
@@ -650,6 +1010,8 @@ fn evidence_of(
         param_value: primary.map(|p| p.value).unwrap_or(neutral),
         param_interval: primary.and_then(|p| p.interval),
         param_z,
+        detection_limit,
+        cross_validated: run.cross_validated,
         fit: run.summary.clone(),
     });
     cand

@@ -1,5 +1,5 @@
-//! Small statistics: the white-noise level of residual series, a paired test across shots, Holm's
-//! correction, folds.
+//! Small statistics: the white-noise level of residual series, a paired test across shots, folds (Holm's
+//! correction is the stats crate's).
 
 use statrs::distribution::{ContinuousCDF, StudentsT};
 
@@ -56,21 +56,6 @@ pub(crate) fn one_sided_t(d: &[f64]) -> (f64, f64) {
     (mean, p)
 }
 
-/// Holm's step-down adjustment of `p` (same order as given).
-pub(crate) fn holm(p: &[f64]) -> Vec<f64> {
-    let m = p.len();
-    let mut order: Vec<usize> = (0..m).collect();
-    order.sort_by(|&a, &b| p[a].total_cmp(&p[b]).then(a.cmp(&b)));
-    let mut out = vec![1.0; m];
-    let mut running = 0.0f64;
-    for (rank, &i) in order.iter().enumerate() {
-        let adj = ((m - rank) as f64 * p[i]).min(1.0);
-        running = running.max(adj);
-        out[i] = running;
-    }
-    out
-}
-
 /// Assigns shots to `k` folds, round-robin within each surface (in the order the shots are given), so
 /// every fold holds some shots of every surface that has at least `k` shots.
 pub(crate) fn folds(surfaces: &[&str], k: usize) -> Vec<usize> {
@@ -97,16 +82,6 @@ pub(crate) fn folds(surfaces: &[&str], k: usize) -> Vec<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn holm_matches_a_hand_computed_case() {
-        let adj = holm(&[0.01, 0.04, 0.03, 0.005]);
-        // Sorted: 0.005·4 = 0.02, 0.01·3 = 0.03, 0.03·2 = 0.06, 0.04·1 = 0.04 → max-accumulated 0.06.
-        let want = [0.03, 0.06, 0.06, 0.02];
-        for (a, w) in adj.iter().zip(want) {
-            assert!((a - w).abs() < 1e-12, "{adj:?}");
-        }
-    }
 
     #[test]
     fn one_sided_t_of_a_clear_shift_is_small_and_of_noise_is_not() {

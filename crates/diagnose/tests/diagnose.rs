@@ -125,6 +125,76 @@ fn hidden_camera_roll_is_named() {
     assert_eq!(d.verdict.kind, VerdictKind::MissingEffect);
 }
 
+/// A compliant contact patch (the slip reverses): the library's `tangential_spring` is named with its
+/// compliance within 10 %, at two magnitudes a factor 3 apart, and removes ≥ 90 % of the systematic
+/// misfit.
+#[test]
+fn hidden_tangential_spring_is_named_with_its_compliance_at_two_magnitudes() {
+    for compliance in [1e-5, 3e-6] {
+        let shots = session(
+            &truth_at(Some("tangential_spring"), &[("compliance", compliance)]),
+            1,
+            Tracking::default(),
+        );
+        let d = run(
+            &format!("tangential_spring λ = {compliance:e}"),
+            &shots,
+            &SearchOptions::default(),
+        );
+        assert_eq!(d.verdict.kind, VerdictKind::MissingEffect, "{}", d.verdict.sentence);
+        assert_eq!(d.verdict.effect.as_deref(), Some("tangential_spring"));
+        let e = d.candidates[0].evidence.as_ref().unwrap();
+        let err = (e.param_value - compliance) / compliance;
+        eprintln!(
+            "λ = {compliance:e}: fitted {:.4e} ({:+.2} %), interval {:?}, explained {:.3}",
+            e.param_value,
+            err * 100.0,
+            e.param_interval,
+            e.explained_fraction
+        );
+        assert!(err.abs() < 0.1, "λ {} vs {compliance}", e.param_value);
+        assert!(e.explained_fraction >= 0.9, "{}", e.explained_fraction);
+    }
+}
+
+/// Two effects at once (Hertz's stiffness and rolling resistance): neither explains all of the misfit alone;
+/// the search names the one that explains most, goes on from the model with it and names the other, each
+/// with its magnitude within 10 %.
+#[test]
+fn two_hidden_effects_are_both_named() {
+    let shots = session(&truth_pair("hertz", "rolling_resistance"), 1, Tracking::default());
+    let d = run("hertz + rolling_resistance", &shots, &SearchOptions::default());
+    let mut named = d.verdict.effects.clone();
+    named.sort();
+    assert_eq!(d.verdict.kind, VerdictKind::MissingEffect, "{}", d.verdict.sentence);
+    assert_eq!(named, ["hertz", "rolling_resistance"], "{}", d.verdict.sentence);
+    let second = d.then.as_ref().expect("the search went on");
+    print("  then", second);
+    // Each magnitude, from the search that named it last (the second one refits the first too).
+    let fit = &second
+        .candidate(&second.verdict.effects[0])
+        .unwrap()
+        .evidence
+        .as_ref()
+        .unwrap()
+        .fit;
+    for (effect, param, truth) in [("hertz", "k_h", 400_000.0), ("rolling_resistance", "c_rr", 0.02)] {
+        let p = fit
+            .parameters
+            .iter()
+            .find(|p| p.effect == effect && p.param == param)
+            .unwrap_or_else(|| panic!("{effect}.{param} in {:?}", fit.parameters));
+        let err = (p.value - truth) / truth;
+        eprintln!(
+            "{effect}.{param} = {:.4e} ({:+.2} %), interval {:?}",
+            p.value,
+            err * 100.0,
+            p.interval
+        );
+        assert!(err.abs() < 0.1, "{effect}.{param} = {} vs {truth}", p.value);
+    }
+}
+
 #[test]
 fn no_hidden_effect_gives_no_missing_effect_on_three_seeds() {
     for seed in [1, 2, 3] {
@@ -143,12 +213,44 @@ fn no_hidden_effect_gives_no_missing_effect_on_three_seeds() {
             "{}",
             d.verdict.sentence
         );
+        // The floor is learned from the flight (white noise only here: little structure) and stated.
+        assert!(d.floor.flight_systematic_m.is_some() && d.floor.floor_m >= d.floor.contact_allowance_m);
+        assert!(d.verdict.sentence.contains("floor"), "{}", d.verdict.sentence);
+        // Detection limits: every candidate has one, stated in the verdict, and each hidden magnitude that
+        // the tests above name lies beyond its limit. Not drag's: its candidate re-measures every start
+        // under drag, so on clean shots it is not nested in the current model (its fit ends above it,
+        // 12.40 against 12.24 µm) and its linearised limit (≈ 3.2) overstates what the session shows (drag
+        // at 1.5 is named above). Known limit, in `docs/diagnosis.md`.
+        assert!(
+            d.verdict.sentence.contains("detection limits"),
+            "{}",
+            d.verdict.sentence
+        );
+        for (effect, set) in MAGNITUDES.iter().filter(|(e, _)| *e != "drag") {
+            let Some(c) = d.candidate(effect) else { continue };
+            let limit = c.evidence.as_ref().and_then(|e| e.detection_limit);
+            if set.len() > 1 {
+                // Two parameters of its own (Hunt–Crossley): no linear limit.
+                assert!(limit.is_none(), "{effect}: {limit:?}");
+                continue;
+            }
+            eprintln!(
+                "  detection limit {effect} {}: {limit:?} (named at {:?})",
+                c.param, set[0].1
+            );
+            let limit = limit.unwrap_or_else(|| panic!("{effect}: no detection limit"));
+            assert!(limit > 0.0 && limit < (set[0].1 - c.neutral).abs(), "{effect}: {limit}");
+        }
     }
 }
 
 fn invented(name: &str, body: &str, tracking: Tracking) -> Diagnosis {
+    invented_from(&base_spec(), name, body, tracking)
+}
+
+fn invented_from(spec: &ModelSpec, name: &str, body: &str, tracking: Tracking) -> Diagnosis {
     let shots = session(&truth_with_custom(name, body), 1, tracking);
-    let d = run(name, &shots, &SearchOptions::default());
+    let d = run_with(name, spec, &shots, &SearchOptions::default());
     assert_eq!(
         d.verdict.kind,
         VerdictKind::NoneExplains,
@@ -207,10 +309,17 @@ fn a_hidden_library_term_is_proposed_back() {
     assert!(p.systematic_after_m < 8e-6, "{p:?}");
 }
 
-/// Friction growing with the slip speed (a viscous tangential force on top of Coulomb's).
+/// Friction growing with the slip speed (a viscous tangential force on top of Coulomb's), against a model
+/// that knows μ. (With μ free per surface, as in the shipped model, these shots end rolling and μ takes the
+/// whole of it: the verdict is then `no_missing_effect`, systematic 3.7 µm.)
 #[test]
 fn invented_velocity_dependent_friction_is_not_given_a_library_name() {
-    let d = invented("viscous_slip", VISCOUS_SLIP_STRONG, Tracking::default());
+    let d = invented_from(
+        &known_mu_spec(),
+        "viscous_slip",
+        VISCOUS_SLIP_STRONG,
+        Tracking::default(),
+    );
     // It is a term of the library: −η·slip with η = 20 N·s/m.
     let p = d.proposal.as_ref().expect("a term proposed");
     let t = &p.terms[0];
@@ -370,14 +479,26 @@ fn the_same_shots_give_the_same_diagnosis() {
 fn progress_is_reported_for_every_model() {
     let shots = session(&truth(None), 6, Tracking::default());
     let seen = std::sync::Mutex::new(Vec::new());
-    find_missing_effect(&base_spec(), &shots, &quick_options(), &|p| {
-        seen.lock().unwrap().push((p.done, p.total, p.what))
+    let iterations = std::sync::Mutex::new(Vec::new());
+    find_missing_effect(&base_spec(), &shots, &quick_options(), &|p| match p.iteration {
+        Some(i) => iterations.lock().unwrap().push((p.done, p.what, i, p.chi2_red)),
+        None => seen.lock().unwrap().push((p.done, p.total, p.what)),
     })
     .unwrap();
     let seen = seen.into_inner().unwrap();
     let what: Vec<&str> = seen.iter().map(|s| s.2.as_str()).collect();
     assert_eq!(what, ["current model", "+ hunt_crossley", "+ drag", "done"]);
     assert!(seen.iter().all(|s| s.1 == 3) && seen.last().unwrap().0 == 3);
+    // Every model's fit to all shots reports its solver iterations, from 0, with a finite reduced χ².
+    let iterations = iterations.into_inner().unwrap();
+    for (done, model) in [(0, "current model"), (1, "+ hunt_crossley"), (2, "+ drag")] {
+        let its: Vec<_> = iterations.iter().filter(|x| x.1 == model).collect();
+        assert!(its.iter().any(|x| x.2 == 0) && its.len() >= 2, "{model}: {its:?}");
+        assert!(
+            its.iter().all(|x| x.0 == done && x.3.is_some_and(f64::is_finite)),
+            "{its:?}"
+        );
+    }
 }
 
 #[test]

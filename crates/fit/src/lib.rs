@@ -27,7 +27,10 @@ pub use measurement::{observe, observes, true_start};
 pub use params::FreeParam;
 pub use predict::{ForceSample, ImpactPrediction, fitted_model, predict_impact};
 pub use problem::{Problem, profile_surface_level, surface_prior, weighted_residuals};
-pub use result::{FitResult, FittedParam, ObliqueRow, ShotFit, SurfaceError, normal_inverse};
+pub use result::{
+    FitResult, FittedParam, MAX_RELATIVE_STD_ERROR, ObliqueRow, ShotFit, SurfaceError, identified_inverse,
+    normal_inverse,
+};
 pub use shot::{MeasuredFrame, MeasuredOutputs, MeasuredShot, StartState};
 pub use solver::{
     Iteration, LeastSquares, LevenbergMarquardt, LogObserver, NoObserver, Observer, SolverOutcome, Termination,

@@ -30,6 +30,13 @@ pub struct FittedParam {
     pub bounds: [f64; 2],
     /// True if the value ended on a bound (its interval then means little).
     pub at_bound: bool,
+    /// Why the shots do not determine this parameter, `None` when they do. Set when no residual depends on
+    /// it (Coulomb's μ with only normal impacts), when it moves the residuals only as other parameters do
+    /// (then it has no standard error, and the others' are computed with it held), or when it is a
+    /// magnitude (a range starting at ≥ 0) whose standard error exceeds half its value. Its `value` is
+    /// then where the solver left it, not a measurement.
+    #[serde(default)]
+    pub not_identified: Option<String>,
 }
 
 /// Per-shot goodness of fit and outputs.
@@ -148,6 +155,67 @@ impl FitResult {
     }
 }
 
+/// Largest relative standard error of a magnitude (a parameter whose range starts at ≥ 0) that still counts
+/// as determined: beyond it the 95 % interval spans from about zero to twice the value.
+pub const MAX_RELATIVE_STD_ERROR: f64 = 0.5;
+
+/// Smallest eigenvalue of the equilibrated `JᵀJ`, relative to its largest, of a determined set of
+/// parameters (below it a direction of the parameters moves no residual at the Jacobian's resolution).
+const MIN_EIGEN_RATIO: f64 = 1e-12;
+
+/// `(JᵀJ)⁻¹` over the parameters the residuals determine, and for each parameter `None` (determined) or why
+/// not. A parameter whose Jacobian column is zero, or that carries most of a direction of the parameters
+/// the residuals do not see (the smallest eigenvector of the equilibrated `JᵀJ`, dropped one at a time
+/// until the rest is well conditioned), is left out; the returned matrix is full size with its rows and
+/// columns NaN. `None` when no parameter is determined.
+pub fn identified_inverse(jac: &DMatrix<f64>) -> (Option<DMatrix<f64>>, Vec<Option<String>>) {
+    let p = jac.ncols();
+    let a = jac.transpose() * jac;
+    let mut why: Vec<Option<String>> = (0..p)
+        .map(|j| {
+            let d = a[(j, j)];
+            (!(d.is_finite() && d > 0.0)).then(|| "no residual depends on it".to_string())
+        })
+        .collect();
+    loop {
+        let keep: Vec<usize> = (0..p).filter(|&j| why[j].is_none()).collect();
+        if keep.is_empty() {
+            return (None, why);
+        }
+        let sub = DMatrix::from_fn(jac.nrows(), keep.len(), |i, k| jac[(i, keep[k])]);
+        if let Some(inv) = normal_inverse(&sub) {
+            let mut full = DMatrix::from_element(p, p, f64::NAN);
+            for (x, &i) in keep.iter().enumerate() {
+                for (y, &j) in keep.iter().enumerate() {
+                    full[(i, j)] = inv[(x, y)];
+                }
+            }
+            return (Some(full), why);
+        }
+        // The direction the residuals do not see: drop the parameter that carries most of it.
+        let sa = sub.transpose() * &sub;
+        let d: Vec<f64> = (0..keep.len()).map(|j| sa[(j, j)].sqrt()).collect();
+        let scaled = DMatrix::from_fn(keep.len(), keep.len(), |i, j| sa[(i, j)] / (d[i] * d[j]));
+        let eig = scaled.symmetric_eigen();
+        let Some(low) = (0..keep.len()).min_by(|&x, &y| eig.eigenvalues[x].total_cmp(&eig.eigenvalues[y])) else {
+            return (None, why);
+        };
+        let v = eig.eigenvectors.column(low);
+        let Some(worst) = (0..keep.len()).max_by(|&x, &y| v[x].abs().total_cmp(&v[y].abs())) else {
+            return (None, why);
+        };
+        let partners: Vec<String> = (0..keep.len())
+            .filter(|&k| k != worst && v[k].abs() > 0.1)
+            .map(|k| format!("#{}", keep[k]))
+            .collect();
+        why[keep[worst]] = Some(if partners.is_empty() {
+            "the residuals hardly depend on it".to_string()
+        } else {
+            format!("it moves the residuals only as parameters {} do", partners.join(", "))
+        });
+    }
+}
+
 /// Inverts `JᵀJ` (symmetric positive definite when the parameters are determined), equilibrated so the
 /// condition test is about the parameters' correlation; `None` when singular or ill-conditioned.
 pub fn normal_inverse(jac: &DMatrix<f64>) -> Option<DMatrix<f64>> {
@@ -163,7 +231,7 @@ pub fn normal_inverse(jac: &DMatrix<f64>) -> Option<DMatrix<f64>> {
         .eigenvalues
         .iter()
         .fold((f64::INFINITY, 0.0f64), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
-    if min.is_nan() || min <= 1e-12 * max {
+    if min.is_nan() || min <= MIN_EIGEN_RATIO * max {
         return None;
     }
     let inv = scaled.cholesky()?.inverse();
@@ -174,13 +242,27 @@ pub fn normal_inverse(jac: &DMatrix<f64>) -> Option<DMatrix<f64>> {
 
 /// The cluster-robust (sandwich) covariance with each shot a cluster: `(JᵀJ)⁻¹ (Σ_s J_sᵀ r_s r_sᵀ J_s) (JᵀJ)⁻¹`,
 /// times `S/(S − p)` for S shots; `None` with fewer than p + 2 shots, where it is not worth having.
+/// `why` with the parameter numbers `#j` of [`identified_inverse`] replaced by the parameters' names.
+fn name_partners(why: &str, problem: &Problem) -> String {
+    let mut s = why.to_string();
+    // Highest index first, so `#1` does not rewrite the start of `#12`.
+    for (j, fp) in problem.params().iter().enumerate().rev() {
+        s = s.replace(&format!("#{j}"), &fp.name);
+    }
+    s
+}
+
+/// The rows and columns of parameters that are not determined (NaN in `inv`) stay NaN.
 fn cluster_robust(inv: &DMatrix<f64>, out: &SolverOutcome, problem: &Problem) -> Option<DMatrix<f64>> {
     let jac = out.jacobian.as_ref()?;
+    let determined = (0..inv.nrows()).filter(|&j| inv[(j, j)].is_finite()).count();
     let p = inv.nrows();
     let shots = problem.shots();
-    if shots.len() < p + 2 || jac.nrows() != out.residuals.len() {
+    if shots.len() < determined + 2 || jac.nrows() != out.residuals.len() {
         return None;
     }
+    let nan_rows: Vec<bool> = (0..p).map(|j| !inv[(j, j)].is_finite()).collect();
+    let inv = inv.map(|v| if v.is_finite() { v } else { 0.0 });
     let mut meat = DMatrix::<f64>::zeros(p, p);
     let mut row = 0;
     for shot in shots {
@@ -195,7 +277,14 @@ fn cluster_robust(inv: &DMatrix<f64>, out: &SolverOutcome, problem: &Problem) ->
         row += n;
     }
     let s = shots.len() as f64;
-    Some(inv * meat * inv * (s / (s - p as f64)))
+    let robust = &inv * meat * &inv * (s / (s - determined as f64));
+    Some(DMatrix::from_fn(p, p, |i, j| {
+        if nan_rows[i] || nan_rows[j] {
+            f64::NAN
+        } else {
+            robust[(i, j)]
+        }
+    }))
 }
 
 pub(crate) fn build(
@@ -218,7 +307,11 @@ pub(crate) fn build(
     let t_quantile = StudentsT::new(0.0, 1.0, dof as f64)
         .map(|t| t.inverse_cdf(0.5 + confidence / 2.0))
         .unwrap_or(f64::NAN);
-    let cov = out.jacobian.as_ref().and_then(normal_inverse).map(|c| {
+    let (inverse, mut not_identified) = match out.jacobian.as_ref() {
+        Some(jac) => identified_inverse(jac),
+        None => (None, vec![None; p]),
+    };
+    let cov = inverse.map(|c| {
         let classical = &c * covariance_scale;
         match cluster_robust(&c, out, problem) {
             // Residuals within a shot share systematic errors (the track's bias in contact, the scale), so
@@ -238,6 +331,15 @@ pub(crate) fn build(
         .map(|(j, fp)| {
             let value = out.params[j];
             let se = cov.as_ref().map(|c| c[(j, j)].sqrt()).filter(|s| s.is_finite());
+            if let Some(s) = se
+                && fp.min >= 0.0
+                && s > MAX_RELATIVE_STD_ERROR * value.abs()
+            {
+                not_identified[j] = Some(format!(
+                    "its standard error {s:.3e} is more than {:.0} % of its value",
+                    MAX_RELATIVE_STD_ERROR * 100.0
+                ));
+            }
             FittedParam {
                 name: fp.name.clone(),
                 effect: fp.effect.clone(),
@@ -249,6 +351,7 @@ pub(crate) fn build(
                 interval: se.map(|s| [value - t_quantile * s, value + t_quantile * s]),
                 bounds: [fp.min, fp.max],
                 at_bound: value <= fp.min || value >= fp.max,
+                not_identified: not_identified[j].take().map(|w| name_partners(&w, problem)),
             }
         })
         .collect();
@@ -256,7 +359,16 @@ pub(crate) fn build(
         .as_ref()
         .map(|c| {
             (0..p)
-                .map(|i| (0..p).map(|j| c[(i, j)] / (c[(i, i)] * c[(j, j)]).sqrt()).collect())
+                .map(|i| {
+                    (0..p)
+                        .map(|j| {
+                            // A parameter that is not determined is uncorrelated by convention (JSON has
+                            // no NaN).
+                            let r = c[(i, j)] / (c[(i, i)] * c[(j, j)]).sqrt();
+                            if r.is_finite() { r } else { f64::from(u8::from(i == j)) }
+                        })
+                        .collect()
+                })
                 .collect()
         })
         .unwrap_or_default();
@@ -348,4 +460,79 @@ pub(crate) fn build(
         iterations: out.iterations,
         evaluations: out.evaluations,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// A Jacobian of `rows` residuals whose columns are smooth, independent functions.
+    fn independent(rows: usize, cols: usize) -> DMatrix<f64> {
+        DMatrix::from_fn(rows, cols, |i, j| {
+            let t = i as f64 / rows as f64;
+            t.powi(j as i32) * (1.0 + 0.3 * (7.0 * t + j as f64).sin())
+        })
+    }
+
+    #[test]
+    fn a_zero_column_is_not_identified_and_the_others_keep_their_errors() {
+        let jac = independent(40, 3);
+        let mut with_zero = DMatrix::zeros(40, 4);
+        for j in 0..3 {
+            with_zero.set_column(if j < 2 { j } else { 3 }, &jac.column(j));
+        }
+        let (inv, why) = identified_inverse(&with_zero);
+        let inv = inv.unwrap();
+        assert_eq!(
+            why.iter().map(Option::is_some).collect::<Vec<_>>(),
+            [false, false, true, false]
+        );
+        assert!(why[2].as_deref().unwrap().contains("no residual"));
+        let direct = normal_inverse(&jac).unwrap();
+        for (a, x) in [(0, 0), (1, 1), (3, 2)] {
+            for (b, y) in [(0, 0), (1, 1), (3, 2)] {
+                assert!((inv[(a, b)] - direct[(x, y)]).abs() <= 1e-9 * direct[(x, y)].abs().max(1e-12));
+            }
+        }
+        assert!(inv[(2, 2)].is_nan() && inv[(0, 2)].is_nan());
+        // With every column determined, nothing is flagged and the inverse is `normal_inverse`'s.
+        let (all, why) = identified_inverse(&jac);
+        assert!(why.iter().all(Option::is_none));
+        assert!((all.unwrap() - direct).abs().max() < 1e-9);
+    }
+
+    #[test]
+    fn a_column_that_copies_another_is_not_identified_and_names_its_partner() {
+        let jac = independent(40, 2);
+        let mut dup = DMatrix::zeros(40, 3);
+        dup.set_column(0, &jac.column(0));
+        dup.set_column(1, &jac.column(1));
+        dup.set_column(2, &(jac.column(1) * 3.0));
+        let (inv, why) = identified_inverse(&dup);
+        assert!(inv.is_some());
+        let flagged: Vec<usize> = (0..3).filter(|&j| why[j].is_some()).collect();
+        assert_eq!(flagged.len(), 1, "{why:?}");
+        let other = if flagged[0] == 1 { "#2" } else { "#1" };
+        assert!(why[flagged[0]].as_deref().unwrap().contains(other), "{why:?}");
+        assert!(why[0].is_none());
+    }
+
+    proptest! {
+        /// Zeroing any set of columns flags exactly those, and never all the rest.
+        #[test]
+        fn zeroed_columns_are_exactly_the_flagged_ones(mask in prop::collection::vec(any::<bool>(), 4)) {
+            let mut jac = independent(30, 4);
+            for (j, zero) in mask.iter().enumerate() {
+                if *zero {
+                    jac.set_column(j, &nalgebra::DVector::zeros(30));
+                }
+            }
+            let (inv, why) = identified_inverse(&jac);
+            for (j, zero) in mask.iter().enumerate() {
+                prop_assert_eq!(why[j].is_some(), *zero);
+            }
+            prop_assert_eq!(inv.is_some(), mask.iter().any(|z| !z));
+        }
+    }
 }

@@ -25,8 +25,14 @@ fn shipped_paper_model_has_three_surfaces_with_the_papers_values() {
     let settings = spec.settings(Some("clay")).unwrap();
     let k = settings.iter().find(|(r, _)| r.to_string() == "spring.k").unwrap().1;
     assert!(k.free && k.min == 1000.0 && k.max == 1e6 && k.value == 25_650.0);
+    // Friction is fitted per surface.
     let mu = settings.iter().find(|(r, _)| r.to_string() == "coulomb.mu").unwrap().1;
-    assert!(!mu.free);
+    assert!(mu.free && mu.value == 0.5);
+    assert!(
+        spec.surfaces
+            .iter()
+            .all(|(_, v)| v.iter().any(|(r, s)| r.to_string() == "coulomb.mu" && s.free))
+    );
     assert!(matches!(
         spec.build(Some("grass")),
         Err(ModelError::UnknownSurface { .. })

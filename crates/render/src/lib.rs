@@ -24,7 +24,7 @@ mod shot;
 
 pub use error::RenderError;
 pub use look::{BallLook, HotSpot, Item, ItemKind, LOOK_COLUMNS, LOOK_FAMILIES, Look, LookSpec, Range, SurfaceLook};
-pub use presets::{EFFECT_MAGNITUDES, preset_names, preset_toml};
+pub use presets::{EFFECT_MAGNITUDES, EFFECT_PAIRS, preset_names, preset_toml};
 pub use progress::ProgressBarObserver;
 pub use scenario::{BallSpec, Camera, Downslope, Format, RandomPhysics, Scenario, Shot, Surface, Texture};
 pub use scene::{Frame, Pixels, ShotRenderer};

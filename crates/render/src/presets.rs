@@ -1,6 +1,7 @@
 //! Built-in scenarios: `smoke` (regression tests), `paper` (the paper's 144-shot session), `none` and one
 //! `effect-<name>` session per non-base effect of the model crate (for the missing-effect diagnosis),
-//! `looks` (64 shots, each with its own look and physics) and `looks-smoke` (6 small ones for tests).
+//! `pair-A+B` sessions with two effects at once ([`EFFECT_PAIRS`]), `looks` (64 shots, each with its own
+//! look and physics) and `looks-smoke` (6 small ones for tests).
 
 use bouncelab_model::{ModelSpec, builtin_effects};
 
@@ -15,6 +16,17 @@ pub const EFFECT_MAGNITUDES: &[(&str, &str)] = &[
     ("inertia_factor", "dc = -0.25"),
     ("drag", "cd = 1.5\nrho = 1.204"),
     ("camera_roll", "roll_deg = 3"),
+    // k_t = 1e5 N/m: the slip reverses within the contact and the outgoing spin and tangential speed move
+    // by tens of µm over the flight filmed (the diagnosis is also checked at 3e-6, a factor 3 stiffer).
+    ("tangential_spring", "compliance = 1e-5"),
+];
+
+/// The pair presets `pair-A+B`: two effects hidden at once, each at its [`EFFECT_MAGNITUDES`] value (any two
+/// non-base effects make a preset; these are the ones listed and tested).
+pub const EFFECT_PAIRS: &[(&str, &str)] = &[
+    ("hertz", "drag"),
+    ("inertia_factor", "camera_roll"),
+    ("hunt_crossley", "rolling_resistance"),
 ];
 
 /// The names of every preset.
@@ -25,6 +37,9 @@ pub fn preset_names() -> Vec<String> {
         .collect();
     for e in builtin_effects().iter().filter(|e| !e.base) {
         v.push(format!("effect-{}", e.name));
+    }
+    for (a, b) in EFFECT_PAIRS {
+        v.push(format!("pair-{a}+{b}"));
     }
     v
 }
@@ -78,38 +93,55 @@ pub fn preset_toml(name: &str) -> Option<String> {
             "name = \"paper\"\ndescription = \"The paper's session: 3 surfaces x 4 drop heights x 4 angles x 3 repeats\"\nseed = 2024\npre_contact_ms = 15\npost_separation_ms = 20\n\n{ball}\n{CAMERA_512}\n{}\n[grid]\nsurfaces = [\"clay\", \"tape1\", \"tape2\"]\ndrop_heights_m = [0.2, 0.27, 0.33, 0.4]\nangles_deg = [0, 7.5, 15, 22.5]\nrepeats = 3\n",
             paper_model_tables()
         )),
-        "none" => Some(effect_session("none", None)),
+        "none" => Some(effect_session("none", &[])),
         "looks" => Some(looks()),
         "looks-smoke" => Some(looks_smoke()),
         _ => {
+            let library = |effect: &str| builtin_effects().iter().find(|e| e.name == effect && !e.base);
+            if let Some(pair) = name.strip_prefix("pair-") {
+                let (a, b) = pair.split_once('+')?;
+                let (a, b) = (library(a)?, library(b)?);
+                if a.name == b.name {
+                    return None;
+                }
+                return Some(effect_session(name, &[a.name, b.name]));
+            }
             let effect = name.strip_prefix("effect-")?;
-            let info = builtin_effects().iter().find(|e| e.name == effect && !e.base)?;
-            Some(effect_session(name, Some(info.name)))
+            Some(effect_session(name, &[library(effect)?.name]))
         }
     }
 }
 
-/// A 12-shot clay session (drop heights 0.2, 0.55, 0.9 m × angles 0, 7.5, 15, 22.5°) with `effect`
-/// switched on at its [`EFFECT_MAGNITUDES`] value.
-fn effect_session(name: &str, effect: Option<&str>) -> String {
-    let (extra, list, what) = match effect {
-        Some(e) => {
-            let params = EFFECT_MAGNITUDES
-                .iter()
-                .find(|(n, _)| *n == e)
-                .map(|(_, p)| *p)
-                .unwrap_or("");
-            (
-                format!("[extra_effects.{e}]\n{params}\n"),
-                format!("[\"{e}\"]"),
-                format!("the hidden effect `{e}` switched on"),
-            )
-        }
-        None => (
+/// A 12-shot clay session (drop heights 0.2, 0.55, 0.9 m × angles 0, 7.5, 15, 22.5°) with `effects`
+/// switched on at their [`EFFECT_MAGNITUDES`] values.
+fn effect_session(name: &str, effects: &[&str]) -> String {
+    let (extra, list, what) = if effects.is_empty() {
+        (
             String::new(),
             "[]".to_string(),
             "no hidden effect (the paper's model)".to_string(),
-        ),
+        )
+    } else {
+        let mut extra = String::new();
+        for e in effects {
+            let params = EFFECT_MAGNITUDES
+                .iter()
+                .find(|(n, _)| n == e)
+                .map(|(_, p)| *p)
+                .unwrap_or("");
+            extra += &format!("[extra_effects.{e}]\n{params}\n");
+        }
+        let quoted: Vec<String> = effects.iter().map(|e| format!("\"{e}\"")).collect();
+        let named: Vec<String> = effects.iter().map(|e| format!("`{e}`")).collect();
+        (
+            extra,
+            format!("[{}]", quoted.join(", ")),
+            format!(
+                "the hidden effect{} {} switched on",
+                if effects.len() > 1 { "s" } else { "" },
+                named.join(" and ")
+            ),
+        )
     };
     let seed = crate::rng::mix(
         name.bytes()
@@ -117,7 +149,7 @@ fn effect_session(name: &str, effect: Option<&str>) -> String {
     ) % 1_000_000;
     // Drag acts in flight: its trace grows with the square of the flight filmed, so its session films
     // longer flights (the other effects act in contact, where 10 ms either side suffice).
-    let flight_ms = if effect == Some("drag") { 35 } else { 10 };
+    let flight_ms = if effects.contains(&"drag") { 35 } else { 10 };
     format!(
         "name = \"{name}\"\ndescription = \"Diagnosis session: clay, {what}\"\nseed = {seed}\npre_contact_ms = {flight_ms}\npost_separation_ms = {flight_ms}\n\n[ball]\ndiameter_m = 0.067\nmass_kg = 0.0567\ninertia_factor = 0.6666666666666666\n\n{CAMERA_512}\n[model]\ngravity_m_s2 = 9.81\n[model.effects.spring]\nk = 25650\n[model.effects.damping]\nb = 14\n[model.effects.coulomb]\nmu = 0.5\n\n[surfaces.clay]\ntexture = \"clay\"\n\n{extra}\n[grid]\nsurfaces = [\"clay\"]\ndrop_heights_m = [0.2, 0.55, 0.9]\nangles_deg = [0, 7.5, 15, 22.5]\nrepeats = 1\neffects = {list}\n"
     )

@@ -20,7 +20,7 @@ pub const INCLINES: [f64; 4] = [0.0, 7.5, 15.0, 22.5];
 /// renderer has since raised Hertz, restitution damping and the plastic dent (6e5, 20, 0.5) so that tracked
 /// sessions stand 3× above the tracking floor; these synthetic tracks have no such floor and keep the
 /// smaller, harder values.
-pub const MAGNITUDES: [(&str, &[(&str, f64)]); 8] = [
+pub const MAGNITUDES: [(&str, &[(&str, f64)]); 9] = [
     ("hertz", &[("k_h", 400_000.0)]),
     ("hunt_crossley", &[("lambda", 2000.0), ("n", 1.0)]),
     ("restitution_damping", &[("b_r", 8.0)]),
@@ -29,18 +29,33 @@ pub const MAGNITUDES: [(&str, &[(&str, f64)]); 8] = [
     ("inertia_factor", &[("dc", -0.25)]),
     ("drag", &[("cd", 1.5), ("rho", 1.204)]),
     ("camera_roll", &[("roll_deg", 3.0)]),
+    ("tangential_spring", &[("compliance", 1e-5)]),
 ];
 
 /// The clay base model with the library effect `hidden` switched on at its renderer magnitude.
 pub fn truth(hidden: Option<&str>) -> Model {
+    let set = hidden
+        .and_then(|name| MAGNITUDES.iter().find(|(n, _)| *n == name))
+        .map(|(_, v)| *v)
+        .unwrap_or(&[]);
+    truth_at(hidden, set)
+}
+
+/// The clay base model with two library effects switched on at their renderer magnitudes.
+pub fn truth_pair(a: &str, b: &str) -> Model {
+    let mut m = truth(Some(a));
+    let with_b = truth(Some(b));
+    let added = with_b.effect(b).unwrap_or_else(|| panic!("no effect {b}"));
+    m.push(added.clone_box());
+    m
+}
+
+/// The clay base model with the library effect `hidden` switched on with the parameter values `set`
+/// (the others at their defaults).
+pub fn truth_at(hidden: Option<&str>, set: &[(&str, f64)]) -> Model {
     let mut m = Model::paper(CLAY.0, CLAY.1, CLAY.2);
     if let Some(name) = hidden {
         let info = builtin(name).unwrap_or_else(|| panic!("no effect {name}"));
-        let set = MAGNITUDES
-            .iter()
-            .find(|(n, _)| *n == name)
-            .map(|(_, v)| *v)
-            .unwrap_or(&[]);
         let values: Vec<f64> = info
             .params
             .iter()
@@ -131,14 +146,30 @@ pub fn session(model: &Model, seed: u64, tracking: Tracking) -> Vec<MeasuredShot
     shots
 }
 
-/// The paper's model file (k, b free per surface, μ fixed): the current model of every test.
+/// The paper's model file (k, b and μ free per surface): the current model of every test.
 pub fn base_spec() -> ModelSpec {
     ModelSpec::paper()
 }
 
+/// The paper's model with μ held at the truth (0.5), as a model that knows its surface's friction.
+pub fn known_mu_spec() -> ModelSpec {
+    let text = bouncelab_model::PAPER_MODEL_TOML
+        .replace(
+            "mu = { value = 0.5, free = true, min = 0, max = 2 }",
+            "mu = { value = 0.5, free = false, min = 0, max = 2 }",
+        )
+        .replace("coulomb.mu = 0.5\n", "");
+    ModelSpec::parse(&text, "paper model, μ known").expect("the edited paper model parses")
+}
+
 /// Runs the search with default options, printing a summary line per candidate.
 pub fn run(label: &str, shots: &[MeasuredShot], options: &SearchOptions) -> Diagnosis {
-    let d = find_missing_effect(&base_spec(), shots, options, &|_| {}).expect("the diagnosis runs");
+    run_with(label, &base_spec(), shots, options)
+}
+
+/// [`run`] from the current model `spec`.
+pub fn run_with(label: &str, spec: &ModelSpec, shots: &[MeasuredShot], options: &SearchOptions) -> Diagnosis {
+    let d = find_missing_effect(spec, shots, options, &|_| {}).expect("the diagnosis runs");
     print(label, &d);
     d
 }
