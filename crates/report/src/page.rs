@@ -62,9 +62,9 @@ details.shot:target{outline:2px solid #0b5fa5}
 .tag.worst{background:#fde2d5}.tag.best{background:#d6f0e2}
 .notes{color:var(--muted);font-size:.92em}
 .strip{display:flex;flex-wrap:wrap;gap:6px;margin:.4em 0 .6em}
-.strip figure{margin:0}
-.strip img{display:block;max-width:180px;height:auto;border:1px solid var(--line)}
-.strip figcaption{font-size:.8em;max-width:180px}
+.strip figure{margin:0;max-width:100%}
+.strip img{display:block;max-width:100%;height:auto;border:1px solid var(--line)}
+.strip figcaption{font-size:.8em}
 nav ol{columns:2;max-width:640px;padding-left:1.4em}
 footer{margin-top:3em;color:var(--muted);font-size:.85em;border-top:1px solid var(--line);padding-top:.6em}
 @media print{nav,#shot-selector{display:none}details.shot,figure{break-inside:avoid}}
