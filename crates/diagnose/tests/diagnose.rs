@@ -559,7 +559,7 @@ fn bad_input_is_an_error_naming_what_is_wrong() {
     assert!(e.to_string().contains("grass"), "{e}");
 }
 
-/// The story of SPEC §2.5: accept the suggestion (the model file gets the effect at its fitted values),
+/// The story of `docs/diagnosis.md`: accept the suggestion (the model file gets the effect at its fitted values),
 /// refit with the fit crate, and the error falls as the diagnosis said.
 #[test]
 fn accepting_the_verdict_makes_the_error_fall() {
