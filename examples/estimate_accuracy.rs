@@ -6,11 +6,13 @@
 //! (RMS of error/SE), and the per-surface, per-angle mean COR against the truth's. With a preset name
 //! (default `none`) or a scenario file it renders into a temporary folder first.
 
+#[path = "../tests/common/rendered.rs"]
+mod rendered;
+
 use bouncelab_estimate::{Conditions, estimate_with_frames};
 use bouncelab_frames::Session;
 use bouncelab_track::{ClipTracking, track_clip};
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
 
 fn rms(v: &[f64]) -> f64 {
     (v.iter().map(|e| e * e).sum::<f64>() / v.len().max(1) as f64).sqrt()
@@ -18,20 +20,7 @@ fn rms(v: &[f64]) -> f64 {
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let _tmp;
-    let (session_dir, truth_dir): (PathBuf, PathBuf) = if args.len() >= 2 {
-        (args[0].clone().into(), args[1].clone().into())
-    } else {
-        let what = args.first().map(String::as_str).unwrap_or("none");
-        let scenario = if what.ends_with(".toml") {
-            bouncelab_render::Scenario::load(Path::new(what)).expect("scenario")
-        } else {
-            bouncelab_render::Scenario::preset(what).expect("preset")
-        };
-        _tmp = tempfile::tempdir().unwrap();
-        bouncelab_render::render(&scenario, _tmp.path()).expect("render");
-        (_tmp.path().join("session"), _tmp.path().join("truth"))
-    };
+    let (session_dir, truth_dir, _tmp) = rendered::session_and_truth(&args, "none");
     let session = Session::load(&session_dir).expect("session");
     let mut truth = csv::Reader::from_path(truth_dir.join("shots.csv")).expect("shots.csv");
     let h = truth.headers().unwrap().clone();

@@ -815,7 +815,8 @@ fn contact_source(e: &bouncelab_estimate::Estimate) -> Option<String> {
 /// One line per distinct camera (as its files' headers describe it) with the shots it recorded: model,
 /// format, rate, exposure, bit depth and where the trigger fell. Nothing for folders of images.
 fn camera_notes(shots: &[ShotData]) -> Vec<String> {
-    let mut cameras: Vec<(String, Vec<&str>)> = Vec::new();
+    // Each camera's description, its shots, and the trigger's file frame of those that state one.
+    let mut cameras: Vec<(String, usize, Vec<String>)> = Vec::new();
     for s in shots {
         let Some(c) = &s.track.camera else { continue };
         let mut text = format!(
@@ -832,23 +833,24 @@ fn camera_notes(shots: &[ShotData]) -> Vec<String> {
         if let Some(b) = c.bit_depth {
             text += &format!(", {b}-bit");
         }
-        match cameras.iter_mut().find(|(t, _)| *t == text) {
-            Some((_, clips)) => clips.push(&s.clip),
-            None => cameras.push((text, vec![&s.clip])),
+        let i = match cameras.iter().position(|(t, _, _)| *t == text) {
+            Some(i) => i,
+            None => {
+                cameras.push((text, 0, Vec::new()));
+                cameras.len() - 1
+            }
+        };
+        cameras[i].1 += 1;
+        if let Some(t) = c.trigger_frame {
+            cameras[i].2.push(format!("{} {t}", s.clip));
         }
     }
     cameras
         .into_iter()
-        .map(|(text, clips)| {
-            let trigger = shots
-                .iter()
-                .filter(|s| clips.contains(&s.clip.as_str()))
-                .filter_map(|s| s.track.camera.as_ref()?.trigger_frame.map(|t| (s.clip.as_str(), t)))
-                .map(|(clip, t)| format!("{clip} {t}"))
-                .collect::<Vec<_>>();
-            let mut line = format!("camera: {text}; {} shot(s)", clips.len());
-            if !trigger.is_empty() {
-                line += &format!("; trigger at file frame {}", trigger.join(", "));
+        .map(|(text, n, triggers)| {
+            let mut line = format!("camera: {text}; {n} shot(s)");
+            if !triggers.is_empty() {
+                line += &format!("; trigger at file frame {}", triggers.join(", "));
             }
             line
         })
