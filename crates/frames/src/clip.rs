@@ -149,15 +149,20 @@ impl Frames {
                 return Self::camera(&only.path, Kind::Tiff, max_pixels);
             }
             let first = &files[0].path;
-            let size = image::ImageReader::open(first)
-                .and_then(|r| r.with_guessed_format())
-                .map_err(|e| e.to_string())
-                .and_then(|r| r.into_dimensions().map_err(|e| e.to_string()))
-                .map_err(|message| FramesError::Decode {
+            let size = crate::decode::header_dimensions(first).map_err(|message| FramesError::Decode {
+                path: first.clone(),
+                index: 0,
+                message,
+            })?;
+            // From the header, before anything is decoded: a bomb header never gets its buffer.
+            if u64::from(size.0) * u64::from(size.1) > max_pixels {
+                return Err(FramesError::FrameTooLarge {
                     path: first.clone(),
-                    index: 0,
-                    message,
-                })?;
+                    width: size.0.into(),
+                    height: size.1.into(),
+                    limit: max_pixels,
+                });
+            }
             return Ok(Self {
                 files,
                 size,
@@ -461,9 +466,16 @@ impl Clip {
     fn decode(&self, file: &FrameFile, png: PngDecoder) -> Result<Frame> {
         let pixels = match &self.camera {
             Some(cam) => cam.decode(file.index as usize)?,
-            None => decode_path(&file.path, png).map_err(|e| match e {
+            None => decode_path(&file.path, png, self.size).map_err(|e| match e {
                 crate::decode::DecodeError::MultiPage => FramesError::MultiPageInFolder {
                     path: file.path.clone(),
+                },
+                crate::decode::DecodeError::Size(found) => FramesError::SizeMismatch {
+                    path: file.path.clone(),
+                    index: file.index,
+                    found,
+                    expected: self.size,
+                    first: self.files[0].path.clone(),
                 },
                 crate::decode::DecodeError::Other(message) => FramesError::Decode {
                     path: file.path.clone(),
@@ -590,7 +602,8 @@ impl Iterator for FrameStream<'_> {
 
 impl ExactSizeIterator for FrameStream<'_> {}
 
-/// The last run of ASCII digits in a file stem, as a number: `Ok(None)` if there is none.
+/// The last run of ASCII digits in a file stem, as a number: `Ok(None)` if there is none, `Err` above
+/// `i64::MAX` (frame numbers are stored as SQLite's signed 64-bit integers).
 pub(crate) fn last_number(stem: &str) -> std::result::Result<Option<u64>, ()> {
     let bytes = stem.as_bytes();
     let Some(end) = bytes.iter().rposition(u8::is_ascii_digit) else {
@@ -600,7 +613,12 @@ pub(crate) fn last_number(stem: &str) -> std::result::Result<Option<u64>, ()> {
         .iter()
         .rposition(|b| !b.is_ascii_digit())
         .map_or(0, |i| i + 1);
-    stem[start..=end].parse::<u64>().map(Some).map_err(|_| ())
+    stem[start..=end]
+        .parse::<u64>()
+        .ok()
+        .filter(|&n| i64::try_from(n).is_ok())
+        .map(Some)
+        .ok_or(())
 }
 
 fn list_frames(dir: &Path) -> Result<Vec<FrameFile>> {

@@ -71,18 +71,35 @@ impl FrameFormat {
 pub(crate) enum DecodeError {
     /// A TIFF with more than one page, met among other frame files.
     MultiPage,
+    /// The header gives this width and height, in pixels, not the clip's (nothing was decoded).
+    Size((u32, u32)),
     /// The decoder's (or the OS's) message.
     Other(String),
 }
 
-/// Reads and decodes one file to gray pixels.
-pub(crate) fn decode_path(path: &Path, png: PngDecoder) -> Result<GrayPixels, DecodeError> {
+/// A frame file's width and height, in pixels, from its header only (nothing is decoded).
+pub(crate) fn header_dimensions(path: &Path) -> Result<(u32, u32), String> {
+    image::ImageReader::open(path)
+        .and_then(|r| r.with_guessed_format())
+        .map_err(|e| e.to_string())
+        .and_then(|r| r.into_dimensions().map_err(|e| e.to_string()))
+}
+
+/// Reads and decodes one file to gray pixels, if its header says it is `expected` (width, height) pixels:
+/// a frame of another size (a corrupt or hostile header among them) is refused before its buffer exists.
+pub(crate) fn decode_path(path: &Path, png: PngDecoder, expected: (u32, u32)) -> Result<GrayPixels, DecodeError> {
     let other = DecodeError::Other;
     let format = FrameFormat::from_path(path).ok_or_else(|| other("not a supported image file".to_string()))?;
     let bytes = std::fs::read(path).map_err(|e| other(e.to_string()))?;
     // Only a stack's first page would be decoded: refuse rather than lose the others.
     if format == FrameFormat::Tiff && crate::camera::tiff_has_more_pages(&bytes) {
         return Err(DecodeError::MultiPage);
+    }
+    let size = image::ImageReader::with_format(std::io::Cursor::new(&bytes), format.image_format())
+        .into_dimensions()
+        .map_err(|e| other(e.to_string()))?;
+    if size != expected {
+        return Err(DecodeError::Size(size));
     }
     decode_bytes(&bytes, format, png).map(to_gray).map_err(other)
 }

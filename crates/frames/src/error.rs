@@ -219,8 +219,8 @@ pub enum FramesError {
         /// The clip's first frame file.
         first: PathBuf,
     },
-    /// A frame rate that is not a finite number in (0, 1e7] frames per second.
-    #[error("{origin}: {field} = {value} is not a usable frame rate (need a number > 0 and ≤ 10,000,000 frames/s)")]
+    /// A frame rate that is not a finite number in [100, 1e7] frames per second.
+    #[error("{origin}: {field} = {value} is not a usable frame rate (need a number from 100 to 10,000,000 frames/s)")]
     BadFps {
         /// Where the value came from: a file path, or `command line`.
         origin: String,
@@ -304,6 +304,17 @@ pub enum FramesError {
         clip: String,
         /// The folder (or file) it should be.
         expected: PathBuf,
+    },
+    /// A `clips.csv` clip name that leads outside the session folder (an absolute path, or `..`).
+    #[error(
+        "clip `{clip}`: a clip name must name a folder or camera file inside the session folder {} (no absolute path, no `..`)",
+        session.display()
+    )]
+    ClipOutsideSession {
+        /// The clip name.
+        clip: String,
+        /// The session folder.
+        session: PathBuf,
     },
     /// The decoding thread pool could not be built.
     #[error("cannot start {threads} decoding threads: {message}")]

@@ -46,8 +46,9 @@ pub use decode::decode_bytes;
 pub use decode::{FrameFormat, PngDecoder};
 pub use error::{FramesError, Result, UnfilledRow};
 pub use pixels::{Gray16Image, GrayPixels};
-pub use session::{BallSpec, ClipEntry, Session};
+pub use session::{BallSpec, ClipEntry, Session, UnusableClip};
 pub use settings::{
-    ClipSettings, ContactLine, DEFAULT_BALL_DIAMETER_M, DEFAULT_FPS, DIAMETER_RANGE_M, Downslope, FpsSource, MAX_FPS,
-    MAX_LINE_TILT_DEG, Roi, SCALE_RANGE_M_PER_PX, SettingOverrides, SettingSource, Warning, clip_toml_path,
+    ClipSettings, ContactLine, DEFAULT_BALL_DIAMETER_M, DEFAULT_FPS, DIAMETER_RANGE_M, DROP_HEIGHT_RANGE_M, Downslope,
+    FpsSource, MASS_RANGE_KG, MAX_FPS, MAX_LINE_TILT_DEG, MIN_FPS, Roi, SCALE_RANGE_M_PER_PX, SettingOverrides,
+    SettingSource, Warning, clip_toml_path,
 };

@@ -8,8 +8,8 @@ use crate::camera::{CameraFile, DEFAULT_MAX_FRAME_PIXELS, Kind};
 use crate::clip::{Clip, ClipOptions};
 use crate::error::{FramesError, Result, UnfilledRow};
 use crate::settings::{
-    ClipSettings, DIAMETER_RANGE_M, Downslope, FpsSource, Warning, camera_keys, camera_keys_at, check_overrides,
-    check_range, choose_fps, choose_settings, clip_toml_path, number, read_toml,
+    ClipSettings, DIAMETER_RANGE_M, DROP_HEIGHT_RANGE_M, Downslope, FpsSource, MASS_RANGE_KG, Warning, camera_keys,
+    camera_keys_at, check_overrides, check_range, choose_fps, choose_settings, clip_toml_path, number, read_toml,
 };
 
 /// The ball, from `session.toml`'s `[ball]` table.
@@ -70,6 +70,28 @@ impl ClipEntry {
     }
 }
 
+/// A `clips.csv` row whose clip cannot be analysed — its folder or camera file absent, its name leading
+/// outside the session folder, its `clip.toml` malformed or out of range: the rest of the session loads,
+/// and this shot fails with [`UnusableClip::reason`].
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct UnusableClip {
+    /// Clip name (the `clip` column).
+    pub name: String,
+    /// Surface name (the `surface` column).
+    pub surface: String,
+    /// Surface inclination, in degrees (the `angle_deg` column).
+    pub angle_deg: f64,
+    /// Drop height, in metres (the `drop_height_m` column).
+    pub drop_height_m: f64,
+    /// The other columns of the row, as (header, value), in header order.
+    pub metadata: Vec<(String, String)>,
+    /// The row's 1-based line in `clips.csv`.
+    pub line: u64,
+    /// Why it cannot be analysed: the [`FramesError`] message, naming the file or field.
+    pub reason: String,
+}
+
 /// A loaded session folder. Loading reads only `session.toml`, `clips.csv` and the clips' `clip.toml`s and
 /// checks that every clip folder exists; frames are read later, clip by clip.
 #[derive(Clone, Debug, PartialEq)]
@@ -85,8 +107,10 @@ pub struct Session {
     pub downslope: Downslope,
     /// The whole of `session.toml`, every table and key, in file order (metadata).
     pub metadata: toml::Table,
-    /// The clips, in `clips.csv` order.
+    /// The clips that can be opened, in `clips.csv` order.
     pub clips: Vec<ClipEntry>,
+    /// The rows whose clip cannot be analysed, with the reason, in `clips.csv` order.
+    pub unusable: Vec<UnusableClip>,
     /// Warnings (e.g. clips with no frame rate given).
     pub warnings: Vec<Warning>,
 }
@@ -130,7 +154,13 @@ impl Session {
                 &toml_path,
                 "[ball] diameter_m",
             )?,
-            mass_kg: positive(&toml_path, &metadata, "ball", "mass_kg")?,
+            mass_kg: check_range(
+                positive(&toml_path, &metadata, "ball", "mass_kg")?,
+                MASS_RANGE_KG,
+                "kg",
+                &toml_path,
+                "[ball] mass_kg",
+            )?,
         };
         let session_keys = camera_keys(&toml_path, &metadata)?;
         let (fps, downslope) = (session_keys.fps, session_keys.downslope.unwrap_or_default());
@@ -145,45 +175,13 @@ impl Session {
         }
         let rows = read_clips_csv(&csv_path)?;
         let mut clips = Vec::with_capacity(rows.len());
+        let mut unusable = Vec::new();
         let mut warnings = Vec::new();
         for row in rows {
-            let clip_dir = resolve_clip(&dir, &row.name)?;
-            let own = camera_keys_at(&clip_toml_path(&clip_dir))?;
-            // The header's record rate, when the clip is a camera file that opens; a file that does not open
-            // fails when the clip is measured, with its own error, rather than the whole session here.
-            let header_fps = Kind::of(&clip_dir)
-                .filter(|_| clip_dir.is_file())
-                .and_then(|kind| CameraFile::open(&clip_dir, kind, DEFAULT_MAX_FRAME_PIXELS).ok())
-                .and_then(|c| c.info.fps.map(|f| (f, c.path)));
-            let (fps, fps_source, warning) = choose_fps(
-                &clip_dir,
-                options.fps,
-                own.as_ref(),
-                header_fps.as_ref().map(|(f, p)| (*f, p.as_path())),
-                fps.map(|f| (f, toml_path.as_path())),
-            )?;
-            warnings.extend(warning);
-            let settings = choose_settings(
-                &clip_dir,
-                &options.overrides,
-                own.as_ref(),
-                Some(&session_keys),
-                &mut warnings,
-            );
-            let downslope = own.and_then(|(_, k)| k.downslope).unwrap_or(downslope);
-            clips.push(ClipEntry {
-                name: row.name,
-                dir: clip_dir,
-                surface: row.surface,
-                angle_deg: row.angle_deg,
-                drop_height_m: row.drop_height_m,
-                fps,
-                fps_source,
-                downslope,
-                metadata: row.metadata,
-                line: row.line,
-                settings,
-            });
+            match entry(&dir, row, options, &toml_path, &session_keys, &mut warnings) {
+                Ok(e) => clips.push(e),
+                Err(u) => unusable.push(u),
+            }
         }
         Ok(Self {
             dir,
@@ -192,20 +190,108 @@ impl Session {
             downslope,
             metadata,
             clips,
+            unusable,
             warnings,
         })
     }
 
-    /// The clip called `name`, if listed.
+    /// The clip called `name`, if listed and usable.
     pub fn clip(&self, name: &str) -> Option<&ClipEntry> {
         self.clips.iter().find(|c| c.name == name)
     }
+
+    /// Every clip name of `clips.csv`, usable or not, in file order.
+    pub fn listed(&self) -> Vec<&str> {
+        let mut rows: Vec<(u64, &str)> = self.clips.iter().map(|c| (c.line, c.name.as_str())).collect();
+        rows.extend(self.unusable.iter().map(|u| (u.line, u.name.as_str())));
+        rows.sort_unstable();
+        rows.into_iter().map(|(_, n)| n).collect()
+    }
+}
+
+/// One row's clip entry, or the row as unusable with why.
+fn entry(
+    dir: &Path,
+    row: Row,
+    options: &ClipOptions,
+    toml_path: &Path,
+    session_keys: &(PathBuf, crate::settings::CameraKeys),
+    warnings: &mut Vec<Warning>,
+) -> std::result::Result<ClipEntry, UnusableClip> {
+    let resolved = (|| {
+        let clip_dir = resolve_clip(dir, &row.name)?;
+        let own = camera_keys_at(&clip_toml_path(&clip_dir))?;
+        // The header's record rate, when the clip is a camera file that opens; a file that does not open
+        // fails when the clip is measured, with its own error.
+        let header_fps = Kind::of(&clip_dir)
+            .filter(|_| clip_dir.is_file())
+            .and_then(|kind| CameraFile::open(&clip_dir, kind, DEFAULT_MAX_FRAME_PIXELS).ok())
+            .and_then(|c| c.info.fps.map(|f| (f, c.path)));
+        let fps = choose_fps(
+            &clip_dir,
+            options.fps,
+            own.as_ref(),
+            header_fps.as_ref().map(|(f, p)| (*f, p.as_path())),
+            session_keys.1.fps.map(|f| (f, toml_path)),
+        )?;
+        Ok::<_, FramesError>((clip_dir, own, fps))
+    })();
+    let (clip_dir, own, (fps, fps_source, warning)) = match resolved {
+        Ok(r) => r,
+        Err(e) => {
+            return Err(UnusableClip {
+                name: row.name,
+                surface: row.surface,
+                angle_deg: row.angle_deg,
+                drop_height_m: row.drop_height_m,
+                metadata: row.metadata,
+                line: row.line,
+                reason: e.to_string(),
+            });
+        }
+    };
+    warnings.extend(warning);
+    let settings = choose_settings(
+        &clip_dir,
+        &options.overrides,
+        own.as_ref(),
+        Some(session_keys),
+        warnings,
+    );
+    let downslope = own
+        .and_then(|(_, k)| k.downslope)
+        .unwrap_or(session_keys.1.downslope.unwrap_or_default());
+    Ok(ClipEntry {
+        name: row.name,
+        dir: clip_dir,
+        surface: row.surface,
+        angle_deg: row.angle_deg,
+        drop_height_m: row.drop_height_m,
+        fps,
+        fps_source,
+        downslope,
+        metadata: row.metadata,
+        line: row.line,
+        settings,
+    })
 }
 
 /// The folder or camera file a `clips.csv` name stands for: the exact name in the session folder, or else
 /// the one camera file whose name without extension is the clip name (a Photron clip's `.cihx`, `.cih` and
 /// `.mraw` count as one, named by its header).
+///
+/// The name must stay inside the session folder: an absolute path or a `..` component is refused (a clip
+/// reached through a symbolic link the user made inside the folder is theirs to make).
 pub(crate) fn resolve_clip(session: &Path, name: &str) -> Result<PathBuf> {
+    let inside = Path::new(name)
+        .components()
+        .all(|c| matches!(c, std::path::Component::Normal(_) | std::path::Component::CurDir));
+    if !inside {
+        return Err(FramesError::ClipOutsideSession {
+            clip: name.into(),
+            session: session.into(),
+        });
+    }
     let exact = session.join(name);
     if exact.exists() {
         return Ok(exact);
@@ -299,7 +385,36 @@ struct Row {
     line: u64,
 }
 
+/// The line where a quoted field opens and never closes, if one does (the CSV reader would take the rest of
+/// the file into that field and carry on without a word).
+fn unterminated_quote(text: &str) -> Option<u64> {
+    let mut open_at = None;
+    for (i, line) in text.lines().enumerate() {
+        if open_at.is_none() && line.starts_with('#') {
+            continue;
+        }
+        for _ in line.matches('"') {
+            open_at = match open_at {
+                None => Some(i as u64 + 1),
+                Some(_) => None,
+            };
+        }
+    }
+    open_at
+}
+
 fn read_clips_csv(path: &Path) -> Result<Vec<Row>> {
+    let text = std::fs::read(path).map_err(|source| FramesError::Io {
+        path: path.into(),
+        source,
+    })?;
+    if let Some(line) = unterminated_quote(&String::from_utf8_lossy(&text)) {
+        return Err(FramesError::Csv {
+            path: path.into(),
+            line: Some(line),
+            message: "a quoted field opens here and never closes (a missing `\"`)".into(),
+        });
+    }
     let csv_err = |e: csv::Error| FramesError::Csv {
         path: path.into(),
         line: e.position().map(csv::Position::line),
@@ -313,8 +428,7 @@ fn read_clips_csv(path: &Path) -> Result<Vec<Row>> {
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .comment(Some(b'#'))
-        .from_path(path)
-        .map_err(csv_err)?;
+        .from_reader(text.as_slice());
     let headers = reader.headers().map_err(csv_err)?.clone();
     let column = |name: &str| -> Result<usize> {
         headers
@@ -390,11 +504,22 @@ fn read_clips_csv(path: &Path) -> Result<Vec<Row>> {
         if angle_deg.abs() >= 90.0 {
             return Err(bad(
                 "angle_deg",
-                format!("{angle_deg} is not an incline: it must lie between −90 and 90 degrees"),
+                format!(
+                    "{} is not an incline: it must lie between −90 and 90 degrees",
+                    crate::settings::short_number(angle_deg)
+                ),
             ));
         }
-        if drop_height_m < 0.0 {
-            return Err(bad("drop_height_m", format!("{drop_height_m} is negative")));
+        if !(DROP_HEIGHT_RANGE_M.0..=DROP_HEIGHT_RANGE_M.1).contains(&drop_height_m) {
+            return Err(bad(
+                "drop_height_m",
+                format!(
+                    "{} is outside the accepted range {}–{} m",
+                    crate::settings::short_number(drop_height_m),
+                    DROP_HEIGHT_RANGE_M.0,
+                    DROP_HEIGHT_RANGE_M.1
+                ),
+            ));
         }
         rows.push(Row {
             name,
@@ -409,6 +534,13 @@ fn read_clips_csv(path: &Path) -> Result<Vec<Row>> {
         return Err(FramesError::UnfilledColumns {
             path: path.into(),
             rows: unfilled,
+        });
+    }
+    if rows.is_empty() {
+        return Err(FramesError::Csv {
+            path: path.into(),
+            line: None,
+            message: "no clip rows: a session lists at least one clip under the header".into(),
         });
     }
     Ok(rows)

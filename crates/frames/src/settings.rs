@@ -14,6 +14,16 @@ pub const DEFAULT_FPS: f64 = 10_000.0;
 /// The largest frame rate accepted, in frames/s (anything above is taken as a typo).
 pub const MAX_FPS: f64 = 1e7;
 
+/// The smallest frame rate accepted, in frames/s: below it a contact of a few milliseconds falls between
+/// two frames and the flight arcs have a handful of points, so a smaller value is a typo or a wrong unit.
+pub const MIN_FPS: f64 = 100.0;
+
+/// Accepted range of `[ball] mass_kg`, in kilograms (a table-tennis ball to a shot put, with margin).
+pub const MASS_RANGE_KG: (f64, f64) = (1e-4, 100.0);
+
+/// Accepted range of `clips.csv`'s `drop_height_m`, in metres.
+pub const DROP_HEIGHT_RANGE_M: (f64, f64) = (0.0, 100.0);
+
 /// Ball diameter assumed for a clip outside a session when nothing gives one, in metres (a tennis ball).
 pub const DEFAULT_BALL_DIAMETER_M: f64 = 0.067;
 
@@ -264,9 +274,9 @@ pub(crate) fn read_toml(path: &Path) -> Result<toml::Table> {
     })
 }
 
-/// Checks a frame rate: finite, > 0, ≤ [`MAX_FPS`].
+/// Checks a frame rate: finite, in [[`MIN_FPS`], [`MAX_FPS`]].
 pub(crate) fn check_fps(fps: f64, origin: &str, field: &str) -> Result<f64> {
-    if fps.is_finite() && fps > 0.0 && fps <= MAX_FPS {
+    if fps.is_finite() && (MIN_FPS..=MAX_FPS).contains(&fps) {
         Ok(fps)
     } else {
         Err(FramesError::BadFps {
@@ -277,9 +287,8 @@ pub(crate) fn check_fps(fps: f64, origin: &str, field: &str) -> Result<f64> {
     }
 }
 
-/// Checks a value against a closed range, naming the file, key, unit and range.
 /// A number as a person reads it: plain when moderate, in e-notation when huge or tiny.
-fn short_number(x: f64) -> String {
+pub(crate) fn short_number(x: f64) -> String {
     if x != 0.0 && x.is_finite() && !(1e-4..1e6).contains(&x.abs()) {
         format!("{x:e}")
     } else {
@@ -287,6 +296,7 @@ fn short_number(x: f64) -> String {
     }
 }
 
+/// Checks a value against a closed range, naming the file, key, unit and range.
 pub(crate) fn check_range(x: f64, (lo, hi): (f64, f64), unit: &str, path: &Path, field: &str) -> Result<f64> {
     if x.is_finite() && x >= lo && x <= hi {
         Ok(x)
@@ -499,6 +509,7 @@ pub(crate) fn choose_fps(
         return Ok((*fps, FpsSource::ClipToml(path.clone()), None));
     }
     if let Some((fps, path)) = header {
+        let fps = check_fps(fps, &path.display().to_string(), "header record rate")?;
         return Ok((fps, FpsSource::Header(path.into()), None));
     }
     if let Some((fps, path)) = session {
@@ -622,7 +633,9 @@ mod tests {
 
     #[test]
     fn nonsense_fps_is_an_error_naming_file_and_field() {
-        for bad in ["0", "-3", "nan", "inf", "\"fast\"", "2e7", "true"] {
+        for bad in [
+            "0", "-3", "nan", "inf", "\"fast\"", "2e7", "true", "0.5", "1", "99.9", "1e-300",
+        ] {
             let err = keys(&format!("[camera]\nfps = {bad}")).unwrap_err();
             assert!(matches!(err, FramesError::BadFps { .. }), "{bad}: {err}");
             let msg = err.to_string();

@@ -286,6 +286,12 @@ fn png(w: u32, h: u32, depth: u8, colour: u8, interlace: u8, plte: Option<&[u8]>
     out
 }
 
+/// A PNG whose header claims `w`×`h` 8-bit gray pixels but whose data is a few bytes: a decompression bomb
+/// header (a decoder that trusts it allocates w·h bytes before it finds the data short).
+pub fn bomb_png(w: u32, h: u32) -> Vec<u8> {
+    png(w, h, 8, 0, 0, None, &[0, 0, 0, 0])
+}
+
 /// A 2×1 palette PNG whose pixels are gray 10 and gray 200.
 pub fn palette_png() -> Vec<u8> {
     png(2, 1, 8, 3, 0, Some(&[10, 10, 10, 200, 200, 200]), &[0, 0, 1])

@@ -174,9 +174,15 @@ fn csv_problems_name_line_and_column() {
 #[test]
 fn a_clip_listed_but_absent_is_named_with_its_expected_path() {
     let (tmp, s) = session_with(SESSION_TOML, CSV, &["shot_01"]);
-    let err = s.unwrap_err();
-    assert!(matches!(err, FramesError::ClipAbsent { .. }));
-    assert_names(&err, &["shot_02", &tmp.path().join("shot_02").display().to_string()]);
+    let s = s.unwrap();
+    assert_eq!(s.clips.len(), 1, "the other clip loads");
+    let [bad] = &s.unusable[..] else {
+        panic!("{:?}", s.unusable)
+    };
+    assert_eq!((bad.name.as_str(), bad.line), ("shot_02", 3));
+    for part in ["shot_02", &tmp.path().join("shot_02").display().to_string()] {
+        assert!(bad.reason.contains(part), "{}", bad.reason);
+    }
 }
 
 #[test]
@@ -184,9 +190,12 @@ fn a_bad_clip_toml_is_named() {
     let tmp = tempfile::tempdir().unwrap();
     write_session(tmp.path(), SESSION_TOML, CSV, &["shot_01"]);
     ClipSpec::new(1).fps(0.0).write(&tmp.path().join("shot_02"));
-    let err = Session::load(tmp.path()).unwrap_err();
-    assert!(matches!(err, FramesError::BadFps { .. }));
-    assert_names(&err, &["shot_02", "clip.toml", "[camera] fps"]);
+    let s = Session::load(tmp.path()).unwrap();
+    assert_eq!(s.clips.len(), 1);
+    let reason = &s.unusable[0].reason;
+    for part in ["shot_02", "clip.toml", "[camera] fps"] {
+        assert!(reason.contains(part), "{reason}");
+    }
 }
 
 /// An incline of 90° or more, or a negative drop height, is no shot: the file, line and column are named.
@@ -195,7 +204,10 @@ fn an_impossible_angle_or_height_in_clips_csv_is_named() {
     for (row, parts) in [
         ("shot_01,clay,90,1.2", ["line 2, angle_deg", "90 is not an incline"]),
         ("shot_01,clay,-95,1.2", ["line 2, angle_deg", "-95 is not an incline"]),
-        ("shot_01,clay,10,-0.5", ["line 2, drop_height_m", "-0.5 is negative"]),
+        (
+            "shot_01,clay,10,-0.5",
+            ["line 2, drop_height_m", "-0.5 is outside the accepted range 0–100 m"],
+        ),
     ] {
         let csv = format!("clip,surface,angle_deg,drop_height_m\n{row}\n");
         let (_tmp, s) = session_with(SESSION_TOML, &csv, &["shot_01"]);
@@ -248,9 +260,15 @@ fn camera_files_are_clips_by_exact_name_or_by_name_without_extension() {
     }
 
     Cine::new(16, 8, CinePacking::U8).write(&d.join("t1.cine"), &moving_disc(16, 8, 4, 255, 1));
-    let err = Session::load(d).unwrap_err();
-    assert!(matches!(err, FramesError::AmbiguousClip { .. }), "{err:?}");
-    assert_names(&err, &["t1", "t1.cine", "t1.tif"]);
+    // An ambiguous name fails that clip only, naming the candidates.
+    let s = Session::load(d).unwrap();
+    let [bad] = &s.unusable[..] else {
+        panic!("{:?}", s.unusable)
+    };
+    assert_eq!(bad.name, "t1");
+    for part in ["t1", "t1.cine", "t1.tif", "several camera files"] {
+        assert!(bad.reason.contains(part), "{}", bad.reason);
+    }
 }
 
 #[test]
@@ -337,9 +355,13 @@ fn settings_values_out_of_range_name_the_file_key_and_range() {
         let tmp = tempfile::tempdir().unwrap();
         write_session(tmp.path(), SESSION_TOML, CSV, &["shot_01", "shot_02"]);
         std::fs::write(tmp.path().join("shot_02/clip.toml"), clip_toml).unwrap();
-        let err = Session::load(tmp.path()).unwrap_err();
-        assert!(matches!(err, FramesError::BadValue { .. }), "{clip_toml}: {err:?}");
-        assert_names(&err, &["shot_02", "clip.toml", key, range]);
+        // The clip's own file fails that clip, naming the file, key and range; the session loads.
+        let s = Session::load(tmp.path()).unwrap();
+        assert_eq!(s.clips.len(), 1, "{clip_toml}");
+        let reason = &s.unusable[0].reason;
+        for part in ["shot_02", "clip.toml", key, range] {
+            assert!(reason.contains(part), "{clip_toml}: `{reason}` lacks `{part}`");
+        }
     }
 }
 

@@ -66,6 +66,30 @@ pub enum StoreError {
         /// Newest version this build can migrate to.
         supported: i64,
     },
+    /// The file is not an SQLite database at all (another kind of file, or a corrupt one); it is left
+    /// untouched.
+    #[error(
+        "{}: not a results store: the file is not an SQLite database (another kind of file, or corrupt); give --store a new file or an existing store",
+        .path.display()
+    )]
+    NotADatabase {
+        /// The file.
+        path: PathBuf,
+    },
+    /// The file is an SQLite database but not a results store (it has tables and no `schema_version`); it
+    /// is left untouched.
+    #[error(
+        "{}: not a bouncelab results store: an SQLite database with {tables} other table(s) ({first} …); give --store a new file or an existing store",
+        .path.display()
+    )]
+    Foreign {
+        /// The database file.
+        path: PathBuf,
+        /// How many tables it holds.
+        tables: usize,
+        /// The first few table names, comma separated.
+        first: String,
+    },
     /// A table name given to the CSV export does not exist.
     #[error("unknown table `{name}`; the tables are: {known}")]
     UnknownTable {

@@ -22,4 +22,4 @@ pub use records::{
     SessionRecord, SessionRow, ShotRecord, ShotRow, ShotStatus, ShotUpsert, TrackRecord, TrajectoryRecord, ValueSe,
 };
 pub use schema::{MIGRATIONS, Migration, Table, latest_version};
-pub use store::{Store, Tx};
+pub use store::{Store, StoreLock, Tx};

@@ -24,6 +24,12 @@ pub struct Store {
     path: PathBuf,
 }
 
+/// The store's measuring lock (see [`Store::lock_measuring`]), released when dropped.
+#[derive(Debug)]
+pub struct StoreLock {
+    _file: std::fs::File,
+}
+
 /// An open write transaction (see [`Store::transaction`]). Dropped without commit, it rolls back.
 #[derive(Debug)]
 pub struct Tx<'a> {
@@ -88,7 +94,14 @@ impl Store {
             path: path.clone(),
             source,
         })?;
-        Self::setup(conn, path, true)
+        Self::setup(conn, path.clone(), true).map_err(|e| match e {
+            StoreError::Open { source, .. } | StoreError::Sql { source, .. }
+                if source.sqlite_error_code() == Some(rusqlite::ErrorCode::NotADatabase) =>
+            {
+                StoreError::NotADatabase { path }
+            }
+            e => e,
+        })
     }
 
     /// A store in memory (for tests and dry runs); lost when dropped.
@@ -107,6 +120,19 @@ impl Store {
             source,
         };
         conn.busy_timeout(BUSY_TIMEOUT).map_err(open)?;
+        // A database that holds tables but no `schema_version` is someone else's: refused before any
+        // pragma or migration writes to it.
+        let tables: Vec<String> = conn
+            .prepare("SELECT name FROM sqlite_master WHERE type = 'table' ORDER BY name")
+            .and_then(|mut st| st.query_map([], |r| r.get(0))?.collect())
+            .map_err(open)?;
+        if !tables.is_empty() && !tables.iter().any(|t| t == "schema_version") {
+            return Err(StoreError::Foreign {
+                path: path.clone(),
+                tables: tables.len(),
+                first: tables.into_iter().take(3).collect::<Vec<_>>().join(", "),
+            });
+        }
         if wal {
             conn.pragma_update_and_check(None, "journal_mode", "WAL", |r| r.get::<_, String>(0))
                 .map_err(open)?;
@@ -157,6 +183,46 @@ impl Store {
             .map_err(err(&self.path))?;
         }
         tx.commit().map_err(err(&self.path))
+    }
+
+    /// Takes the store's measuring lock: an exclusive lock on the file `<store>.lock` beside it, held until
+    /// the guard is dropped (or the process dies: the operating system releases it). Runs that measure shots
+    /// take it around choosing and tracking them, so that two runs on one store never both track a shot:
+    /// the second waits, then finds the first one's results. `waiting` is called once, with the holder's
+    /// process id when known, if another run holds the lock. An in-memory store needs no lock (`None`).
+    pub fn lock_measuring(&self, waiting: impl FnOnce(Option<u32>)) -> Result<Option<StoreLock>> {
+        if self.path == Path::new(":memory:") {
+            return Ok(None);
+        }
+        let mut name = self.path.as_os_str().to_owned();
+        name.push(".lock");
+        let path = PathBuf::from(name);
+        let io = |source| StoreError::Io {
+            path: path.clone(),
+            source,
+        };
+        let mut file = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .create(true)
+            .truncate(false)
+            .open(&path)
+            .map_err(io)?;
+        match file.try_lock() {
+            Ok(()) => {}
+            Err(std::fs::TryLockError::WouldBlock) => {
+                let holder = std::fs::read_to_string(&path).ok().and_then(|t| t.trim().parse().ok());
+                waiting(holder);
+                file.lock().map_err(io)?;
+            }
+            Err(std::fs::TryLockError::Error(e)) => return Err(io(e)),
+        }
+        use std::io::{Seek, Write};
+        // The holder's pid, for the message another run shows while it waits.
+        let _ = file.set_len(0);
+        let _ = file.seek(std::io::SeekFrom::Start(0));
+        let _ = write!(file, "{}", std::process::id());
+        Ok(Some(StoreLock { _file: file }))
     }
 
     /// The database file (`:memory:` for an in-memory store).
@@ -668,7 +734,8 @@ impl Tx<'_> {
             .map_err(err())
     }
 
-    /// Stores a fit and returns its id.
+    /// Stores a fit and returns its id; a fit identical to one stored (same session, model version and
+    /// result) is not stored twice: its id is returned, so re-running an unchanged analysis adds no row.
     pub fn add_fit(&self, r: &FitRecord) -> Result<i64> {
         self.ensure("model_versions", r.model_version_id)?;
         if let Some(s) = r.session_id {
@@ -676,6 +743,19 @@ impl Tx<'_> {
         }
         if let Err(e) = serde_json::from_str::<serde::de::IgnoredAny>(&r.json) {
             return Err(self.field("fits", "json", format!("is not valid JSON: {e}")));
+        }
+        let same: Option<i64> = self
+            .tx
+            .query_row(
+                "SELECT id FROM fits WHERE session_id IS ?1 AND model_version_id = ?2 AND json = ?3
+                 ORDER BY id DESC LIMIT 1",
+                params![r.session_id, r.model_version_id, r.json],
+                |row| row.get(0),
+            )
+            .optional()
+            .map_err(sql(self.path, "fits"))?;
+        if let Some(id) = same {
+            return Ok(id);
         }
         self.tx
             .query_row(
