@@ -232,11 +232,12 @@ fn track_bad_inputs_exit_1_naming_the_folder() {
         .code(1)
         .stderr(predicate::str::contains("/no/such/clip"));
     let clip = write_session_with_one_clip(dir.path());
+    // A flag's value outside its range is a usage error, refused before anything is read.
     bouncelab()
         .args(["track", clip.to_str().unwrap(), "--fps", "-5"])
         .assert()
-        .code(1)
-        .stderr(predicate::str::contains("fps"));
+        .code(2)
+        .stderr(predicate::str::contains("--fps").and(predicate::str::contains("100–10000000 frames/s")));
 }
 
 /// The 30 frames of `write_session_with_one_clip` as an 8-bit Photron recording (`.cih` text header +

@@ -13,12 +13,12 @@ pub struct Args {
     /// session folder or on its own.
     clip_dir: PathBuf,
     /// Incline of the surface, degrees (default: the clip's angle_deg in the session's clips.csv).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_negative_numbers = true, value_parser = super::settings::parse_angle)]
     angle: Option<f64>,
     #[command(flatten)]
     settings: super::settings::Overrides,
     /// Gravitational acceleration, m/s².
-    #[arg(long, default_value_t = 9.81)]
+    #[arg(long, default_value_t = 9.81, allow_negative_numbers = true, value_parser = super::settings::parse_gravity)]
     gravity: f64,
     /// Print JSON instead of a table.
     #[arg(long)]
@@ -76,6 +76,14 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         println!("{}", serde_json::to_string_pretty(&e)?);
     } else {
         print_table(&a.clip_dir, angle, &e);
+    }
+    // Impossible numbers are printed (they help find the cause) but never pass as a measurement.
+    if !e.flags.is_empty() {
+        anyhow::bail!(
+            "{}: impossible numbers, not a measurement (analyze keeps such a shot out of the fit): {}",
+            a.clip_dir.display(),
+            e.flags.join("; ")
+        );
     }
     Ok(())
 }

@@ -19,14 +19,19 @@ pub struct Args {
     #[arg(long, allow_negative_numbers = true)]
     height: Option<f64>,
     /// Incline of the surface, degrees (the paper's impact angle β).
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = super::settings::parse_angle)]
     angle: f64,
     /// Spin at touch, rad/s, counter-clockwise as seen by the camera.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = parse_spin)]
     spin: f64,
     /// Print JSON instead of a table.
     #[arg(long)]
     json: bool,
+}
+
+/// Spin, rad/s: finite, below 10⁵ rad/s (about 1 million rpm) in magnitude.
+fn parse_spin(text: &str) -> Result<f64, String> {
+    super::settings::number_in(text, (-1e5, 1e5), " rad/s")
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
@@ -35,10 +40,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         bail!("--angle {} must be between -89 and 89 degrees", a.angle);
     }
     let speed = match (a.speed, a.height) {
-        (Some(v), _) if v > 0.0 && v.is_finite() => v,
-        (Some(v), _) => bail!("--speed {v} must be a positive number of m/s"),
-        (None, Some(h)) if h > 0.0 && h.is_finite() => (2.0 * spec.gravity * h).sqrt(),
-        (None, Some(h)) => bail!("--height {h} must be a positive number of metres"),
+        (Some(v), _) if v > 0.0 && v <= 1000.0 => v,
+        (Some(v), _) => bail!("--speed {v} must be a number of m/s in (0, 1000]"),
+        (None, Some(h)) if h > 0.0 && h <= 1000.0 => (2.0 * spec.gravity * h).sqrt(),
+        (None, Some(h)) => bail!("--height {h} must be a number of metres in (0, 1000]"),
         (None, None) => 2.0,
     };
     let surfaces: Vec<Option<String>> = match &a.surface {

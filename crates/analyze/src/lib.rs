@@ -17,7 +17,7 @@ pub use error::AnalyzeError;
 pub use measure::{MeasureSummary, measure_session};
 pub use outputs::{
     COMPARISON_COLUMNS, CURVE_COLUMNS, ESTIMATE_COLUMNS, FORCE_COLUMNS, PREDICTION_COLUMNS, SURFACE_COLUMNS,
-    write_comparison_csv, write_estimates_csv,
+    TrajectoryFiles, trajectory_files, write_comparison_csv, write_estimates_csv,
 };
 pub use report::{track_peak_deceleration, verdict_headline};
 pub use shots::{ShotData, load_failed_tracks, load_shots, measured_shot};
@@ -255,15 +255,19 @@ pub fn analyze(
     let t = std::time::Instant::now();
     let measure = measure_session(&session, &mut store, spec.gravity, options.fingerprint, progress)?;
     timings.push((Stage::Track, t.elapsed().as_secs_f64()));
-    let shots = load_shots(&store, measure.session_id)?;
-    let failed_tracks = load_failed_tracks(&store, measure.session_id)?;
+    let listed = session.listed();
+    let shots = load_shots(&store, measure.session_id, &listed)?;
+    let failed_tracks = load_failed_tracks(&store, measure.session_id, &listed)?;
+    let files = trajectory_files(listed.iter().copied());
     if shots.is_empty() {
         // Nothing to fit, but what was measured is written: the trajectories of the shots that were
         // tracked, an empty estimates.csv, and a report listing every shot's failure and how far it got.
         create_dir(&options.out_dir)?;
+        outputs::clear_partials(&options.out_dir);
         let tracks: Vec<_> = failed_tracks.iter().map(|(c, t, _)| (c.clone(), t.clone())).collect();
-        let mut written = vec![outputs::write_estimates_only(&options.out_dir, &shots, &spec)?];
-        written.extend(outputs::write_failed_trajectories(&options.out_dir, &tracks)?);
+        let mut written = vec![outputs::write_estimates_only(&options.out_dir, &shots, &spec, &files)?];
+        written.extend(outputs::write_failed_trajectories(&options.out_dir, &tracks, &files)?);
+        outputs::remove_stale_trajectories(&options.out_dir, &files)?;
         written.push(report::write_failure(
             &options.out_dir,
             &session,
@@ -277,7 +281,7 @@ pub fn analyze(
             .unwrap_or_else(|| "no shot listed".into());
         return Err(AnalyzeError::NothingMeasured {
             session: session_dir.to_path_buf(),
-            total: session.clips.len(),
+            total: listed.len(),
             first,
             written,
         });
@@ -422,9 +426,11 @@ pub fn analyze(
 
     let t = std::time::Instant::now();
     create_dir(&options.out_dir)?;
-    let mut outputs = outputs::write_all(&options.out_dir, &shots, &fit, &spec)?;
+    outputs::clear_partials(&options.out_dir);
+    let mut outputs = outputs::write_all(&options.out_dir, &shots, &fit, &spec, &files)?;
     let tracks: Vec<_> = failed_tracks.iter().map(|(c, t, _)| (c.clone(), t.clone())).collect();
-    outputs::write_failed_trajectories(&options.out_dir, &tracks)?;
+    outputs::write_failed_trajectories(&options.out_dir, &tracks, &files)?;
+    outputs::remove_stale_trajectories(&options.out_dir, &files)?;
     outputs.push(outputs::write_comparison(&options.out_dir, &comparison)?);
     if let Ok(st) = &stats {
         outputs.push(outputs::write_anova(&options.out_dir, &st.ancova)?);
@@ -447,7 +453,7 @@ pub fn analyze(
     let mut analysis = Analysis {
         fitted_at,
         session_dir: session_dir.to_path_buf(),
-        shots_listed: session.clips.len(),
+        shots_listed: session.listed().len(),
         measure,
         model_origin: spec.origin.clone(),
         model: spec.clone(),

@@ -105,6 +105,33 @@ pub fn measure_session(
         session_id,
         ..MeasureSummary::default()
     };
+    // Held from choosing the shots to the last one written: a second run on this store waits here, then
+    // finds the shots measured instead of tracking them again.
+    let _lock = store.lock_measuring(|holder| {
+        progress.note(&format!(
+            "waiting for another run on {} ({}) to finish measuring",
+            store.path().display(),
+            holder.map_or_else(|| "process unknown".to_string(), |p| format!("process {p}"))
+        ))
+    })?;
+    // A row whose clip cannot be opened fails as a shot, with its reason, and the session goes on.
+    for u in &session.unusable {
+        let record = ShotRecord {
+            clip: u.name.clone(),
+            surface: u.surface.clone(),
+            angle_deg: u.angle_deg,
+            drop_height_m: u.drop_height_m,
+            fps: f64::NAN,
+            metadata: u.metadata.iter().cloned().collect(),
+            frames_hash: Fingerprint::new().str("unusable").str(&u.reason).finish(),
+        };
+        store.transaction(|tx| {
+            let up = tx.upsert_shot(session_id, &record)?;
+            tx.mark_failed(up.id, &u.reason)
+        })?;
+        progress.note(&format!("{}: {}", u.name, u.reason));
+        summary.failed.push((u.name.clone(), u.reason.clone()));
+    }
     let mut jobs = Vec::new();
     for entry in &session.clips {
         let hash = fingerprint_clip_dir(&entry.dir, &settings_text(entry, gravity), fingerprint)?;
@@ -165,9 +192,11 @@ pub fn measure_session(
     if let Some(e) = store_error {
         return Err(e.into());
     }
-    // Shots reused from the store may have failed before: list them too.
+    // Shots reused from the store may have failed before: list them too (those still listed).
+    let listed = session.listed();
     for row in store.shots(session_id)? {
         if row.status == bouncelab_store::ShotStatus::Failed
+            && listed.contains(&row.record.clip.as_str())
             && !summary.failed.iter().any(|(c, _)| *c == row.record.clip)
         {
             summary

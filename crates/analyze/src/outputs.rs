@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 /// The columns of `estimates.csv`, in order. Every name ends in its unit (`_m_s`, `_ms`, `_mm`, `_deg`,
 /// `_rad_s`, `_m_s2`, `_s`, `_m`); `cor`, `mu_eff`, their `_se` and `chi2_red_flight` are dimensionless. A
 /// standard error is `<quantity>_se_<unit>` (see `docs/outputs.md`).
-pub const ESTIMATE_COLUMNS: [&str; 42] = [
+pub const ESTIMATE_COLUMNS: [&str; 43] = [
     "clip",
     "surface",
     "angle_deg",
@@ -53,6 +53,7 @@ pub const ESTIMATE_COLUMNS: [&str; 42] = [
     "surface_tilt_se_deg",
     "flags",
     "notes",
+    "trajectory_file",
 ];
 
 /// The columns of `comparison.csv`: one row per shot, phase and component. `rms` is in `unit` (µm for the
@@ -125,7 +126,11 @@ pub(crate) fn write_atomic(
         path: path.to_path_buf(),
         source,
     };
-    let tmp = path.with_extension("partial");
+    // A short name of its own in the same folder: `<name>.partial` would pass the file system's name limit
+    // for a long legal name.
+    static COUNTER: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let n = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let tmp = path.with_file_name(format!(".partial-{}-{n}", std::process::id()));
     {
         let mut file = std::io::BufWriter::new(std::fs::File::create(&tmp).map_err(io)?);
         write(&mut file).map_err(io)?;
@@ -139,12 +144,14 @@ fn num(v: f64) -> String {
 }
 
 /// `estimates.csv`: one row per measured shot with every estimate and its standard error; the ball's mass
-/// (kg) and gravity (m/s²) turn the track's peak deceleration into a force.
+/// (kg) and gravity (m/s²) turn the track's peak deceleration into a force; `files` maps each clip to its
+/// file under `trajectories/` ([`trajectory_files`]).
 pub fn write_estimates_csv(
     out: &mut dyn Write,
     shots: &[ShotData],
     ball_mass_kg: f64,
     gravity: f64,
+    files: &TrajectoryFiles,
 ) -> Result<(), csv::Error> {
     let mut w = csv::Writer::from_writer(out);
     w.write_record(ESTIMATE_COLUMNS)?;
@@ -209,6 +216,9 @@ pub fn write_estimates_csv(
             tilt_se,
             e.flags.join("; "),
             e.notes.join("; "),
+            files
+                .get(&s.clip)
+                .map_or_else(String::new, |f| format!("trajectories/{f}")),
         ])?;
     }
     w.flush()?;
@@ -225,6 +235,7 @@ fn write_trajectory(out: &mut dyn Write, s: &ShotData) -> Result<(), csv::Error>
 pub(crate) fn write_failed_trajectories(
     dir: &Path,
     tracks: &[(String, bouncelab_store::TrackRecord)],
+    files: &TrajectoryFiles,
 ) -> Result<Vec<PathBuf>, AnalyzeError> {
     let traj = dir.join("trajectories");
     std::fs::create_dir_all(&traj).map_err(|source| AnalyzeError::Io {
@@ -233,7 +244,7 @@ pub(crate) fn write_failed_trajectories(
     })?;
     let mut written = Vec::new();
     for (clip, track) in tracks {
-        let path = traj.join(format!("{}.csv", safe_name(clip)));
+        let path = traj.join(file_for(files, clip));
         write_atomic(&path, |w| write_track_rows(w, track).map_err(csv_io))?;
         written.push(path);
     }
@@ -246,10 +257,11 @@ pub(crate) fn write_estimates_only(
     dir: &Path,
     shots: &[ShotData],
     spec: &bouncelab_model::ModelSpec,
+    files: &TrajectoryFiles,
 ) -> Result<PathBuf, AnalyzeError> {
     let path = dir.join("estimates.csv");
     write_atomic(&path, |w| {
-        write_estimates_csv(w, shots, spec.ball.mass_kg, spec.gravity).map_err(csv_io)
+        write_estimates_csv(w, shots, spec.ball.mass_kg, spec.gravity, files).map_err(csv_io)
     })?;
     Ok(path)
 }
@@ -281,17 +293,101 @@ fn csv_io(e: csv::Error) -> std::io::Error {
     std::io::Error::other(e)
 }
 
-/// A file name for a clip that cannot escape the trajectories folder.
-fn safe_name(clip: &str) -> String {
-    clip.chars()
-        .map(|c| {
-            if c.is_alphanumeric() || "-_.".contains(c) {
-                c
-            } else {
-                '_'
+/// Removes the temporary files ([`write_atomic`]'s `.partial-*`) a killed run left in `dir` and
+/// `dir/trajectories`.
+pub(crate) fn clear_partials(dir: &Path) {
+    for d in [dir.to_path_buf(), dir.join("trajectories")] {
+        let Ok(entries) = std::fs::read_dir(&d) else { continue };
+        for e in entries.flatten() {
+            let name = e.file_name().to_string_lossy().into_owned();
+            let Some(pid) = name.strip_prefix(".partial-").and_then(|r| r.split('-').next()) else {
+                continue;
+            };
+            // Only a dead writer's (known where /proc lists the living): a live run renames its own.
+            let proc = Path::new("/proc");
+            if proc.is_dir() && !proc.join(pid).exists() {
+                let _ = std::fs::remove_file(e.path());
             }
-        })
-        .collect()
+        }
+    }
+}
+
+/// Removes the `.csv` files of `dir/trajectories` that are no clip's file in `files` (clips no longer listed
+/// in `clips.csv`), so that the folder shows exactly the session's clips.
+pub(crate) fn remove_stale_trajectories(dir: &Path, files: &TrajectoryFiles) -> Result<(), AnalyzeError> {
+    let traj = dir.join("trajectories");
+    let Ok(entries) = std::fs::read_dir(&traj) else {
+        return Ok(());
+    };
+    let current: std::collections::HashSet<&str> = files.values().map(String::as_str).collect();
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let Some(name) = name.to_str() else { continue };
+        if name.ends_with(".csv") && !current.contains(name) {
+            let path = entry.path();
+            std::fs::remove_file(&path).map_err(|source| AnalyzeError::Io { path, source })?;
+        }
+    }
+    Ok(())
+}
+
+/// Each clip's file name under `trajectories/` (see [`trajectory_files`]).
+pub type TrajectoryFiles = std::collections::HashMap<String, String>;
+
+/// The file of `clip`: from the map, or (a clip the map was not given, which the pipeline never does) its
+/// own bounded name.
+fn file_for(files: &TrajectoryFiles, clip: &str) -> String {
+    files
+        .get(clip)
+        .cloned()
+        .unwrap_or_else(|| trajectory_files([clip]).remove(clip).unwrap_or_default())
+}
+
+/// Longest clip-derived part of an output file name, in bytes: with the hash suffix and `.csv` the name stays
+/// far below the 255-byte limit of common file systems, with room for a temporary suffix.
+const MAX_STEM_BYTES: usize = 96;
+
+/// The file name under `trajectories/` of each clip, unique and bounded, decided from the names alone (so
+/// the same clips always get the same files, whatever else the session holds). A name that is already a
+/// safe, short file name (letters, digits, `-`, `_`, `.`, not starting with `.`) is kept as it is plus
+/// `.csv`; any other is cleaned, cut to [`MAX_STEM_BYTES`] and given 8 hex digits of a hash of the
+/// original, so `shot 1` and `shot_1` never share a file. Names equal but for case (one file on
+/// case-insensitive file systems) get `-2`, `-3` … in the order given.
+pub fn trajectory_files<'a>(clips: impl IntoIterator<Item = &'a str>) -> TrajectoryFiles {
+    let mut out = std::collections::HashMap::new();
+    let mut taken = std::collections::HashSet::new();
+    for clip in clips {
+        if out.contains_key(clip) {
+            continue;
+        }
+        let clean: String = clip
+            .chars()
+            .map(|c| {
+                if c.is_ascii_alphanumeric() || "-_.".contains(c) {
+                    c
+                } else {
+                    '_'
+                }
+            })
+            .collect();
+        let kept = clean == clip && !clip.is_empty() && !clip.starts_with('.') && clip.len() <= MAX_STEM_BYTES;
+        let mut stem = if kept {
+            clean
+        } else {
+            let mut cut = clean.trim_start_matches('.').to_string();
+            cut.truncate(MAX_STEM_BYTES);
+            let hash = bouncelab_store::Fingerprint::new().str(clip).finish();
+            format!("{cut}-{}", &hash[..8])
+        };
+        let base = stem.clone();
+        let mut n = 1;
+        while !taken.insert(stem.to_ascii_lowercase()) {
+            n += 1;
+            stem = format!("{base}-{n}");
+        }
+        out.insert(clip.to_string(), format!("{stem}.csv"));
+    }
+    out
 }
 
 /// Writes `estimates.csv`, `trajectories/`, `fit.json` and returns their paths.
@@ -300,11 +396,12 @@ pub(crate) fn write_all(
     shots: &[ShotData],
     fit: &FitResult,
     spec: &bouncelab_model::ModelSpec,
+    files: &TrajectoryFiles,
 ) -> Result<Vec<PathBuf>, AnalyzeError> {
     let mut written = Vec::new();
     let path = dir.join("estimates.csv");
     write_atomic(&path, |w| {
-        write_estimates_csv(w, shots, spec.ball.mass_kg, spec.gravity).map_err(csv_io)
+        write_estimates_csv(w, shots, spec.ball.mass_kg, spec.gravity, files).map_err(csv_io)
     })?;
     written.push(path);
     let traj = dir.join("trajectories");
@@ -313,7 +410,7 @@ pub(crate) fn write_all(
         source,
     })?;
     for s in shots {
-        let path = traj.join(format!("{}.csv", safe_name(&s.clip)));
+        let path = traj.join(file_for(files, &s.clip));
         write_atomic(&path, |w| write_trajectory(w, s).map_err(csv_io))?;
     }
     written.push(traj);
@@ -582,6 +679,37 @@ mod tests {
         );
     }
 
+    /// `shot 1` and `shot_1` wrote the same file; a 250-character name passed the name limit.
+    #[test]
+    fn trajectory_files_are_unique_bounded_and_stable() {
+        let long = "é".repeat(200);
+        let clips = [
+            "shot 1",
+            "shot_1",
+            "Shot_1",
+            "../up",
+            ".hidden",
+            "a/b",
+            long.as_str(),
+            "ok-1.2",
+        ];
+        let files = trajectory_files(clips);
+        let mut names: Vec<&String> = files.values().collect();
+        names.sort();
+        names.dedup_by(|a, b| a.eq_ignore_ascii_case(b));
+        assert_eq!(names.len(), clips.len(), "{files:?}");
+        for (clip, f) in &files {
+            assert!(f.len() <= MAX_STEM_BYTES + 20, "{clip}: {f}");
+            assert!(f.ends_with(".csv") && !f.starts_with('.'), "{f}");
+            assert!(f.chars().all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c)), "{f}");
+        }
+        assert_eq!(files["shot_1"], "shot_1.csv");
+        assert_eq!(files["ok-1.2"], "ok-1.2.csv");
+        assert_ne!(files["shot 1"], files["shot_1"]);
+        // The same names give the same files, whatever else is listed.
+        assert_eq!(trajectory_files(["shot 1"])["shot 1"], files["shot 1"]);
+    }
+
     /// Every column name but the text and dimensionless ones ends in a unit.
     #[test]
     fn every_column_names_its_unit() {
@@ -597,6 +725,7 @@ mod tests {
             "chi2_red_flight",
             "contact_line",
             "flags",
+            "trajectory_file",
             "phase",
             "component",
             "unit",

@@ -764,7 +764,7 @@ pub(crate) fn write_failure(
         session: r::SessionInfo {
             path: session.dir.display().to_string(),
             description: String::new(),
-            shots: session.clips.len(),
+            shots: session.listed().len(),
             surfaces: Vec::new(),
             generated_by: format!("bouncelab {}", env!("CARGO_PKG_VERSION")),
             generated_at: None,

@@ -26,14 +26,15 @@ pub struct ShotData {
     pub measured: MeasuredShot,
 }
 
-/// The session's estimated shots, in `clips.csv` order of insertion, read back from the store.
+/// The session's estimated shots among `listed` (the clip names `clips.csv` lists now: a clip removed from
+/// it stays in the store but is not analysed), in order of insertion, read back from the store.
 ///
 /// A stored estimate without its detail (written by an older program) is an error naming the shot: re-run
 /// with the store removed, or touch the clip's folder, to measure it again.
-pub fn load_shots(store: &Store, session_id: i64) -> Result<Vec<ShotData>, AnalyzeError> {
+pub fn load_shots(store: &Store, session_id: i64, listed: &[&str]) -> Result<Vec<ShotData>, AnalyzeError> {
     let mut out = Vec::new();
     for row in store.shots(session_id)? {
-        if row.status != ShotStatus::Estimated {
+        if row.status != ShotStatus::Estimated || !listed.contains(&row.record.clip.as_str()) {
             continue;
         }
         let clip = row.record.clip.clone();
@@ -60,12 +61,17 @@ pub fn load_shots(store: &Store, session_id: i64) -> Result<Vec<ShotData>, Analy
     Ok(out)
 }
 
-/// The stored tracks of the session's shots that could not be estimated, with their failure: (clip, track,
-/// reason). Shots that failed before a track was made are left out (see [`crate::MeasureSummary::failed`]).
-pub fn load_failed_tracks(store: &Store, session_id: i64) -> Result<Vec<(String, TrackRecord, String)>, AnalyzeError> {
+/// The stored tracks of the session's shots among `listed` that could not be estimated, with their
+/// failure: (clip, track, reason). Shots that failed before a track was made are left out (see
+/// [`crate::MeasureSummary::failed`]).
+pub fn load_failed_tracks(
+    store: &Store,
+    session_id: i64,
+    listed: &[&str],
+) -> Result<Vec<(String, TrackRecord, String)>, AnalyzeError> {
     let mut out = Vec::new();
     for row in store.shots(session_id)? {
-        if row.status != ShotStatus::Failed {
+        if row.status != ShotStatus::Failed || !listed.contains(&row.record.clip.as_str()) {
             continue;
         }
         if let Some(track) = store.track(row.id)? {
