@@ -11,6 +11,7 @@
 mod cli;
 mod common;
 mod kills;
+mod physics;
 mod props;
 mod session;
 mod store;

@@ -1,0 +1,155 @@
+//! Physics sanity as a gate, for footage that is wrong in ways only the pictures show: saturated frames,
+//! a ball leaving the frame, two moving balls. The tracker and the estimator own these checks; the cases
+//! that still fail are `#[ignore]`d with what they need.
+
+use crate::common::*;
+use std::path::Path;
+
+/// Every PNG frame of `clip` rewritten by `f`, in file-name order.
+fn rewrite_frames(clip: &Path, mut f: impl FnMut(usize, image::GrayImage) -> image::GrayImage) {
+    let mut frames: Vec<_> = std::fs::read_dir(clip)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "png"))
+        .collect();
+    frames.sort();
+    for (i, p) in frames.iter().enumerate() {
+        let img = image::open(p).unwrap().into_luma8();
+        f(i, img).save(p).unwrap();
+    }
+}
+
+fn gain3(clip: &Path) {
+    rewrite_frames(clip, |_, mut img| {
+        for p in img.pixels_mut() {
+            p.0[0] = p.0[0].saturating_mul(3);
+        }
+        img
+    });
+}
+
+/// Saturated frames (gain ×3) gave COR 3.15 ± 16.6 as a measurement: the shot is flagged and kept out of
+/// the fit (today by its impossible COR and contact time).
+#[test]
+fn saturated_frames_are_kept_out_of_the_fit() {
+    let dir = tempfile::tempdir().unwrap();
+    let session = copy_session(dir.path());
+    gain3(&session.join(CLIPS[0]));
+    let out = dir.path().join("out");
+    let ran = expect(
+        &mut analyze(&session, &out, &dir.path().join("s.sqlite")),
+        0,
+        &["left out of the fit"],
+    );
+    assert!(ran.stderr.contains(CLIPS[0]), "{}", ran.stderr);
+    let fit = std::fs::read_to_string(out.join("fit.json")).unwrap();
+    assert!(!fit.contains(CLIPS[0]));
+}
+
+/// The reason should be the saturation itself, not its consequences.
+#[test]
+#[ignore = "needs the tracker/estimator to detect saturation over the ball's rim and flag it by name (crates/track, crates/estimate)"]
+fn saturated_frames_are_flagged_as_saturated() {
+    let dir = tempfile::tempdir().unwrap();
+    let session = copy_session(dir.path());
+    gain3(&session.join(CLIPS[0]));
+    let out = dir.path().join("out");
+    expect(
+        &mut analyze(&session, &out, &dir.path().join("s.sqlite")),
+        0,
+        &["saturat"],
+    );
+}
+
+/// A ball leaving the frame gave frames marked `ok` far from the truth while it was out of view: every
+/// `ok` frame's circle lies inside the frame and within 5 px of the truth; the others are `cut_by_border`
+/// or absent.
+#[test]
+fn a_ball_cut_by_the_top_edge_is_never_ok_off_the_ball() {
+    // The ball's top is cut in the first frames, then it is whole.
+    ball_leaving_the_frame(110);
+}
+
+/// The same with the ball's centre above the frame at the start and never fully in view (113 of 166
+/// frames marked `ok` with the circle crossing the edge, today).
+#[test]
+#[ignore = "needs the tracker to mark a ball cut by the frame's edge `cut_by_border` (or absent), never `ok` (crates/track)"]
+fn a_ball_mostly_out_of_view_is_never_ok_off_the_ball() {
+    ball_leaving_the_frame(150);
+}
+
+fn ball_leaving_the_frame(top: u32) {
+    let dir = tempfile::tempdir().unwrap();
+    let session = copy_session(dir.path());
+    let clip = session.join(CLIPS[0]);
+    rewrite_frames(&clip, |_, img| {
+        image::imageops::crop_imm(&img, 0, top, img.width(), img.height() - top).to_image()
+    });
+    let truth = smoke().join("truth").join(format!("{}.csv", CLIPS[0]));
+    let truth: Vec<(f64, f64)> = csv::Reader::from_path(truth)
+        .unwrap()
+        .records()
+        .map(|r| {
+            let r = r.unwrap();
+            (r[2].parse().unwrap(), r[3].parse::<f64>().unwrap() - f64::from(top))
+        })
+        .collect();
+    let ran = expect(bouncelab().arg("track").arg(&clip), 0, &[]);
+    let mut r = csv::Reader::from_reader(ran.stdout.as_bytes());
+    let mut bad = Vec::new();
+    for rec in r.records() {
+        let rec = rec.unwrap();
+        if &rec[7] != "ok" {
+            continue;
+        }
+        let frame: usize = rec[0].parse().unwrap();
+        let (x, y, radius): (f64, f64, f64) = (
+            rec[2].parse().unwrap(),
+            rec[3].parse().unwrap(),
+            rec[4].parse().unwrap(),
+        );
+        let (tx, ty) = truth[frame];
+        if y - radius < -0.5 || (x - tx).hypot(y - ty) > 5.0 {
+            bad.push(frame);
+        }
+    }
+    assert!(
+        bad.is_empty(),
+        "top {top}: {} frames marked ok off the ball or cut by the edge: {bad:?}",
+        bad.len()
+    );
+}
+
+/// Two moving balls in one clip were tracked without a word: the track warns that there are two.
+#[test]
+#[ignore = "needs the tracker to notice a second moving ball and warn (crates/track acquire.rs)"]
+fn two_moving_balls_are_reported() {
+    let dir = tempfile::tempdir().unwrap();
+    let session = copy_session(dir.path());
+    let (a, b) = (session.join(CLIPS[0]), session.join(CLIPS[1]));
+    let mut other: Vec<_> = std::fs::read_dir(&b)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "png"))
+        .collect();
+    other.sort();
+    // The second ball, 110 px to the right of its own place, drawn over the first clip (brighter wins).
+    rewrite_frames(&a, |i, mut img| {
+        if let Some(p) = other.get(i) {
+            let o = image::open(p).unwrap().into_luma8();
+            for (x, y, px) in img.enumerate_pixels_mut() {
+                if x >= 110 {
+                    px.0[0] = px.0[0].max(o.get_pixel(x - 110, y).0[0]);
+                }
+            }
+        }
+        img
+    });
+    let ran = expect(bouncelab().arg("track").arg(&a), 0, &[]);
+    let s = ran.stderr.to_lowercase();
+    assert!(
+        s.contains("two") || s.contains("second") || s.contains("several"),
+        "{}",
+        ran.stderr
+    );
+}
