@@ -64,6 +64,10 @@ pub struct Overrides {
     /// (counter-clockwise in the image) [default: found in the image, else from the ball's trajectory].
     #[arg(long, value_parser = parse_line, value_name = "Y[,TILT]", allow_negative_numbers = true)]
     pub line: Option<ContactLine>,
+    /// Largest frame accepted, in pixels, checked from each file's header before decoding (a corrupt or
+    /// hostile header is refused) [default: 67108864 = 8192×8192].
+    #[arg(long, value_name = "PIXELS", value_parser = clap::value_parser!(u64).range(1..))]
+    pub max_frame_pixels: Option<u64>,
 }
 
 impl Overrides {
@@ -75,6 +79,9 @@ impl Overrides {
         o.overrides.scale_m_per_px = self.scale;
         o.overrides.roi = self.roi;
         o.overrides.contact_line = self.line;
+        if let Some(max) = self.max_frame_pixels {
+            o.max_frame_pixels = max;
+        }
         o
     }
 }

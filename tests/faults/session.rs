@@ -313,3 +313,17 @@ fn shuffled_and_reversed_frame_names_are_flagged_and_kept_out_of_the_fit() {
         assert!(!fit.contains(CLIPS[0]), "{order}: not fitted");
     }
 }
+
+/// The frame-size limit is the user's to set (`--max-frame-pixels`): over it, each shot fails from the
+/// header, naming the limit.
+#[test]
+fn the_frame_size_limit_is_configurable() {
+    let dir = tempfile::tempdir().unwrap();
+    let session = copy_session(dir.path());
+    let out = dir.path().join("out");
+    expect(
+        analyze(&session, &out, &dir.path().join("s.sqlite")).args(["--max-frame-pixels", "1000"]),
+        1,
+        &["over the limit of 1000 pixels"],
+    );
+}

@@ -24,8 +24,9 @@ pub struct ClipOptions {
     pub fps: Option<f64>,
     /// Geometry overrides (from the command line); each beats `clip.toml` and `session.toml`.
     pub overrides: SettingOverrides,
-    /// Largest frame accepted from a camera file's header, in pixels (default 2²⁶ = 8192 × 8192): a
-    /// corrupt header is refused before anything is allocated for it.
+    /// Largest frame accepted, in pixels (default 2²⁶ = 8192 × 8192), checked from a camera file's header
+    /// or a folder's first frame's header: a corrupt or hostile header is refused before anything is
+    /// allocated for it.
     pub max_frame_pixels: u64,
 }
 

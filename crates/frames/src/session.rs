@@ -4,7 +4,7 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-use crate::camera::{CameraFile, DEFAULT_MAX_FRAME_PIXELS, Kind};
+use crate::camera::{CameraFile, Kind};
 use crate::clip::{Clip, ClipOptions};
 use crate::error::{FramesError, Result, UnfilledRow};
 use crate::settings::{
@@ -49,6 +49,8 @@ pub struct ClipEntry {
     /// Scale, ball diameter, region of interest and contact line, each with its source (`clip.toml` >
     /// `session.toml` > default).
     pub settings: ClipSettings,
+    /// Largest frame accepted when the clip is opened, in pixels ([`ClipOptions::max_frame_pixels`]).
+    pub max_frame_pixels: u64,
 }
 
 impl ClipEntry {
@@ -65,7 +67,7 @@ impl ClipEntry {
             self.fps,
             self.fps_source.clone(),
             self.settings.clone(),
-            DEFAULT_MAX_FRAME_PIXELS,
+            self.max_frame_pixels,
         )
     }
 }
@@ -225,7 +227,7 @@ fn entry(
         // fails when the clip is measured, with its own error.
         let header_fps = Kind::of(&clip_dir)
             .filter(|_| clip_dir.is_file())
-            .and_then(|kind| CameraFile::open(&clip_dir, kind, DEFAULT_MAX_FRAME_PIXELS).ok())
+            .and_then(|kind| CameraFile::open(&clip_dir, kind, options.max_frame_pixels).ok())
             .and_then(|c| c.info.fps.map(|f| (f, c.path)));
         let fps = choose_fps(
             &clip_dir,
@@ -273,6 +275,7 @@ fn entry(
         metadata: row.metadata,
         line: row.line,
         settings,
+        max_frame_pixels: options.max_frame_pixels,
     })
 }
 

@@ -221,3 +221,15 @@ fn bomb_headers_are_refused_before_decoding() {
         "{err:?}"
     );
 }
+
+/// The frame-size limit given to a session reaches its clips.
+#[test]
+fn a_sessions_frame_size_limit_reaches_its_clips() {
+    let tmp = session3();
+    let mut options = ClipOptions::default();
+    options.max_frame_pixels = 10;
+    let s = Session::load_with(tmp.path(), &options).unwrap();
+    let err = s.clips[0].open().unwrap_err();
+    assert!(matches!(err, FramesError::FrameTooLarge { limit: 10, .. }), "{err:?}");
+    assert!(Session::load(tmp.path()).unwrap().clips[0].open().is_ok());
+}
