@@ -13,11 +13,6 @@ use std::path::{Path, PathBuf};
 /// Clips up to this many frames are drawn whole by default; longer ones every N-th frame to about this many.
 const DEFAULT_MAX_PICTURES: u64 = 500;
 
-/// A magnification from 1/16 to 16: a larger one would allocate pictures of gigapixels.
-fn parse_zoom(text: &str) -> Result<f64, String> {
-    super::settings::number_in(text, (1.0 / 16.0, 16.0), "")
-}
-
 #[derive(clap::Args)]
 pub struct Args {
     /// Folder of frames (one clip).
@@ -27,13 +22,13 @@ pub struct Args {
     out: Option<PathBuf>,
     /// Draw every N-th frame (default: every frame of a clip up to 500 frames, else about 500 frames);
     /// the key frames are always drawn.
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    #[arg(long)]
     every: Option<u64>,
     /// Write only the contact sheet of the key frames, no per-frame pictures.
     #[arg(long)]
     sheet: bool,
     /// Magnification of the per-frame pictures (2 doubles their width and height).
-    #[arg(long, default_value_t = 1.0, value_parser = parse_zoom)]
+    #[arg(long, default_value_t = 1.0)]
     zoom: f64,
     /// Gray levels: the file's full scale, or stretched to the clip's range (0.5–99.5 % of the first frame;
     /// for 12-bit cameras writing 16-bit files, or dark footage).

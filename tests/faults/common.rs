@@ -141,3 +141,30 @@ pub fn rename_row(session: &Path, from: &str, to: &str) {
         .collect();
     std::fs::write(&path, text.join("\n") + "\n").unwrap();
 }
+
+/// The PNG frames of `clip`, in file-name order.
+pub fn png_frames(clip: &Path) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(clip)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "png"))
+        .collect();
+    v.sort();
+    v
+}
+
+/// Renames the frames of `clip` so that the k-th in time gets number `to(k, n)` (`frame_NNNNNN.png`).
+pub fn permute_frames(clip: &Path, to: impl Fn(usize, usize) -> usize) {
+    let frames = png_frames(clip);
+    let n = frames.len();
+    for (k, f) in frames.iter().enumerate() {
+        std::fs::rename(f, clip.join(format!("tmp_{:06}.png", to(k, n)))).unwrap();
+    }
+    for k in 0..n {
+        std::fs::rename(
+            clip.join(format!("tmp_{k:06}.png")),
+            clip.join(format!("frame_{k:06}.png")),
+        )
+        .unwrap();
+    }
+}

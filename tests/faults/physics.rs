@@ -7,12 +7,7 @@ use std::path::Path;
 
 /// Every PNG frame of `clip` rewritten by `f`, in file-name order.
 fn rewrite_frames(clip: &Path, mut f: impl FnMut(usize, image::GrayImage) -> image::GrayImage) {
-    let mut frames: Vec<_> = std::fs::read_dir(clip)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "png"))
-        .collect();
-    frames.sort();
+    let frames = png_frames(clip);
     for (i, p) in frames.iter().enumerate() {
         let img = image::open(p).unwrap().into_luma8();
         f(i, img).save(p).unwrap();
@@ -127,12 +122,7 @@ fn two_moving_balls_are_reported() {
     let dir = tempfile::tempdir().unwrap();
     let session = copy_session(dir.path());
     let (a, b) = (session.join(CLIPS[0]), session.join(CLIPS[1]));
-    let mut other: Vec<_> = std::fs::read_dir(&b)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "png"))
-        .collect();
-    other.sort();
+    let other = png_frames(&b);
     // The second ball, 110 px to the right of its own place, drawn over the first clip (brighter wins).
     rewrite_frames(&a, |i, mut img| {
         if let Some(p) = other.get(i) {

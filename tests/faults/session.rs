@@ -182,13 +182,8 @@ fn a_frame_number_above_i64_max_fails_that_shot_naming_the_file() {
     let dir = tempfile::tempdir().unwrap();
     let session = copy_session(dir.path());
     let clip = session.join(CLIPS[0]);
-    let mut frames: Vec<_> = std::fs::read_dir(&clip).unwrap().map(|e| e.unwrap().path()).collect();
-    frames.sort();
-    let last = frames
-        .iter()
-        .rev()
-        .find(|p| p.extension().is_some_and(|e| e == "png"))
-        .unwrap();
+    let frames = png_frames(&clip);
+    let last = frames.last().unwrap();
     std::fs::rename(last, clip.join("frame_99999999999999999999.png")).unwrap();
     let out = dir.path().join("out");
     expect(
@@ -233,12 +228,7 @@ fn corrupt_frames_fail_their_shot_naming_file_and_frame() {
         let root = dir.path().join(i.to_string());
         let session = copy_session(&root);
         let clip = session.join(CLIPS[0]);
-        let mut frames: Vec<_> = std::fs::read_dir(&clip)
-            .unwrap()
-            .map(|e| e.unwrap().path())
-            .filter(|p| p.extension().is_some_and(|e| e == "png"))
-            .collect();
-        frames.sort();
+        let frames = png_frames(&clip);
         let victim = &frames[frames.len() / 2];
         let bytes = std::fs::read(victim).unwrap();
         match spoil {
@@ -266,38 +256,20 @@ fn shuffled_and_reversed_frame_names_are_flagged_and_kept_out_of_the_fit() {
         let root = dir.path().join(i.to_string());
         let session = copy_session(&root);
         let clip = session.join(CLIPS[0]);
-        let mut frames: Vec<_> = std::fs::read_dir(&clip)
-            .unwrap()
-            .map(|e| e.unwrap().path())
-            .filter(|p| p.extension().is_some_and(|e| e == "png"))
-            .collect();
-        frames.sort();
-        let n = frames.len();
-        // A fixed permutation: reversed, or a stride coprime with n (a thorough shuffle, the same every run).
         let gcd = |mut a: usize, mut b: usize| {
             while b != 0 {
                 (a, b) = (b, a % b);
             }
             a
         };
-        let stride = (n / 3..n).find(|&s| gcd(s, n) == 1).unwrap();
-        let to = |k: usize| {
+        // Reversed, or a stride coprime with n: a thorough shuffle, the same every run.
+        permute_frames(&clip, |k, n| {
             if order == "reversed" {
                 n - 1 - k
             } else {
-                (k * stride) % n
+                k * (n / 3..n).find(|&s| gcd(s, n) == 1).unwrap() % n
             }
-        };
-        for (k, f) in frames.iter().enumerate() {
-            std::fs::rename(f, clip.join(format!("tmp_{:06}.png", to(k)))).unwrap();
-        }
-        for k in 0..n {
-            std::fs::rename(
-                clip.join(format!("tmp_{k:06}.png")),
-                clip.join(format!("frame_{k:06}.png")),
-            )
-            .unwrap();
-        }
+        });
         let out = root.join("out");
         let ran = expect(
             &mut analyze(&session, &out, &root.join("s.sqlite")),
