@@ -5,6 +5,7 @@
 //! (12-bit values `<< 4`), so that [`crate::GrayPixels::U16`] always means 0–65535.
 
 use std::mem::MaybeUninit;
+use std::sync::Mutex;
 
 /// 12-bit big-endian packing, two pixels in three bytes: `p0 = b0·16 + b1 >> 4`,
 /// `p1 = (b1 & 15)·256 + b2` (Photron MRAW 12-bit; Phantom CINE "P12L"), at 16-bit full scale (`<< 4`).
@@ -52,11 +53,10 @@ fn extend16_le(out: &mut Vec<u16>, src: &[u8], shift: u32) {
     out.extend(src.chunks_exact(2).map(|s| u16::from_le_bytes([s[0], s[1]]) << shift));
 }
 
-/// A frame of little-endian 16-bit samples, rows reversed if `bottom_up`, in a new buffer that is written
-/// once (no zero-fill first).
+/// Appends a frame of little-endian 16-bit samples to `out` (empty, with room for them), rows reversed if
+/// `bottom_up`: each sample is written once (no zero-fill first).
 #[inline(always)]
-fn copy16_le(src: &[u8], w: usize, shift: u32, bottom_up: bool) -> Vec<u16> {
-    let mut out = Vec::with_capacity(src.len() / 2);
+fn copy16_le(src: &[u8], w: usize, shift: u32, bottom_up: bool, mut out: Vec<u16>) -> Vec<u16> {
     if bottom_up {
         for row in src.chunks_exact(2 * w).rev() {
             extend16_le(&mut out, row, shift);
@@ -65,6 +65,54 @@ fn copy16_le(src: &[u8], w: usize, shift: u32, bottom_up: bool) -> Vec<u16> {
         extend16_le(&mut out, src, shift);
     }
     out
+}
+
+/// Frame buffers the consumer gave back ([`crate::Clip::recycle`]), reused for the next frames decoded.
+///
+/// Why: frames are decoded on worker threads and dropped on the consumer's, so the allocator hands each new
+/// frame fresh pages from the kernel (a page fault and the kernel's zero-fill a page, and an `madvise` when
+/// the consumer frees it): on the 2-thread stream this cost about 3× the unpacking itself. A reused buffer
+/// is already mapped.
+#[derive(Debug, Default)]
+pub(crate) struct Pool {
+    gray8: Mutex<Vec<Vec<u8>>>,
+    gray16: Mutex<Vec<Vec<u16>>>,
+}
+
+/// Most bytes of buffers a pool keeps (beyond two buffers): enough for the frames in flight of a stream of
+/// 512×512 frames, bounded for large frames.
+const POOL_BYTES: usize = 64 << 20;
+
+/// Most buffers a pool keeps.
+const POOL_BUFFERS: usize = 32;
+
+impl Pool {
+    /// An empty buffer with room for `n` samples: a recycled one when there is one.
+    fn take<T>(list: &Mutex<Vec<Vec<T>>>, n: usize) -> Vec<T> {
+        let mut v = list.lock().map(|mut l| l.pop()).ok().flatten().unwrap_or_default();
+        v.clear();
+        v.reserve_exact(n);
+        v
+    }
+
+    fn keep<T>(list: &Mutex<Vec<Vec<T>>>, v: Vec<T>) {
+        let bytes = v.capacity() * std::mem::size_of::<T>();
+        let most = (POOL_BYTES / bytes.max(1)).clamp(2, POOL_BUFFERS);
+        if let Ok(mut l) = list.lock()
+            && l.len() < most
+        {
+            l.push(v);
+        }
+    }
+
+    /// Keeps a frame's buffer for reuse if it holds at least `n` samples (and the pool is not full).
+    pub(crate) fn give(&self, pixels: crate::GrayPixels, n: usize) {
+        match pixels {
+            crate::GrayPixels::U8(i) if i.as_raw().capacity() >= n => Self::keep(&self.gray8, i.into_raw()),
+            crate::GrayPixels::U16(i) if i.as_raw().capacity() >= n => Self::keep(&self.gray16, i.into_raw()),
+            _ => {}
+        }
+    }
 }
 
 /// How a frame's samples are stored.
@@ -103,30 +151,29 @@ impl Packing {
     }
 
     /// Unpacks `src` (exactly one frame, `rows` of `width` pixels, stored top row first unless
-    /// `bottom_up`) to gray pixels.
-    pub(crate) fn unpack(self, src: &[u8], width: u32, height: u32, bottom_up: bool) -> crate::GrayPixels {
+    /// `bottom_up`) to gray pixels, in a buffer from `pool` when it has one.
+    pub(crate) fn unpack(self, src: &[u8], width: u32, height: u32, bottom_up: bool, pool: &Pool) -> crate::GrayPixels {
         let (w, h) = (width as usize, height as usize);
         match self {
             Self::U8 => {
-                let buf = if bottom_up {
-                    let mut out = Vec::with_capacity(w * h);
+                let mut buf = Pool::take(&pool.gray8, w * h);
+                if bottom_up {
                     for row in src.chunks_exact(w).rev() {
-                        out.extend_from_slice(row);
+                        buf.extend_from_slice(row);
                     }
-                    out
                 } else {
-                    src.to_vec()
-                };
+                    buf.extend_from_slice(src);
+                }
                 crate::GrayPixels::U8(image::GrayImage::from_raw(width, height, buf).expect("size checked by caller"))
             }
             Self::U16Le(shift) => {
-                let out = fast_copy16_le(src, w, shift, bottom_up);
+                let out = fast_copy16_le(src, w, shift, bottom_up, Pool::take(&pool.gray16, w * h));
                 crate::GrayPixels::U16(
                     crate::Gray16Image::from_raw(width, height, out).expect("size checked by caller"),
                 )
             }
             Self::P10 | Self::P12 => {
-                let out = unpack_packed(self, src, w * h);
+                let out = unpack_packed(self, src, w * h, Pool::take(&pool.gray16, w * h));
                 crate::GrayPixels::U16(
                     crate::Gray16Image::from_raw(width, height, out).expect("size checked by caller"),
                 )
@@ -135,10 +182,11 @@ impl Packing {
     }
 }
 
-/// Unpacks a frame of `n` packed samples (stored top-down) into a new buffer, written once: the loops fill
-/// the buffer's uninitialised capacity, which saves the zero-fill pass over a frame's worth of memory.
-fn unpack_packed(packing: Packing, src: &[u8], n: usize) -> Vec<u16> {
-    let mut out = Vec::with_capacity(n);
+/// Unpacks a frame of `n` packed samples (stored top-down) into `out` (emptied first), written once: the
+/// loops fill the buffer's uninitialised capacity, which saves a zero-fill pass over a frame's memory.
+fn unpack_packed(packing: Packing, src: &[u8], n: usize, mut out: Vec<u16>) -> Vec<u16> {
+    out.clear();
+    out.reserve_exact(n);
     let dst = &mut out.spare_capacity_mut()[..n];
     match packing {
         Packing::P10 => fast_unpack10(src, dst),
@@ -170,7 +218,7 @@ dispatched!(fn fast_unpack12(src: &[u8], dst: &mut [MaybeUninit<u16>]) -> ();
     avx2: avx2::unpack12, baseline: unpack12);
 dispatched!(fn fast_unpack10(src: &[u8], dst: &mut [MaybeUninit<u16>]) -> ();
     avx2: avx2::unpack10, baseline: unpack10);
-dispatched!(fn fast_copy16_le(src: &[u8], w: usize, shift: u32, bottom_up: bool) -> Vec<u16>;
+dispatched!(fn fast_copy16_le(src: &[u8], w: usize, shift: u32, bottom_up: bool, out: Vec<u16>) -> Vec<u16>;
     avx2: avx2::copy16_le, baseline: copy16_le);
 
 /// The same loops for CPUs with AVX2.
@@ -192,8 +240,8 @@ mod avx2 {
     use std::mem::MaybeUninit;
 
     #[target_feature(enable = "avx2")]
-    pub(super) fn copy16_le(src: &[u8], w: usize, shift: u32, bottom_up: bool) -> Vec<u16> {
-        super::copy16_le(src, w, shift, bottom_up)
+    pub(super) fn copy16_le(src: &[u8], w: usize, shift: u32, bottom_up: bool, out: Vec<u16>) -> Vec<u16> {
+        super::copy16_le(src, w, shift, bottom_up, out)
     }
 
     /// Loads `lo[..16]` into the low lane and `hi[..16]` into the high lane.
@@ -301,7 +349,7 @@ mod tests {
     }
 
     fn decoded(packing: Packing, src: &[u8], w: usize, h: usize, bottom_up: bool) -> Vec<u16> {
-        match packing.unpack(src, w as u32, h as u32, bottom_up) {
+        match packing.unpack(src, w as u32, h as u32, bottom_up, &Pool::default()) {
             crate::GrayPixels::U8(i) => i.into_raw().into_iter().map(u16::from).collect(),
             crate::GrayPixels::U16(i) => i.into_raw(),
         }
@@ -372,11 +420,70 @@ mod tests {
     }
 
     #[test]
+    fn a_recycled_buffer_is_reused_and_overwritten_whole() {
+        let pool = Pool::default();
+        let (w, h) = (40usize, 3usize);
+        let src: Vec<u8> = (0..w * h * 2).map(|i| (i * 37 % 256) as u8).collect();
+        for packing in [Packing::P12, Packing::U16Le(4), Packing::U8] {
+            let bytes = &src[..packing.frame_bytes((w * h) as u64).unwrap() as usize];
+            let first = packing.unpack(bytes, w as u32, h as u32, false, &pool);
+            let ptr = match &first {
+                crate::GrayPixels::U8(i) => i.as_raw().as_ptr() as usize,
+                crate::GrayPixels::U16(i) => i.as_raw().as_ptr() as usize,
+            };
+            // A buffer holding other values, given back, comes out holding this frame's values only.
+            let dirty = match first {
+                crate::GrayPixels::U8(_) => {
+                    crate::GrayPixels::U8(image::GrayImage::from_pixel(w as u32, h as u32, image::Luma([7])))
+                }
+                crate::GrayPixels::U16(_) => {
+                    crate::GrayPixels::U16(crate::Gray16Image::from_pixel(w as u32, h as u32, image::Luma([7])))
+                }
+            };
+            let dirty_ptr = match &dirty {
+                crate::GrayPixels::U8(i) => i.as_raw().as_ptr() as usize,
+                crate::GrayPixels::U16(i) => i.as_raw().as_ptr() as usize,
+            };
+            assert_ne!(ptr, dirty_ptr);
+            pool.give(dirty, w * h);
+            let again = packing.unpack(bytes, w as u32, h as u32, false, &pool);
+            let again_ptr = match &again {
+                crate::GrayPixels::U8(i) => i.as_raw().as_ptr() as usize,
+                crate::GrayPixels::U16(i) => i.as_raw().as_ptr() as usize,
+            };
+            assert_eq!(again_ptr, dirty_ptr, "{packing:?}: the given buffer is reused");
+            assert_eq!(
+                decoded(packing, bytes, w, h, false),
+                reference(packing, bytes, w, h, false)
+            );
+            let values: Vec<u16> = match again {
+                crate::GrayPixels::U8(i) => i.into_raw().into_iter().map(u16::from).collect(),
+                crate::GrayPixels::U16(i) => i.into_raw(),
+            };
+            assert_eq!(values, reference(packing, bytes, w, h, false), "{packing:?}");
+        }
+    }
+
+    #[test]
+    fn the_pool_keeps_a_bounded_number_of_buffers_and_none_too_small() {
+        let pool = Pool::default();
+        for _ in 0..100 {
+            pool.give(crate::GrayPixels::U16(crate::Gray16Image::new(8, 8)), 64);
+        }
+        assert_eq!(pool.gray16.lock().unwrap().len(), POOL_BUFFERS);
+        pool.give(crate::GrayPixels::U8(image::GrayImage::new(4, 4)), 64);
+        assert!(
+            pool.gray8.lock().unwrap().is_empty(),
+            "a 16-pixel buffer is no use for 64-pixel frames"
+        );
+    }
+
+    #[test]
     fn sixteen_bit_rows_flip_when_stored_bottom_up() {
         let src: Vec<u8> = [1u16, 2, 3, 4, 5, 6].iter().flat_map(|v| v.to_le_bytes()).collect();
-        let px = Packing::U16Le(0).unpack(&src, 3, 2, true);
+        let px = Packing::U16Le(0).unpack(&src, 3, 2, true, &Pool::default());
         assert_eq!(px.as_u16().unwrap().as_raw(), &vec![4, 5, 6, 1, 2, 3]);
-        let px = Packing::U8.unpack(&[1, 2, 3, 4], 2, 2, true);
+        let px = Packing::U8.unpack(&[1, 2, 3, 4], 2, 2, true, &Pool::default());
         assert_eq!(px.as_u8().unwrap().as_raw(), &vec![3, 4, 1, 2]);
     }
 }
