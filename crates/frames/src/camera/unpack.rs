@@ -1,8 +1,9 @@
 //! Bit unpacking from camera files into 16-bit samples: the hot loops of camera-file decoding.
 //!
-//! Every function writes exactly `dst.len()` samples and expects `src` to hold exactly enough bytes for them
-//! (the callers check sizes against the header first). The shift puts a narrower sample at 16-bit full scale
-//! (12-bit values `<< 4`), so that [`crate::GrayPixels::U16`] always means 0–65535.
+//! Every loop writes exactly `dst.len()` samples and asserts that `src` holds exactly the bytes for them
+//! (the callers check sizes against the header first). A narrower sample is shifted to 16-bit full scale
+//! (12-bit values `<< 4`), so that [`crate::GrayPixels::U16`] always means 0–65535. Each frame is written once
+//! into a buffer that is either new or given back by the consumer ([`Pool`]).
 
 use std::mem::MaybeUninit;
 use std::sync::Mutex;
