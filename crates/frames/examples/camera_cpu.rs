@@ -15,7 +15,6 @@ use std::hint::black_box;
 use std::time::Instant;
 
 use bouncelab_frames::{Clip, ClipOptions, ReadOptions};
-use camera::{Cine, CinePacking, Mraw, TiffCompression, moving_disc, write_tiff_stack};
 
 const N: usize = 64;
 const SIDE: u32 = 512;
@@ -34,30 +33,7 @@ fn main() {
     let passes: usize = args.next().map_or(40, |a| a.parse().expect("PASSES"));
     let repeats: usize = args.next().map_or(3, |a| a.parse().expect("REPEATS"));
     let tmp = tempfile::tempdir().expect("temp dir");
-    let d = tmp.path();
-    let frames = |max| moving_disc(SIDE, SIDE, N, max, 7);
-    let mut clips = Vec::new();
-    for bits in [8u32, 12, 16] {
-        let max = if bits == 8 { 255 } else { 4095 };
-        let header = Mraw::new(SIDE, SIDE, bits).write(d, &format!("m{bits}"), &frames(max));
-        clips.push((format!("mraw_{bits}bit"), header));
-    }
-    for (label, packing, max) in [
-        ("cine_8bit", CinePacking::U8, 255),
-        ("cine_10bit_packed", CinePacking::P10, 1023),
-        ("cine_12bit_packed", CinePacking::P12, 4095),
-        ("cine_16bit", CinePacking::U16 { real_bpp: 12 }, 4095),
-    ] {
-        let path = d.join(format!("{label}.cine"));
-        Cine::new(SIDE, SIDE, packing).write(&path, &frames(max));
-        clips.push((label.to_string(), path));
-    }
-    for (label, bits) in [("tiff_8bit", 8), ("tiff_16bit", 16)] {
-        let path = d.join(format!("{label}.tif"));
-        let max = if bits == 8 { 255 } else { 65535 };
-        write_tiff_stack(&path, SIDE, SIDE, bits, &frames(max), TiffCompression::None);
-        clips.push((label.to_string(), path));
-    }
+    let clips = camera::speed_files(tmp.path(), SIDE, N, false);
     let read = ReadOptions::with_threads(1);
     let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
     println!(

@@ -265,52 +265,69 @@ mod avx2 {
         unsafe { _mm256_storeu_si256(dst.as_mut_ptr().cast::<__m256i>(), v) }
     }
 
-    /// 10-bit packing, 16 samples (20 bytes) a step; the last groups, whose 16-byte loads would run past
-    /// `src`, by the scalar loop.
+    /// How one kind of packing becomes 16 samples a step (see the module's doc).
+    struct Lanes {
+        /// Packed bytes read a step: 8 samples a lane.
+        step: usize,
+        /// Byte pairs (high, low) of each sample's 16-bit window, within a lane's bytes.
+        windows: __m256i,
+        /// The power of two that moves each sample to the top of its window.
+        to_top: __m256i,
+        /// The bits of a sample at the top of its window.
+        keep: __m256i,
+    }
+
+    /// Unpacks `src` into `dst`, 16 samples a step, then the last groups (whose 16-byte loads would run
+    /// past `src`) by the scalar loop `tail`.
+    #[target_feature(enable = "avx2")]
+    fn unpack(src: &[u8], dst: &mut [MaybeUninit<u16>], l: &Lanes, tail: fn(&[u8], &mut [MaybeUninit<u16>])) {
+        let half = l.step / 2;
+        let (mut i, mut o) = (0, 0);
+        // The high lane's load reads bytes i + half .. i + half + 16.
+        while src.len() - i >= half + 16 {
+            let v = _mm256_shuffle_epi8(load_lanes(&src[i..], &src[i + half..]), l.windows);
+            store16(&mut dst[o..], _mm256_and_si256(_mm256_mullo_epi16(v, l.to_top), l.keep));
+            i += l.step;
+            o += 16;
+        }
+        tail(&src[i..], &mut dst[o..]);
+    }
+
+    /// 10-bit packing, 20 bytes a step.
     #[target_feature(enable = "avx2")]
     pub(super) fn unpack10(src: &[u8], dst: &mut [MaybeUninit<u16>]) {
         assert_eq!(src.len() * 4, dst.len() * 5, "10-bit packing: 5 bytes for 4 samples");
-        // Byte pairs (high, low) of each sample's window: sample j of a 5-byte group starts in byte j.
         #[rustfmt::skip]
-        let windows = _mm256_setr_epi8(
-            1, 0, 2, 1, 3, 2, 4, 3, 6, 5, 7, 6, 8, 7, 9, 8,
-            1, 0, 2, 1, 3, 2, 4, 3, 6, 5, 7, 6, 8, 7, 9, 8,
-        );
-        // Sample j sits 6 − 2j bits up its window: move it to the top (× 4^j), clear the 6 bits below.
-        let to_top = _mm256_setr_epi16(1, 4, 16, 64, 1, 4, 16, 64, 1, 4, 16, 64, 1, 4, 16, 64);
-        let keep = _mm256_set1_epi16(0xFFC0_u16 as i16);
-        let (mut i, mut o) = (0, 0);
-        // The high lane's load reads bytes i + 10 .. i + 26.
-        while src.len() - i >= 26 {
-            let v = _mm256_shuffle_epi8(load_lanes(&src[i..], &src[i + 10..]), windows);
-            store16(&mut dst[o..], _mm256_and_si256(_mm256_mullo_epi16(v, to_top), keep));
-            i += 20;
-            o += 16;
-        }
-        super::unpack10(&src[i..], &mut dst[o..]);
+        let lanes = Lanes {
+            step: 20,
+            // Sample j of a 5-byte group starts in byte j, 6 − 2j bits up its window: × 4^j, keep 10 bits.
+            windows: _mm256_setr_epi8(
+                1, 0, 2, 1, 3, 2, 4, 3, 6, 5, 7, 6, 8, 7, 9, 8,
+                1, 0, 2, 1, 3, 2, 4, 3, 6, 5, 7, 6, 8, 7, 9, 8,
+            ),
+            to_top: _mm256_setr_epi16(1, 4, 16, 64, 1, 4, 16, 64, 1, 4, 16, 64, 1, 4, 16, 64),
+            keep: _mm256_set1_epi16(0xFFC0_u16 as i16),
+        };
+        unpack(src, dst, &lanes, super::unpack10);
     }
 
-    /// 12-bit packing, 16 samples (24 bytes) a step; the last groups by the scalar loop.
+    /// 12-bit packing, 24 bytes a step.
     #[target_feature(enable = "avx2")]
     pub(super) fn unpack12(src: &[u8], dst: &mut [MaybeUninit<u16>]) {
         assert_eq!(src.len() * 2, dst.len() * 3, "12-bit packing: 3 bytes for 2 samples");
-        // Sample 2k starts at bit 0 of byte 3k, sample 2k + 1 at bit 4 of byte 3k + 1.
         #[rustfmt::skip]
-        let windows = _mm256_setr_epi8(
-            1, 0, 2, 1, 4, 3, 5, 4, 7, 6, 8, 7, 10, 9, 11, 10,
-            1, 0, 2, 1, 4, 3, 5, 4, 7, 6, 8, 7, 10, 9, 11, 10,
-        );
-        let to_top = _mm256_setr_epi16(1, 16, 1, 16, 1, 16, 1, 16, 1, 16, 1, 16, 1, 16, 1, 16);
-        let keep = _mm256_set1_epi16(0xFFF0_u16 as i16);
-        let (mut i, mut o) = (0, 0);
-        // The high lane's load reads bytes i + 12 .. i + 28.
-        while src.len() - i >= 28 {
-            let v = _mm256_shuffle_epi8(load_lanes(&src[i..], &src[i + 12..]), windows);
-            store16(&mut dst[o..], _mm256_and_si256(_mm256_mullo_epi16(v, to_top), keep));
-            i += 24;
-            o += 16;
-        }
-        super::unpack12(&src[i..], &mut dst[o..]);
+        let lanes = Lanes {
+            step: 24,
+            // Sample 2k fills the top 12 bits of the window of bytes 3k, 3k + 1 (× 1), sample 2k + 1 the
+            // low 12 bits of bytes 3k + 1, 3k + 2 (× 16); keep 12 bits.
+            windows: _mm256_setr_epi8(
+                1, 0, 2, 1, 4, 3, 5, 4, 7, 6, 8, 7, 10, 9, 11, 10,
+                1, 0, 2, 1, 4, 3, 5, 4, 7, 6, 8, 7, 10, 9, 11, 10,
+            ),
+            to_top: _mm256_setr_epi16(1, 16, 1, 16, 1, 16, 1, 16, 1, 16, 1, 16, 1, 16, 1, 16),
+            keep: _mm256_set1_epi16(0xFFF0_u16 as i16),
+        };
+        unpack(src, dst, &lanes, super::unpack12);
     }
 }
 
