@@ -24,19 +24,20 @@ fn gain3(clip: &Path) {
 }
 
 /// Saturated frames (gain ×3) gave COR 3.15 ± 16.6 as a measurement: the shot is flagged and kept out of
-/// the fit (today by its impossible COR and contact time).
+/// the fit (exit 0, by its impossible numbers) or fails (exit 1, its flight cannot be fitted); never
+/// fitted.
 #[test]
 fn saturated_frames_are_kept_out_of_the_fit() {
     let dir = tempfile::tempdir().unwrap();
     let session = copy_session(dir.path());
     gain3(&session.join(CLIPS[0]));
     let out = dir.path().join("out");
-    let ran = expect(
-        &mut analyze(&session, &out, &dir.path().join("s.sqlite")),
-        0,
-        &["left out of the fit"],
-    );
-    assert!(ran.stderr.contains(CLIPS[0]), "{}", ran.stderr);
+    let o = analyze(&session, &out, &dir.path().join("s.sqlite")).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!err.contains("panicked"), "{err}");
+    let kept_out = o.status.code() == Some(0) && err.contains("left out of the fit");
+    let failed = o.status.code() == Some(1) && err.contains("could not be measured");
+    assert!((kept_out || failed) && err.contains(CLIPS[0]), "{:?}: {err}", o.status);
     let fit = std::fs::read_to_string(out.join("fit.json")).unwrap();
     assert!(!fit.contains(CLIPS[0]));
 }
@@ -65,8 +66,8 @@ fn a_ball_cut_by_the_top_edge_is_never_ok_off_the_ball() {
     ball_leaving_the_frame(110);
 }
 
-/// The same with the ball's centre above the frame at the start and never fully in view (113 of 166
-/// frames marked `ok` with the circle crossing the edge, today).
+/// The same with the ball's centre above the frame at the start and never fully in view (78 of 166
+/// frames marked `ok` with the circle crossing the edge or more than 5 px off, on main of 24 Nov).
 #[test]
 #[ignore = "needs the tracker to mark a ball cut by the frame's edge `cut_by_border` (or absent), never `ok` (crates/track)"]
 fn a_ball_mostly_out_of_view_is_never_ok_off_the_ball() {
