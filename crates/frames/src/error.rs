@@ -77,7 +77,7 @@ pub enum FramesError {
     /// A frame larger than the configured limit ([`crate::ClipOptions::max_frame_pixels`]): the header is
     /// probably corrupt, and nothing is allocated for it.
     #[error(
-        "{}: frame size {width}×{height} px is over the limit of {limit} pixels (a corrupt header? raise ClipOptions::max_frame_pixels if it is real)",
+        "{}: frame size {width}×{height} px is over the limit of {limit} pixels (a corrupt header? if it is real, raise the limit with --max-frame-pixels)",
         path.display()
     )]
     FrameTooLarge {
