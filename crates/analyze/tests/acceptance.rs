@@ -490,10 +490,10 @@ fn magnitude(scenario: &Scenario, effect: &str, fitted: &[bouncelab_diagnose::Fi
             interval: p.interval,
         };
     }
-    // n is held at its default (the linear spring's exponent) unless the search freed it.
-    let n_fit = fitted
-        .iter()
-        .find(|p| p.effect == effect && p.param == "n")
+    // n is held at its default (the linear spring's exponent) unless the search freed it; held, λ's
+    // interval gives the force's.
+    let n_free = fitted.iter().find(|p| p.effect == effect && p.param == "n");
+    let n_fit = n_free
         .map(|p| p.value)
         .unwrap_or_else(|| info.params[1].default.expect("n has a default"));
     let n_true = scenario_truth(scenario, effect, "n");
@@ -506,7 +506,11 @@ fn magnitude(scenario: &Scenario, effect: &str, fitted: &[bouncelab_diagnose::Fi
         label: "hunt_crossley λ·δⁿ at δ = 2 mm (N·s/m)".into(),
         value: force(p.value, n_fit),
         truth: force(truth, n_true),
-        interval: None,
+        interval: if n_free.is_none() {
+            p.interval.map(|[lo, hi]| [force(lo, n_fit), force(hi, n_fit)])
+        } else {
+            None
+        },
     }
 }
 
