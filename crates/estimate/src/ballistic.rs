@@ -105,8 +105,11 @@ pub fn fit_ballistic(points: &[(f64, f64, f64, f64)], a: [f64; 2]) -> Option<Bal
 }
 
 /// Fits `points` (t s, x m, y m, σ m) with the acceleration free: a weighted quadratic per coordinate.
-/// Returns the acceleration (x, y), m/s², and its standard errors (inflated by √χ²_red when the scatter
-/// exceeds the given σ); `None` with fewer than 6 points or degenerate times.
+/// Returns the acceleration (x, y), m/s², and its standard errors: from the given σ, or from the scatter
+/// when that is larger, counted as √(χ²_red·(1+ρ)/(1−ρ)) with ρ the lag-1 correlation of the residuals in
+/// time order (a tracker's error drifts with the rim's look from frame to frame, so neighbouring residuals
+/// are not independent and an acceleration would otherwise look more certain than it is); `None` with
+/// fewer than 6 points or degenerate times.
 pub fn fit_free_acceleration(points: &[(f64, f64, f64, f64)]) -> Option<([f64; 2], [f64; 2])> {
     if points.len() < 6 {
         return None;
@@ -137,19 +140,31 @@ pub fn fit_free_acceleration(points: &[(f64, f64, f64, f64)]) -> Option<([f64; 2
         }
         let inv = invert3(m)?;
         let c: Vec<f64> = (0..3).map(|i| (0..3).map(|j| inv[i][j] * b[j]).sum()).collect();
-        let chi2: f64 = points
+        let residuals: Vec<f64> = points
             .iter()
             .map(|p| {
                 let u = (p.0 - t_ref) / span;
                 let z = if k == 0 { p.1 } else { p.2 };
-                ((z - (c[0] + c[1] * u + c[2] * u * u)) / p.3).powi(2)
+                (z - (c[0] + c[1] * u + c[2] * u * u)) / p.3
             })
-            .sum();
-        let inflate = (chi2 / (points.len() as f64 - 3.0)).max(1.0);
+            .collect();
+        let chi2: f64 = residuals.iter().map(|r| r * r).sum();
+        let inflate = (chi2 / (points.len() as f64 - 3.0) * ar1_factor(&residuals)).max(1.0);
         a[k] = 2.0 * c[2] / (span * span);
         se[k] = 2.0 * (inv[2][2] * inflate).sqrt() / (span * span);
     }
     Some((a, se))
+}
+
+/// The variance factor (1+ρ)/(1−ρ) of a mean of AR(1) residuals with lag-1 correlation ρ (measured,
+/// held to 0–0.9: a negative ρ is not credited).
+fn ar1_factor(residuals: &[f64]) -> f64 {
+    let n = residuals.len() as f64;
+    let m = residuals.iter().sum::<f64>() / n;
+    let var: f64 = residuals.iter().map(|r| (r - m).powi(2)).sum();
+    let lag: f64 = residuals.windows(2).map(|w| (w[0] - m) * (w[1] - m)).sum();
+    let rho = (lag / var.max(1e-300)).clamp(0.0, 0.9);
+    (1.0 + rho) / (1.0 - rho)
 }
 
 /// The inverse of a symmetric 3×3 matrix by cofactors, `None` when singular.
@@ -174,6 +189,27 @@ fn invert3(m: [[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn a_drifting_error_makes_the_acceleration_less_certain_than_the_same_errors_shuffled() {
+        // The same 60 errors in two orders: a slow drift (a rim whose look changes from frame to frame) and
+        // interleaved (white-like). Only the drift's neighbours agree, so only its standard error grows.
+        let errors: Vec<f64> = (0..60).map(|i| 2e-5 * (i as f64 * 0.3).sin()).collect();
+        let shuffled: Vec<f64> = (0..60).map(|i| errors[(i * 37) % 60]).collect();
+        let fit = |e: &[f64]| {
+            let pts: Vec<_> = e
+                .iter()
+                .enumerate()
+                .map(|(i, e)| {
+                    let t = i as f64 * 1e-4;
+                    (t, 0.1 + 0.5 * t, 0.2 - 2.0 * t - 4.905 * t * t + e, 1e-6)
+                })
+                .collect();
+            fit_free_acceleration(&pts).unwrap().1[1]
+        };
+        let (drift, white) = (fit(&errors), fit(&shuffled));
+        assert!(drift > 2.0 * white, "drift SE {drift}, shuffled SE {white}");
+    }
+
     #[test]
     fn a_free_fit_recovers_the_acceleration() {
         let pts: Vec<_> = (0..40)

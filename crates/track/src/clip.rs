@@ -268,6 +268,7 @@ pub fn track_clip(
     // In heavy sensor noise a ray's largest step is as often a noise spike as the rim: sample the rays smoothed.
     let noisy = ClipTracking {
         tracker: TrackOptions {
+            ball_diameter_m: Some(opts.ball_diameter_m),
             search: EdgeSearch {
                 smooth: opts.tracker.search.smooth || noise > NOISY_SIGMA,
                 ..opts.tracker.search.clone()

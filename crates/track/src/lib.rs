@@ -15,6 +15,7 @@ mod clip;
 mod fit;
 mod hough;
 mod local;
+mod motion;
 #[cfg(feature = "opencv")]
 pub mod opencv;
 mod plane;

@@ -238,6 +238,14 @@ impl Refined {
         let kept = self.fit.inliers as f64 / self.rays as f64;
         kept * (self.contrast as f64 / 10.0).min(1.0)
     }
+
+    /// [`Refined::quality`] over the rays that could see the rim: those outside the image or below the
+    /// surface line are not counted against it (a ball leaving the frame or sinking into the surface keeps
+    /// the quality of the rim it still shows).
+    pub fn visible_quality(&self) -> f64 {
+        let visible = self.rays.saturating_sub(self.rays_outside + self.rays_hidden).max(1);
+        (self.fit.inliers as f64 / visible as f64).min(1.0) * (self.contrast as f64 / 10.0).min(1.0)
+    }
 }
 
 /// Refines the circle (`x`, `y`, `r`) in px: edge points along rays, then a robust fit. With a search
@@ -602,7 +610,7 @@ fn grow_outward<P: Pixel>(
 ) -> Refined {
     for _ in 0..4 {
         let c = f.fit;
-        let grown = [1.12, 1.25, 1.4].iter().find_map(|k| {
+        let grown = [1.06, 1.12, 1.25, 1.4].iter().find_map(|k| {
             let r = c.r * k;
             if r > max_r * 1.05 {
                 return None;

@@ -150,7 +150,7 @@ pub fn find_surface_line<P: Pixel>(img: &Plane<P>) -> Option<SurfaceLine> {
 pub fn find_surface_lines<P: Pixel>(img: &Plane<P>, ball: Option<(f64, f64, f64)>) -> Option<SurfaceLines> {
     let step = brightness_lines(img);
     let texture = crate::texture::texture_lines(img);
-    let mut candidates: Vec<SurfaceLine> = merge_cues(step, texture)
+    let mut candidates: Vec<SurfaceLine> = merge_cues(step, texture, img.width)
         .into_iter()
         .filter(|l| ball.is_none_or(|(x, y, r)| l.height_of(x, y) >= BALL_CLEARANCE_RADII * r))
         .collect();
@@ -166,8 +166,9 @@ pub fn find_surface_lines<P: Pixel>(img: &Plane<P>, ball: Option<(f64, f64, f64)
 
 /// One list of candidates from both cues, topmost first: where a brightness line and a texture line see the
 /// same edge (within 3 px plus twice the roughness) the brightness line is kept (it is the sharper), with the
-/// larger roughness of the two.
-fn merge_cues(step: Vec<SurfaceLine>, texture: Vec<SurfaceLine>) -> Vec<SurfaceLine> {
+/// larger roughness of the two; a line crossing a better-supported line of the other cue inside the frame
+/// (`width` px wide) is dropped, as within a cue (two edges of a scene do not cross).
+fn merge_cues(step: Vec<SurfaceLine>, texture: Vec<SurfaceLine>, width: usize) -> Vec<SurfaceLine> {
     let mut used = vec![false; texture.len()];
     let mut out: Vec<SurfaceLine> = Vec::new();
     for s in step {
@@ -186,8 +187,18 @@ fn merge_cues(step: Vec<SurfaceLine>, texture: Vec<SurfaceLine>) -> Vec<SurfaceL
         }
     }
     out.extend(texture.into_iter().zip(used).filter(|(_, u)| !u).map(|(t, _)| t));
-    out.sort_by(|a, b| a.y_at(a.x0).total_cmp(&b.y_at(b.x0)));
-    out
+    let right = width.saturating_sub(1) as f64;
+    let crosses =
+        |a: &SurfaceLine, b: &SurfaceLine| (a.y_at(0.0) - b.y_at(0.0)) * (a.y_at(right) - b.y_at(right)) <= 0.0;
+    out.sort_by(|a, b| b.columns.cmp(&a.columns));
+    let mut kept: Vec<SurfaceLine> = Vec::new();
+    for line in out {
+        if !kept.iter().any(|k| k.cue != line.cue && crosses(k, &line)) {
+            kept.push(line);
+        }
+    }
+    kept.sort_by(|a, b| a.y_at(a.x0).total_cmp(&b.y_at(b.x0)));
+    kept
 }
 
 /// The lines of the strongest brightness steps (the brightness cue), topmost first.
@@ -363,9 +374,19 @@ fn refine_line(
 ) -> Option<SurfaceLine> {
     let mut result = None;
     for _ in 0..3 {
-        let inliers: Vec<usize> = (0..cands.len())
-            .filter(|&i| (cands[i].1 - (c + slope * cands[i].0)).abs() <= tol)
-            .collect();
+        // One point per column (the nearest to the line), however many edges the column gave near it.
+        let off = |i: usize| (cands[i].1 - (c + slope * cands[i].0)).abs();
+        let mut inliers: Vec<usize> = Vec::new();
+        for i in (0..cands.len()).filter(|&i| off(i) <= tol) {
+            match inliers.last_mut() {
+                Some(last) if cands[*last].0 == cands[i].0 => {
+                    if off(i) < off(*last) {
+                        *last = i;
+                    }
+                }
+                _ => inliers.push(i),
+            }
+        }
         let pts: Vec<(f64, f64)> = inliers.iter().map(|&i| (cands[i].0 - xc, cands[i].1)).collect();
         let mut lean: Vec<f64> = inliers.iter().map(|&i| leans[i].abs()).collect();
         let n = pts.len() as f64;
@@ -431,6 +452,34 @@ mod tests {
                 (70.0 * (1.0 - cover) + band * cover) as f32
             })
             .collect()
+    }
+
+    fn line(y0: f64, tilt_deg: f64, columns: usize, cue: LineCue) -> SurfaceLine {
+        SurfaceLine {
+            columns,
+            cue,
+            ..SurfaceLine::given(255.5, y0, tilt_deg)
+        }
+    }
+
+    /// A texture line crossing a better-supported brightness line inside the frame is not an edge of the
+    /// scene, however high it lies; one that does not cross it stays, topmost first.
+    #[test]
+    fn a_line_crossing_a_better_one_of_the_other_cue_is_dropped() {
+        let flat = line(265.0, -0.6, 81, LineCue::Brightness);
+        let crossing = line(255.0, 3.2, 68, LineCue::Texture);
+        let parallel = line(250.0, -0.5, 60, LineCue::Texture);
+        let merged = merge_cues(vec![flat], vec![crossing, parallel], 512);
+        let ys: Vec<f64> = merged.iter().map(|l| l.y0).collect();
+        assert_eq!(ys, vec![250.0, 265.0]);
+        // The better-supported line of the two stands, whichever cue found it.
+        let merged = merge_cues(
+            vec![line(265.0, -0.6, 40, LineCue::Brightness)],
+            vec![line(255.0, 3.2, 68, LineCue::Texture)],
+            512,
+        );
+        assert_eq!(merged.len(), 1);
+        assert_eq!(merged[0].cue, LineCue::Texture);
     }
 
     #[test]

@@ -2,6 +2,7 @@
 //! what happened in every frame.
 
 use crate::hough::{Circle, CircleDetection};
+use crate::motion::fit_motion;
 use crate::plane::{Pixel, Plane};
 use crate::refine::{
     EdgeSearch, Refined, RimShapeLearner, refine_circle_with_rays, refined_candidates, residuals_about, rim_residuals,
@@ -93,6 +94,9 @@ pub struct TrackOptions {
     pub search: EdgeSearch,
     /// Largest distance between prediction and measurement before the measurement is not trusted, px.
     pub max_jump_px: f64,
+    /// The ball's diameter, m, when known: with the measured radius it turns
+    /// [`MAX_BALL_ACCELERATION_M_S2`] into px/s² for the prediction (unbounded without it).
+    pub ball_diameter_m: Option<f64>,
 }
 
 impl Default for TrackOptions {
@@ -101,6 +105,7 @@ impl Default for TrackOptions {
             radius_px: None,
             search: EdgeSearch::default(),
             max_jump_px: 4.0,
+            ball_diameter_m: None,
         }
     }
 }
@@ -109,8 +114,12 @@ impl Default for TrackOptions {
 #[derive(Debug, Clone)]
 pub struct Tracker {
     opts: TrackOptions,
-    /// Recent measured (t, x, y).
+    /// Recent measured (t, x, y), at most [`PREDICTION_FIXES`].
     history: Vec<(f64, f64, f64)>,
+    /// Qualities of the recent fixes measured `ok` with their whole rim in view, at most [`QUALITY_FIXES`].
+    qualities: Vec<f64>,
+    /// Distances between the recent predictions and their fixes, px, at most [`QUALITY_FIXES`].
+    innovations: Vec<f64>,
     /// Radii measured in free flight (the bottom clear of the surface).
     flight_radii: Vec<f64>,
     /// Edge-definition spread (see [`Refined::edge_definition_px`]) in the first free-flight frames, px.
@@ -149,12 +158,35 @@ const CONFIDENT_HALF_WIDTH: f64 = 2.0;
 /// Candidates within this fraction of the best support count as rivals.
 const RIVAL_SUPPORT: f64 = 0.7;
 
+/// Fixes the prediction is fitted to, at most (see [`crate::motion`]).
+const PREDICTION_FIXES: usize = 8;
+
+/// The largest acceleration a ball takes, m/s²: a 50 m/s ball reversing its normal speed in a 4 ms contact
+/// peaks near 2·10⁴ m/s², half a sine's π/2 above its mean; in flight it is g. The prediction's acceleration
+/// is held to this, so that a track cannot speed away from the ball on its own noise.
+pub const MAX_BALL_ACCELERATION_M_S2: f64 = 3.0e4;
+
+/// A fix this far from its prediction, px, and four times further than the recent fixes were from theirs,
+/// marks a change of motion: the prediction starts again from the last fixes.
+const CHANGE_OF_MOTION_PX: f64 = 1.0;
+
+/// Recent clean fixes whose median quality a new fix is compared with.
+const QUALITY_FIXES: usize = 16;
+
+/// A fix whose visible rim's quality falls below this fraction of the track's recent median is not the
+/// rim the track has been measuring (a seam, texture or another object near the prediction), and the frame
+/// is not `ok`. A ball passing behind a thin ruler keeps most of its rim, and one sinking into the surface
+/// or leaving the frame loses rays that are not counted against it.
+const QUALITY_DROP: f64 = 0.6;
+
 impl Tracker {
     /// A tracker with no history.
     pub fn new(opts: TrackOptions) -> Tracker {
         Tracker {
             opts,
             history: Vec::new(),
+            qualities: Vec::new(),
+            innovations: Vec::new(),
             flight_radii: Vec::new(),
             flight_edges: Vec::new(),
             rim: RimShapeLearner::default(),
@@ -221,24 +253,17 @@ impl Tracker {
         Some(*r.select_nth_unstable_by(mid, f64::total_cmp).1)
     }
 
+    /// Where the ball should be at `t`: the least-squares parabola through the recent fixes, its
+    /// acceleration bounded (see [`crate::motion`]).
     fn predict(&self, t: f64) -> Option<(f64, f64)> {
-        let h = &self.history;
-        match h.len() {
-            0 => None,
-            1 => Some((h[0].1, h[0].2)),
-            2 => {
-                let (a, b) = (h[0], h[1]);
-                let s = (t - b.0) / (b.0 - a.0);
-                Some((b.1 + s * (b.1 - a.1), b.2 + s * (b.2 - a.2)))
-            }
-            n => {
-                // Quadratic through the last three measurements (Lagrange), evaluated at t.
-                let (a, b, c) = (h[n - 3], h[n - 2], h[n - 1]);
-                let l = |ti: f64, tj: f64, tk: f64| (t - tj) * (t - tk) / ((ti - tj) * (ti - tk));
-                let (la, lb, lc) = (l(a.0, b.0, c.0), l(b.0, a.0, c.0), l(c.0, a.0, b.0));
-                Some((la * a.1 + lb * b.1 + lc * c.1, la * a.2 + lb * b.2 + lc * c.2))
-            }
-        }
+        fit_motion(&self.history, self.max_accel_px_s2()).map(|m| m.at(t))
+    }
+
+    /// [`MAX_BALL_ACCELERATION_M_S2`] in px/s² at the expected radius, when the ball's size is known.
+    fn max_accel_px_s2(&self) -> Option<f64> {
+        let d = self.opts.ball_diameter_m.filter(|d| *d > 0.0)?;
+        let r = self.expected_radius()?;
+        Some(MAX_BALL_ACCELERATION_M_S2 * 2.0 * r / d)
     }
 
     fn expected_radius(&self) -> Option<f64> {
@@ -293,8 +318,10 @@ impl Tracker {
         self.rim_rays = rays;
         if let Some((found, px, py, r)) = found
             && self.plausible(&found, px, py, r, max_jump)
+            && self.same_rim(&found)
         {
             self.last_innovation = (found.fit.x - px).hypot(found.fit.y - py);
+            self.note_innovation(self.last_innovation);
             return self.accept(frame, t_s, img, found, Status::Ok);
         }
         self.last_innovation = 0.0;
@@ -322,7 +349,7 @@ impl Tracker {
         let r_expected = self.expected_radius().unwrap_or(0.5 * (lo + hi));
         let gate = 0.5 * r_expected + (2.0 * self.speed_px_per_s() * self.frame_period() + 1.0) * self.missed as f64;
         let d = |c: &(Circle, Refined)| (c.1.fit.x - px).hypot(c.1.fit.y - py);
-        cands.retain(|c| d(c) <= gate);
+        cands.retain(|c| d(c) <= gate && self.same_rim(&c.1));
         if cands.is_empty() {
             self.missed += 1;
             if self.missed == 3 {
@@ -341,6 +368,9 @@ impl Tracker {
             .min_by(|a, b| d(a.1).total_cmp(&d(b.1)))
             .expect("non-empty");
         let chosen = cands.swap_remove(i);
+        if self.missed == 0 {
+            self.note_innovation(d(&chosen));
+        }
         if rivals > 1 {
             self.warnings.push(format!(
                 "frame {frame}: {rivals} ball-like circles near the track; tracking the one at ({:.1}, {:.1}) because it continues it",
@@ -380,26 +410,21 @@ impl Tracker {
         self.accept(frame, t_s, img, chosen.1, Status::Ok)
     }
 
-    /// Where the ball should be at `t`: the quadratic through the last three fixes while the track holds, a
-    /// straight line from the last two once frames have been missed (a parabola extrapolated far runs away).
+    /// Where the ball should be at `t` after missed frames: the straight line fitted to the recent fixes
+    /// once frames have been missed (a parabola extrapolated far runs away).
     fn predict_after_gap(&self, t: f64) -> Option<(f64, f64)> {
-        let h = &self.history;
-        if self.missed < 2 || h.len() < 2 {
+        if self.missed < 2 || self.history.len() < 2 {
             return self.predict(t);
         }
-        let (a, b) = (h[h.len() - 2], h[h.len() - 1]);
-        let s = (t - b.0) / (b.0 - a.0);
-        Some((b.1 + s * (b.1 - a.1), b.2 + s * (b.2 - a.2)))
+        fit_motion(&self.history, Some(0.0)).map(|m| m.at(t))
     }
 
-    /// The ball's speed over its last two fixes, px/s (0 before two).
+    /// The ball's speed at its last fix, from the motion fitted to the recent fixes, px/s (0 before two).
     fn speed_px_per_s(&self) -> f64 {
-        let h = &self.history;
-        if h.len() < 2 {
+        if self.history.len() < 2 {
             return 0.0;
         }
-        let (a, b) = (h[h.len() - 2], h[h.len() - 1]);
-        (b.1 - a.1).hypot(b.2 - a.2) / (b.0 - a.0).abs().max(1e-12)
+        fit_motion(&self.history, self.max_accel_px_s2()).map_or(0.0, |m| m.speed())
     }
 
     /// The time between the last two fixes, s (the frame period while none are missed).
@@ -409,6 +434,29 @@ impl Tracker {
             return 0.0;
         }
         (h[h.len() - 1].0 - h[h.len() - 2].0).abs()
+    }
+
+    /// Keeps `innovation` (px, the distance of a fix from its prediction) among the recent ones; when it is
+    /// far beyond them ([`CHANGE_OF_MOTION_PX`]) the motion changed (a bounce seen in few frames): the fixes
+    /// before it no longer describe the path, and a fit through them would lag behind it.
+    fn note_innovation(&mut self, innovation: f64) {
+        if innovation > CHANGE_OF_MOTION_PX.max(4.0 * median(&self.innovations)) {
+            let stale = self.history.len().saturating_sub(2);
+            self.history.drain(..stale);
+        }
+        self.innovations.push(innovation);
+        if self.innovations.len() > QUALITY_FIXES {
+            self.innovations.remove(0);
+        }
+    }
+
+    /// Whether `f` is as clear a rim as the track's recent fixes (see [`QUALITY_DROP`]); true until five
+    /// have been seen.
+    fn same_rim(&self, f: &Refined) -> bool {
+        if self.qualities.len() < 5 {
+            return true;
+        }
+        f.visible_quality() >= QUALITY_DROP * median(&self.qualities)
     }
 
     fn plausible(&self, f: &Refined, px: f64, py: f64, r: f64, max_jump: f64) -> bool {
@@ -430,6 +478,12 @@ impl Tracker {
             Some(line) => fit.y + fit.r < line.y_at(fit.x) - 3.0,
             None => true,
         };
+        if status == Status::Ok && f.rays_hidden == 0 && f.rays_outside == 0 {
+            self.qualities.push(f.visible_quality());
+            if self.qualities.len() > QUALITY_FIXES {
+                self.qualities.remove(0);
+            }
+        }
         if status == Status::Ok && clear && f.rays_hidden == 0 {
             self.flight_radii.push(fit.r);
             if self.flight_radii.len() > 64 {
@@ -463,7 +517,7 @@ impl Tracker {
         // Seeds from later frames give way to real measurements.
         self.history.retain(|h| h.0 < t_s);
         self.history.push((t_s, fit.x, fit.y));
-        if self.history.len() > 3 {
+        if self.history.len() > PREDICTION_FIXES {
             self.history.remove(0);
         }
         BallFix {
@@ -478,4 +532,14 @@ impl Tracker {
             status,
         }
     }
+}
+
+/// The median of `v` (0 when empty).
+fn median(v: &[f64]) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    let mut v = v.to_vec();
+    let mid = v.len() / 2;
+    *v.select_nth_unstable_by(mid, f64::total_cmp).1
 }
