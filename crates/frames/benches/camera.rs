@@ -11,7 +11,6 @@ mod camera;
 use std::hint::black_box;
 
 use bouncelab_frames::{Clip, ClipOptions, ReadOptions};
-use camera::{Cine, CinePacking, Mraw, TiffCompression, moving_disc, write_tiff_stack};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 
 const N: usize = 64;
@@ -19,34 +18,7 @@ const SIDE: u32 = 512;
 
 fn bench(c: &mut Criterion) {
     let tmp = tempfile::tempdir().expect("temp dir");
-    let d = tmp.path();
-    let frames = |max| moving_disc(SIDE, SIDE, N, max, 7);
-    let mut clips = Vec::new();
-    for bits in [8u32, 12, 16] {
-        let max = if bits == 8 { 255 } else { 4095 };
-        let header = Mraw::new(SIDE, SIDE, bits).write(d, &format!("m{bits}"), &frames(max));
-        clips.push((format!("mraw_{bits}bit"), header));
-    }
-    for (label, packing, max) in [
-        ("cine_8bit", CinePacking::U8, 255),
-        ("cine_10bit_packed", CinePacking::P10, 1023),
-        ("cine_12bit_packed", CinePacking::P12, 4095),
-        ("cine_16bit", CinePacking::U16 { real_bpp: 12 }, 4095),
-    ] {
-        let path = d.join(format!("{label}.cine"));
-        Cine::new(SIDE, SIDE, packing).write(&path, &frames(max));
-        clips.push((label.to_string(), path));
-    }
-    for (label, bits, compression) in [
-        ("tiff_8bit", 8, TiffCompression::None),
-        ("tiff_16bit", 16, TiffCompression::None),
-        ("tiff_8bit_lzw", 8, TiffCompression::Lzw),
-    ] {
-        let path = d.join(format!("{label}.tif"));
-        let max = if bits == 8 { 255 } else { 65535 };
-        write_tiff_stack(&path, SIDE, SIDE, bits, &frames(max), compression);
-        clips.push((label.to_string(), path));
-    }
+    let clips = camera::speed_files(tmp.path(), SIDE, N, true);
     let mut g = c.benchmark_group("decode_512x512_one_thread");
     g.throughput(Throughput::Elements(N as u64));
     g.sample_size(20);

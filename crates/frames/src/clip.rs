@@ -419,6 +419,15 @@ impl Clip {
         self.files.get(k).map(|f| self.decode(f, png_decoder))
     }
 
+    /// Gives a frame's pixel buffer back, to be reused by the next frames decoded from this clip (MRAW and
+    /// CINE files; otherwise the frame is dropped). A consumer done with each frame saves an allocation of
+    /// fresh memory a frame, which costs more than unpacking it when frames are decoded on other threads.
+    pub fn recycle(&self, frame: Frame) {
+        if let Some(cam) = &self.camera {
+            cam.recycle(frame.pixels);
+        }
+    }
+
     /// Streams the frames in order, decoding a bounded window ahead in parallel on rayon's global pool.
     pub fn frames(&self) -> FrameStream<'_> {
         FrameStream {
@@ -555,6 +564,13 @@ impl<'a> FrameStream<'a> {
             source,
             remaining,
         })
+    }
+}
+
+impl FrameStream<'_> {
+    /// Gives a frame's pixel buffer back for the frames still to come: [`Clip::recycle`].
+    pub fn recycle(&self, frame: Frame) {
+        self.clip.recycle(frame);
     }
 }
 

@@ -120,6 +120,34 @@ fn written_mraw_round_trips_at_8_12_and_16_bits_with_both_headers() {
 }
 
 #[test]
+fn frames_given_back_while_streaming_do_not_change_the_frames_that_follow() {
+    let tmp = tempfile::tempdir().unwrap();
+    let frames = moving_disc(40, 12, 24, 4095, 3);
+    let path = packed_cine(tmp.path(), &frames);
+    let mraw = Mraw::new(40, 12, 12).write(tmp.path(), "given_back", &frames);
+    for path in [path, mraw] {
+        let clip = Clip::open(&path).unwrap();
+        let mut stream = clip.frames_with(&ReadOptions::with_threads(2)).unwrap();
+        let mut seen = 0;
+        while let Some(f) = stream.next() {
+            let f = f.unwrap();
+            let want: Vec<u16> = frames[f.index as usize].iter().map(|v| v << 4).collect();
+            assert_eq!(u16s(&f.pixels), want, "{} frame {}", path.display(), f.index);
+            stream.recycle(f);
+            seen += 1;
+        }
+        assert_eq!(seen, 24);
+    }
+}
+
+/// A 12-bit packed CINE of these frames.
+fn packed_cine(dir: &Path, frames: &[Vec<u16>]) -> PathBuf {
+    let path = dir.join("given_back.cine");
+    Cine::new(40, 12, CinePacking::P12).write(&path, frames);
+    path
+}
+
+#[test]
 fn written_cine_round_trips_at_every_depth_with_its_metadata() {
     let tmp = tempfile::tempdir().unwrap();
     let cases = [

@@ -447,11 +447,14 @@ pub(crate) fn stream_fixes(
     let mut fixes = Vec::with_capacity(total);
     let (mut waiting, mut working) = (0.0, 0.0);
     let mut t_wait = Instant::now();
-    for frame in frames {
+    let mut frames = frames;
+    while let Some(frame) = frames.next() {
         let frame = frame?;
         let t_work = Instant::now();
         waiting += (t_work - t_wait).as_secs_f64();
         fixes.push(fix_of(&frame));
+        // The decoder reuses the buffer for a frame to come rather than asking the system for fresh memory.
+        frames.recycle(frame);
         t_wait = Instant::now();
         working += (t_wait - t_work).as_secs_f64();
         progress(fixes.len(), total);

@@ -4,8 +4,9 @@
 //! A parabola through only the last three fixes is exact for a clean track but turns a noisy rim's error
 //! into acceleration: its second difference carries √6 ≈ 2.4 times the centre's noise, and a tracker that
 //! then searches around that prediction can follow a seam or the texture away from the ball, faster every
-//! frame. Fitted through eight fixes, the acceleration's noise is about 16 times smaller, and bounded by a
-//! physical limit it cannot run away at all.
+//! frame. Fitted through eight fixes, the acceleration's noise is about 16 times smaller, and bounded by
+//! physical limits it cannot run away: no ball accelerates faster than a hard contact pushes it, and none
+//! towards the surface faster than gravity (contact only ever pushes it away).
 
 /// A motion per axis x(τ) = p + v τ + ½ a τ², with τ the time since the last fix, s; px, px/s, px/s².
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -37,9 +38,10 @@ impl Motion {
 /// The least-squares motion through `fixes` (t in s, x and y in px; in time order, the last one latest):
 /// a parabola through three or more, a line through two, a point through one; `None` without any.
 ///
-/// With `max_accel` (px/s²) the acceleration's size is held to it, and position and velocity refitted
-/// under that acceleration; `Some(0.0)` fits a straight line. Cost: O(n) for n fixes.
-pub(crate) fn fit_motion(fixes: &[(f64, f64, f64)], max_accel: Option<f64>) -> Option<Motion> {
+/// With `max_accel` (px/s²) the acceleration's size is held to it, with `max_down` (px/s²) its downward
+/// (+y, towards the surface) part, and position and velocity are refitted under that acceleration;
+/// `Some(0.0)` fits a straight line. Cost: O(n) for n fixes.
+pub(crate) fn fit_motion(fixes: &[(f64, f64, f64)], max_accel: Option<f64>, max_down: Option<f64>) -> Option<Motion> {
     let &(t_ref, x_last, y_last) = fixes.last()?;
     let n = fixes.len();
     let still = Motion {
@@ -64,6 +66,9 @@ pub(crate) fn fit_motion(fixes: &[(f64, f64, f64)], max_accel: Option<f64>) -> O
             if let Some(c) = least_squares(&taus, &axes[k], 3) {
                 a[k] = 2.0 * c[2] / (span * span);
             }
+        }
+        if let Some(limit) = max_down {
+            a[1] = a[1].min(limit);
         }
         if let Some(limit) = max_accel {
             let size = a[0].hypot(a[1]);
@@ -145,12 +150,12 @@ mod tests {
 
     #[test]
     fn a_point_and_a_line_are_extrapolated_as_such() {
-        let m = fit_motion(&[(0.0, 3.0, 4.0)], None).unwrap();
+        let m = fit_motion(&[(0.0, 3.0, 4.0)], None, None).unwrap();
         assert_eq!(m.at(1.0), (3.0, 4.0));
-        let m = fit_motion(&[(0.0, 0.0, 0.0), (1e-4, 1.0, -2.0)], None).unwrap();
+        let m = fit_motion(&[(0.0, 0.0, 0.0), (1e-4, 1.0, -2.0)], None, None).unwrap();
         let (x, y) = m.at(3e-4);
         assert!((x - 3.0).abs() < 1e-9 && (y + 6.0).abs() < 1e-9, "{x} {y}");
-        assert!(fit_motion(&[], None).is_none());
+        assert!(fit_motion(&[], None, None).is_none());
     }
 
     #[test]
@@ -160,8 +165,8 @@ mod tests {
         let noisy: Vec<_> = (0..8)
             .map(|i| (i as f64 * 1e-4, 100.0, 100.0 + if i % 2 == 0 { 2.0 } else { -2.0 }))
             .collect();
-        let three = fit_motion(&noisy[5..], None).unwrap();
-        let eight = fit_motion(&noisy, Some(1e6)).unwrap();
+        let three = fit_motion(&noisy[5..], None, None).unwrap();
+        let eight = fit_motion(&noisy, Some(1e6), None).unwrap();
         let ahead = |m: &Motion| (m.at(noisy[7].0 + 10e-4).1 - 100.0).abs();
         assert!(ahead(&three) > 100.0, "three fixes: {}", ahead(&three));
         assert!(ahead(&eight) < 5.0, "eight fixes, bounded: {}", ahead(&eight));
@@ -171,9 +176,22 @@ mod tests {
     #[test]
     fn a_zero_bound_fits_a_straight_line() {
         let fixes = parabola(6, 1e-4, [10.0, 20.0], [1e4, 0.0], [0.0, 1e8]);
-        let m = fit_motion(&fixes, Some(0.0)).unwrap();
+        let m = fit_motion(&fixes, Some(0.0), None).unwrap();
         assert_eq!(m.a, [0.0, 0.0]);
         assert!((m.v[0] - 1e4).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_track_never_falls_faster_than_the_bound_towards_the_surface() {
+        // Fixes that accelerate downward at 1 px per frame² (a search sliding down a seam) and sideways at
+        // 0.5: the downward part is held to the bound, the sideways part kept.
+        let fixes = parabola(8, 1e-4, [0.0, 0.0], [0.0, 0.0], [0.5e8, 1e8]);
+        let m = fit_motion(&fixes, None, Some(1e6)).unwrap();
+        assert!((m.a[1] - 1e6).abs() < 1e-6, "{:?}", m.a);
+        assert!((m.a[0] - 0.5e8).abs() < 1e-3 * 0.5e8, "{:?}", m.a);
+        // Upward (a bounce's push) is not bounded by it.
+        let up = parabola(8, 1e-4, [0.0, 0.0], [0.0, 0.0], [0.0, -1e8]);
+        assert!((fit_motion(&up, None, Some(1e6)).unwrap().a[1] + 1e8).abs() < 1e-3 * 1e8);
     }
 
     proptest! {
@@ -189,7 +207,7 @@ mod tests {
             // Velocities and accelerations in px per frame and per frame².
             let (v, a) = ([vx / dt / 1e3, vy / dt / 1e3], [ax / (dt * dt) / 1e4, ay / (dt * dt) / 1e4]);
             let fixes = parabola(n, dt, [px, py], v, a);
-            let m = fit_motion(&fixes, None).unwrap();
+            let m = fit_motion(&fixes, None, None).unwrap();
             let t = n as f64 * dt;
             let (x, y) = m.at(t);
             let (ex, ey) = (px + v[0] * t + 0.5 * a[0] * t * t, py + v[1] * t + 0.5 * a[1] * t * t);

@@ -190,7 +190,7 @@ fn merge_cues(step: Vec<SurfaceLine>, texture: Vec<SurfaceLine>, width: usize) -
     let right = width.saturating_sub(1) as f64;
     let crosses =
         |a: &SurfaceLine, b: &SurfaceLine| (a.y_at(0.0) - b.y_at(0.0)) * (a.y_at(right) - b.y_at(right)) <= 0.0;
-    out.sort_by(|a, b| b.columns.cmp(&a.columns));
+    out.sort_by_key(|l| std::cmp::Reverse(l.columns));
     let mut kept: Vec<SurfaceLine> = Vec::new();
     for line in out {
         if !kept.iter().any(|k| k.cue != line.cue && crosses(k, &line)) {

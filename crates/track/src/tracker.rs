@@ -170,6 +170,12 @@ pub const MAX_BALL_ACCELERATION_M_S2: f64 = 3.0e4;
 /// marks a change of motion: the prediction starts again from the last fixes.
 const CHANGE_OF_MOTION_PX: f64 = 1.0;
 
+/// The largest downward (+y, towards the surface) acceleration the prediction takes, m/s²: gravity is the
+/// only force towards the surface (contact pushes away from it), so 100 g leaves room for a frame rate
+/// wrong by up to 10× (accelerations scale with its square) and still stops a search that slides down a
+/// seam or the texture at thousands of g.
+pub const MAX_DOWNWARD_ACCELERATION_M_S2: f64 = 100.0 * 9.81;
+
 /// Recent clean fixes whose median quality a new fix is compared with.
 const QUALITY_FIXES: usize = 16;
 
@@ -256,14 +262,23 @@ impl Tracker {
     /// Where the ball should be at `t`: the least-squares parabola through the recent fixes, its
     /// acceleration bounded (see [`crate::motion`]).
     fn predict(&self, t: f64) -> Option<(f64, f64)> {
-        fit_motion(&self.history, self.max_accel_px_s2()).map(|m| m.at(t))
+        fit_motion(&self.history, self.max_accel_px_s2(), self.max_down_px_s2()).map(|m| m.at(t))
     }
 
     /// [`MAX_BALL_ACCELERATION_M_S2`] in px/s² at the expected radius, when the ball's size is known.
     fn max_accel_px_s2(&self) -> Option<f64> {
+        Some(MAX_BALL_ACCELERATION_M_S2 * self.px_per_m()?)
+    }
+
+    /// [`MAX_DOWNWARD_ACCELERATION_M_S2`] in px/s², when the ball's size is known.
+    fn max_down_px_s2(&self) -> Option<f64> {
+        Some(MAX_DOWNWARD_ACCELERATION_M_S2 * self.px_per_m()?)
+    }
+
+    /// The image's scale from the expected radius and the ball's diameter, px/m.
+    fn px_per_m(&self) -> Option<f64> {
         let d = self.opts.ball_diameter_m.filter(|d| *d > 0.0)?;
-        let r = self.expected_radius()?;
-        Some(MAX_BALL_ACCELERATION_M_S2 * 2.0 * r / d)
+        Some(2.0 * self.expected_radius()? / d)
     }
 
     fn expected_radius(&self) -> Option<f64> {
@@ -416,7 +431,7 @@ impl Tracker {
         if self.missed < 2 || self.history.len() < 2 {
             return self.predict(t);
         }
-        fit_motion(&self.history, Some(0.0)).map(|m| m.at(t))
+        fit_motion(&self.history, Some(0.0), None).map(|m| m.at(t))
     }
 
     /// The ball's speed at its last fix, from the motion fitted to the recent fixes, px/s (0 before two).
@@ -424,7 +439,7 @@ impl Tracker {
         if self.history.len() < 2 {
             return 0.0;
         }
-        fit_motion(&self.history, self.max_accel_px_s2()).map_or(0.0, |m| m.speed())
+        fit_motion(&self.history, self.max_accel_px_s2(), self.max_down_px_s2()).map_or(0.0, |m| m.speed())
     }
 
     /// The time between the last two fixes, s (the frame period while none are missed).

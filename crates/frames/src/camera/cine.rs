@@ -21,7 +21,7 @@
 
 use std::path::Path;
 
-use super::unpack::Packing;
+use super::unpack::{Packing, Pool};
 use super::{CameraFile, CameraInfo, Layout, SourceFormat, check_size, header_error, map};
 use crate::error::{FramesError, Result};
 use crate::pixels::GrayPixels;
@@ -57,7 +57,14 @@ pub(crate) struct Frames {
 }
 
 impl Frames {
-    pub(crate) fn decode(&self, map: &[u8], path: &Path, k: usize, w: u32, h: u32) -> Result<GrayPixels> {
+    pub(crate) fn decode(
+        &self,
+        map: &[u8],
+        path: &Path,
+        k: usize,
+        (w, h): (u32, u32),
+        pool: &Pool,
+    ) -> Result<GrayPixels> {
         let err = |message: String| FramesError::Decode {
             path: path.into(),
             index: k as u64,
@@ -92,7 +99,7 @@ impl Frames {
                 map.len()
             ))
         })?;
-        Ok(self.packing.unpack(bytes, w, h, self.bottom_up))
+        Ok(self.packing.unpack(bytes, w, h, self.bottom_up, pool))
     }
 }
 
@@ -267,6 +274,7 @@ pub(crate) fn open(path: &Path, max_pixels: u64) -> Result<CameraFile> {
             frame_bytes: frame_bytes as usize,
         }),
         map,
+        pool: Pool::default(),
         info,
         size,
         count: image_count as usize,

@@ -147,6 +147,8 @@ pub(crate) struct CameraFile {
     sources: Vec<PathBuf>,
     map: memmap2::Mmap,
     layout: Layout,
+    /// Buffers of frames given back, for the next frames decoded (MRAW and CINE).
+    pool: unpack::Pool,
     pub info: CameraInfo,
     pub size: (u32, u32),
     pub count: usize,
@@ -186,11 +188,17 @@ impl CameraFile {
                         index: k as u64,
                         message: "frame beyond the end of the file".into(),
                     })?;
-                Ok(packing.unpack(bytes, w, h, false))
+                Ok(packing.unpack(bytes, w, h, false, &self.pool))
             }
-            Layout::Cine(frames) => frames.decode(&self.map, &self.data_path, k, w, h),
+            Layout::Cine(frames) => frames.decode(&self.map, &self.data_path, k, self.size, &self.pool),
             Layout::Tiff(pages) => pages.decode(&self.map, &self.data_path, k, self.size),
         }
+    }
+
+    /// Keeps a decoded frame's buffer for the next frames decoded.
+    pub(crate) fn recycle(&self, pixels: GrayPixels) {
+        let (w, h) = self.size;
+        self.pool.give(pixels, w as usize * h as usize);
     }
 
     /// Every file the clip is made of (header and data), for fingerprints.

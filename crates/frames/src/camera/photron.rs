@@ -336,6 +336,7 @@ pub(crate) fn open(path: &Path, max_pixels: u64) -> Result<CameraFile> {
         path: path.into(),
         data_path,
         map,
+        pool: Default::default(),
         layout: Layout::Contiguous {
             packing,
             frame_bytes: frame_bytes as usize,

@@ -284,6 +284,7 @@ pub(crate) fn open(path: &Path, max_pixels: u64) -> Result<CameraFile> {
         data_path: path.into(),
         layout: Layout::Tiff(pages),
         map,
+        pool: Default::default(),
         info,
         size,
         count,

@@ -342,3 +342,40 @@ pub fn moving_disc(width: u32, height: u32, count: usize, max: u16, seed: u64) -
         })
         .collect()
 }
+
+/// The camera files the speed figures are taken on (`benches/camera.rs`, `examples/camera_cpu.rs`): `count`
+/// frames of `side`×`side` each ([`moving_disc`]) as MRAW 8/12/16-bit, CINE 8-bit, P10, P12 and 16-bit, and
+/// uncompressed 8- and 16-bit TIFF stacks, plus an LZW one if `lzw`; with their labels.
+pub fn speed_files(dir: &Path, side: u32, count: usize, lzw: bool) -> Vec<(String, PathBuf)> {
+    let frames = |max| moving_disc(side, side, count, max, 7);
+    let mut files = Vec::new();
+    for bits in [8u32, 12, 16] {
+        let max = if bits == 8 { 255 } else { 4095 };
+        let header = Mraw::new(side, side, bits).write(dir, &format!("m{bits}"), &frames(max));
+        files.push((format!("mraw_{bits}bit"), header));
+    }
+    for (label, packing, max) in [
+        ("cine_8bit", CinePacking::U8, 255),
+        ("cine_10bit_packed", CinePacking::P10, 1023),
+        ("cine_12bit_packed", CinePacking::P12, 4095),
+        ("cine_16bit", CinePacking::U16 { real_bpp: 12 }, 4095),
+    ] {
+        let path = dir.join(format!("{label}.cine"));
+        Cine::new(side, side, packing).write(&path, &frames(max));
+        files.push((label.to_string(), path));
+    }
+    let mut tiffs = vec![
+        ("tiff_8bit", 8, TiffCompression::None),
+        ("tiff_16bit", 16, TiffCompression::None),
+    ];
+    if lzw {
+        tiffs.push(("tiff_8bit_lzw", 8, TiffCompression::Lzw));
+    }
+    for (label, bits, compression) in tiffs {
+        let path = dir.join(format!("{label}.tif"));
+        let max = if bits == 8 { 255 } else { 65535 };
+        write_tiff_stack(&path, side, side, bits, &frames(max), compression);
+        files.push((label.to_string(), path));
+    }
+    files
+}
