@@ -43,21 +43,30 @@ fn run(session: &Path, root: &Path, model: Option<PathBuf>) -> Analysis {
     a
 }
 
-/// The effect preset `effect-<name>`: named first (alone, or first of an ambiguous few), and once added the
-/// error falls ≥ 3× to χ²_red ≤ 1.5. Prints the verdict table's row (magnitude recovered, interval covers
-/// the truth, time).
+/// The effect preset `effect-<name>`, judged by issue 16's criteria: named first (alone, or first of an
+/// ambiguous few); its magnitude within 10 % of the truth; and, once added at its fitted values, the misfit
+/// left within the session's floor (learned from its own flight) with χ²_red ≤ 1.5. Prints the verdict
+/// table's row (magnitude recovered, interval covers the truth, time).
+///
+/// Not "the error falls ≥ 3×": that ratio is the hidden effect's size over the floor, not a measure of the
+/// search. The floor bounds what any model can reach (8–9 µm on these renders), and with μ fitted per
+/// surface the paper's model absorbs part of a contact or flight effect into μ, so the same effect found
+/// as well shows a smaller fall (restitution damping: 32.9 µm before with μ fixed, 26.4 µm with μ free,
+/// 9.1 µm after either way). Whether the interval covers the truth is printed, not asserted: issue 16
+/// item 6 is open for several effects (docs/accuracy.md).
 fn hidden(effect: &str) {
     hidden_in(effect, &Scenario::preset(&format!("effect-{effect}")).unwrap());
 }
 
-/// [`hidden`] on a given scenario with `effect` hidden; returns the fitted switch parameter's value, its
-/// interval and its truth (from the scenario text).
+/// [`hidden`] on a given scenario with `effect` hidden; returns its fitted magnitude (see [`magnitude`]),
+/// the interval and the truth (from the scenario text).
 fn hidden_in(effect: &str, scenario: &Scenario) -> (f64, Option<[f64; 2]>, f64) {
     let dir = tempfile::tempdir().unwrap();
     let session = render(scenario, dir.path());
     let first = run(&session, dir.path(), None);
     let d = first.diagnosis.as_ref().expect("the diagnosis ran");
     eprintln!("{effect}: {}", d.verdict.sentence);
+    print_candidates(d);
     // Named first: alone (`missing_effect`), or first of the effects the data cannot tell apart
     // (`ambiguous`), never behind another.
     assert!(
@@ -86,8 +95,7 @@ fn hidden_in(effect: &str, scenario: &Scenario) -> (f64, Option<[f64; 2]>, f64) 
         .unwrap_or_default();
     let c = d.candidate(effect).expect("the hidden effect was tried");
     let e = c.evidence.as_ref().expect("its fit ran");
-    let truth = scenario_truth(scenario, effect, &c.param);
-    let covers = e.param_interval.map(|[lo, hi]| lo <= truth && truth <= hi);
+    let m = magnitude(scenario, effect, &e.fit.parameters);
     eprintln!(
         "{effect}: systematic part removed {:.1} %",
         e.explained_fraction * 100.0
@@ -96,16 +104,13 @@ fn hidden_in(effect: &str, scenario: &Scenario) -> (f64, Option<[f64; 2]>, f64) 
         assert!(e.explained_fraction >= 0.9, "{effect}: {}", e.explained_fraction);
     }
     eprintln!(
-        "| effect-{effect} | {} | {} = {:.4e} ({:+.1} % of {truth:e}) | {} | {:.1} s |",
+        "| effect-{effect} | {} | {} = {:.4e} ({:+.1} % of {:e}) | {} | {:.1} s |",
         d.verdict.kind.name(),
-        c.param,
-        e.param_value,
-        (e.param_value - truth) / truth * 100.0,
-        match covers {
-            Some(true) => "yes",
-            Some(false) => "no",
-            None => "no interval",
-        },
+        m.label,
+        m.value,
+        m.error() * 100.0,
+        m.truth,
+        m.covers_text(),
         d.seconds
     );
     let text = add_effect_to_model_toml(bouncelab_model::PAPER_MODEL_TOML, effect, &values).unwrap();
@@ -121,13 +126,84 @@ fn hidden_in(effect: &str, scenario: &Scenario) -> (f64, Option<[f64; 2]>, f64) 
         b.reduced_chi2.0,
         b.reduced_chi2.1
     );
-    assert!(fall >= 3.0, "{effect}: the error fell only {fall:.2}×");
+    let after = second
+        .diagnosis
+        .as_ref()
+        .expect("the diagnosis ran with the effect added");
+    eprintln!(
+        "{effect}: with it added, systematic {:.1} µm against the floor {:.1} µm; {}",
+        after.baseline.systematic_m * 1e6,
+        after.floor.floor_m * 1e6,
+        after.verdict.sentence
+    );
+    assert!(
+        after.baseline.systematic_m <= after.floor.floor_m,
+        "{effect}: {:.1} µm left above the {:.1} µm floor",
+        after.baseline.systematic_m * 1e6,
+        after.floor.floor_m * 1e6
+    );
     assert!(
         second.fit.reduced_chi2 <= 1.5,
         "{effect}: reduced χ² {}",
         second.fit.reduced_chi2
     );
-    (e.param_value, e.param_interval, truth)
+    assert!(
+        m.error().abs() <= 0.1,
+        "{effect}: {} = {} vs {} ({:+.1} %)",
+        m.label,
+        m.value,
+        m.truth,
+        m.error() * 100.0
+    );
+    (m.value, m.interval, m.truth)
+}
+
+/// Prints every search's candidates (this one's, then the search that went on from it): the evidence a
+/// failure is read from.
+fn print_candidates(d: &bouncelab_diagnose::Diagnosis) {
+    let mut level = Some(d);
+    let mut depth = 0;
+    while let Some(d) = level {
+        eprintln!(
+            "  search {}: {} (current model {:?}; systematic {:.1} µm, floor {:.1} µm, noise {:.1} µm, {:.1} s)",
+            depth + 1,
+            d.verdict.kind.name(),
+            d.baseline.fit.effects,
+            d.baseline.systematic_m * 1e6,
+            d.floor.floor_m * 1e6,
+            d.noise.noise_m * 1e6,
+            d.seconds
+        );
+        for ph in d.signature.phases.iter().take(3) {
+            eprintln!(
+                "    residual: {} {}: systematic {:.1} µm, {:.0} % of χ²",
+                ph.component.name(),
+                ph.phase.words(),
+                ph.systematic_m * 1e6,
+                ph.chi2_share * 100.0
+            );
+        }
+        for c in d.candidates.iter().take(5) {
+            match &c.evidence {
+                Some(e) => eprintln!(
+                    "    {}. {} = {:.4e}: held-out {:.1} → {:.1} µm, {:.0} % removed, ΔBIC {:.0}, explains {} (part {}); {}",
+                    c.rank,
+                    c.effect,
+                    e.param_value,
+                    c.heldout_error_before * 1e6,
+                    e.heldout_error_after * 1e6,
+                    e.explained_fraction * 100.0,
+                    e.delta_bic,
+                    c.explains,
+                    c.partly_explains,
+                    c.reasons.join("; ")
+                ),
+                None => eprintln!("    {}. {}: {}", c.rank, c.effect, c.reasons.join("; ")),
+            }
+        }
+        level = d.then.as_deref();
+        depth += 1;
+    }
 }
 
 /// The hidden value of `effect`'s parameter `param` in the scenario's model (its `[extra_effects]` table).
@@ -339,6 +415,7 @@ fn pair(a: &str, b: &str) {
     let run = run(&session, dir.path(), None);
     let d = run.diagnosis.as_ref().expect("the diagnosis ran");
     eprintln!("{a} + {b}: {}", d.verdict.sentence);
+    print_candidates(d);
     let mut named = d.verdict.effects.clone();
     named.sort();
     let mut want = vec![a.to_string(), b.to_string()];
@@ -350,48 +427,90 @@ fn pair(a: &str, b: &str) {
         .candidate(last.verdict.effect.as_deref().expect("a named effect"))
         .unwrap();
     let fit = &c.evidence.as_ref().expect("its fit").fit;
+    for p in &fit.parameters {
+        eprintln!("  {} = {:.6e} {:?}", p.name, p.value, p.interval);
+    }
     for effect in [a, b] {
-        let info = bouncelab_model::builtin(effect).unwrap();
-        let param = info.params[0].name;
-        let truth = scenario_truth(&scenario, effect, param);
-        let p = fit
-            .parameters
-            .iter()
-            .find(|p| p.effect == effect && p.param == param)
-            .unwrap_or_else(|| panic!("{effect}.{param} not fitted: {:?}", fit.parameters));
-        let (mut value, mut truth, mut interval) = (p.value, truth, p.interval);
-        let mut label = format!("{effect}.{param}");
-        if effect == "hunt_crossley" {
-            // λ and n trade along a valley (a larger n with a larger λ fits as well): the magnitude that
-            // the shots determine is the damping force λ·δⁿ·δ̇, compared at δ = 2 mm, δ̇ = 1 m/s.
-            let n_of = |v: Option<f64>| v.unwrap_or(1.0);
-            let n_fit = n_of(
-                fit.parameters
-                    .iter()
-                    .find(|p| p.effect == effect && p.param == "n")
-                    .map(|p| p.value),
-            );
-            let n_true = scenario_truth(&scenario, effect, "n");
-            let force = |lambda: f64, n: f64| lambda * 0.002f64.powf(n);
-            eprintln!("hunt_crossley: λ = {value:.4e}, n = {n_fit:.3} (truth λ = {truth}, n = {n_true})");
-            (value, truth, interval) = (force(value, n_fit), force(truth, n_true), None);
-            label = "hunt_crossley λ·δⁿ at δ = 2 mm (N·s/m)".into();
-        }
-        let err = (value - truth) / truth;
-        let covers = interval.map(|[lo, hi]| lo <= truth && truth <= hi);
+        let m = magnitude(&scenario, effect, &fit.parameters);
         eprintln!(
-            "| pair-{a}+{b} | {} | {label} = {:.4e} ({:+.1} % of {truth:e}) | {} | {:.1} s |",
+            "| pair-{a}+{b} | {} | {} = {:.4e} ({:+.1} % of {:e}) | {} | {:.1} s |",
             d.verdict.kind.name(),
-            value,
-            err * 100.0,
-            match covers {
-                Some(true) => "yes",
-                Some(false) => "no",
-                None => "no interval",
-            },
+            m.label,
+            m.value,
+            m.error() * 100.0,
+            m.truth,
+            m.covers_text(),
             d.seconds
         );
-        assert!(err.abs() <= 0.1, "{label} = {value} vs {truth}");
+        assert!(m.error().abs() <= 0.1, "{} = {} vs {}", m.label, m.value, m.truth);
+    }
+}
+
+/// An effect's magnitude as fitted, against the scenario's truth.
+struct Magnitude {
+    label: String,
+    value: f64,
+    truth: f64,
+    interval: Option<[f64; 2]>,
+}
+
+impl Magnitude {
+    fn error(&self) -> f64 {
+        (self.value - self.truth) / self.truth
+    }
+
+    fn covers_text(&self) -> &'static str {
+        match self.interval {
+            Some([lo, hi]) if lo <= self.truth && self.truth <= hi => "yes",
+            Some(_) => "no",
+            None => "no interval",
+        }
+    }
+}
+
+/// `effect`'s magnitude in `fitted` (a search's fit): its first parameter, except for Hunt–Crossley, whose
+/// magnitude is the damping force per unit speed λ·δⁿ at δ = 2 mm (so a search that frees n is judged by
+/// the force, not by a λ that trades with n along a valley).
+fn magnitude(scenario: &Scenario, effect: &str, fitted: &[bouncelab_diagnose::FittedValue]) -> Magnitude {
+    let find = |param: &str| {
+        fitted
+            .iter()
+            .find(|p| p.effect == effect && p.param == param)
+            .unwrap_or_else(|| panic!("{effect}.{param} not fitted: {fitted:?}"))
+    };
+    let info = bouncelab_model::builtin(effect).unwrap();
+    let param = info.params[0].name;
+    let p = find(param);
+    let truth = scenario_truth(scenario, effect, param);
+    if effect != "hunt_crossley" {
+        return Magnitude {
+            label: format!("{effect}.{param}"),
+            value: p.value,
+            truth,
+            interval: p.interval,
+        };
+    }
+    // n is held at its default (the linear spring's exponent) unless the search freed it; held, λ's
+    // interval gives the force's.
+    let n_free = fitted.iter().find(|p| p.effect == effect && p.param == "n");
+    let n_fit = n_free
+        .map(|p| p.value)
+        .unwrap_or_else(|| info.params[1].default.expect("n has a default"));
+    let n_true = scenario_truth(scenario, effect, "n");
+    let force = |lambda: f64, n: f64| lambda * 0.002f64.powf(n);
+    eprintln!(
+        "hunt_crossley: λ = {:.4e}, n = {n_fit:.3} (truth λ = {truth}, n = {n_true})",
+        p.value
+    );
+    Magnitude {
+        label: "hunt_crossley λ·δⁿ at δ = 2 mm (N·s/m)".into(),
+        value: force(p.value, n_fit),
+        truth: force(truth, n_true),
+        interval: if n_free.is_none() {
+            p.interval.map(|[lo, hi]| [force(lo, n_fit), force(hi, n_fit)])
+        } else {
+            None
+        },
     }
 }
 

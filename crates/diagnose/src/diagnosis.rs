@@ -145,7 +145,7 @@ pub struct Evidence {
     /// unit) at which this session would have named the effect, linearised at the fit: the larger of
     /// `min_param_z` standard errors and the size whose change of the trajectories, after the other
     /// parameters are refitted, has an RMS equal to the floor. `None` when the parameter is not determined
-    /// or the candidate frees more than one parameter of its own (Hunt–Crossley).
+    /// or the candidate frees more than one parameter of its own.
     #[serde(default)]
     pub detection_limit: Option<f64>,
     /// False when the candidate was not cross-validated: its fit to all shots already failed the BIC check,

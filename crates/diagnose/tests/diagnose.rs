@@ -195,6 +195,73 @@ fn two_hidden_effects_are_both_named() {
     }
 }
 
+/// Hertz and drag at the renderer's magnitudes on exact tracks filmed as the renderer films drag (35 ms of
+/// flight either side): both named, each within 10 % (k_h +0.08 %, C_d +0.3 %; 26 s in release). The
+/// rendered pair (`crates/analyze/tests/acceptance.rs`) names neither; this and the next test separate the
+/// search from what `analyze` adds. Slow: ignored.
+#[test]
+#[ignore]
+fn hertz_and_drag_on_long_flights_are_both_named() {
+    hertz_and_drag_on_long_flights(Tracking::default(), SearchOptions::default());
+}
+
+/// [`hertz_and_drag_on_long_flights_are_both_named`] with each shot's surface line off by up to ±40 µm and
+/// the levels free per shot, as `analyze` fits them (here without the prior from each line's σ). **Fails
+/// today (issue 16)**: neither is named; drag's fit goes to C_d = −0.44 (unphysical) and Hertz explains
+/// 16 % — the rendered pair's failure, reproduced in 80 s without rendering or tracking. Ignored until
+/// fixed.
+#[test]
+#[ignore]
+fn hertz_and_drag_on_long_flights_with_surface_levels_are_both_named() {
+    hertz_and_drag_on_long_flights(
+        Tracking {
+            surface_level_m: 40e-6,
+            ..Tracking::default()
+        },
+        SearchOptions {
+            surface_levels: true,
+            ..SearchOptions::default()
+        },
+    );
+}
+
+fn hertz_and_drag_on_long_flights(tracking: Tracking, options: SearchOptions) {
+    let mut model = truth_at(Some("hertz"), &[("k_h", 600_000.0)]);
+    let drag = truth(Some("drag"));
+    model.push(drag.effect("drag").expect("drag").clone_box());
+    let shots = session_filmed(&model, 1, tracking, 0.035);
+    let d = run("hertz + drag, 35 ms", &shots, &options);
+    if let Some(then) = d.then.as_deref() {
+        print("  then", then);
+    }
+    let mut named = d.verdict.effects.clone();
+    named.sort();
+    assert_eq!(named, ["drag", "hertz"], "{}", d.verdict.sentence);
+    let last = d.then.as_deref().unwrap_or(&d);
+    let fit = &last
+        .candidate(&last.verdict.effects[0])
+        .unwrap()
+        .evidence
+        .as_ref()
+        .unwrap()
+        .fit;
+    for (effect, param, truth) in [("hertz", "k_h", 600_000.0), ("drag", "cd", 1.5)] {
+        let p = fit
+            .parameters
+            .iter()
+            .find(|p| p.effect == effect && p.param == param)
+            .unwrap();
+        let err = (p.value - truth) / truth;
+        eprintln!(
+            "{effect}.{param} = {:.4e} ({:+.2} %), interval {:?}",
+            p.value,
+            err * 100.0,
+            p.interval
+        );
+        assert!(err.abs() < 0.1, "{effect}.{param} = {} vs {truth}", p.value);
+    }
+}
+
 #[test]
 fn no_hidden_effect_gives_no_missing_effect_on_three_seeds() {
     for seed in [1, 2, 3] {
@@ -228,12 +295,9 @@ fn no_hidden_effect_gives_no_missing_effect_on_three_seeds() {
         );
         for (effect, set) in MAGNITUDES.iter().filter(|(e, _)| *e != "drag") {
             let Some(c) = d.candidate(effect) else { continue };
+            // Every candidate frees one parameter of its own (Hunt–Crossley's exponent is held), so each
+            // has a linear limit.
             let limit = c.evidence.as_ref().and_then(|e| e.detection_limit);
-            if set.len() > 1 {
-                // Two parameters of its own (Hunt–Crossley): no linear limit.
-                assert!(limit.is_none(), "{effect}: {limit:?}");
-                continue;
-            }
             eprintln!(
                 "  detection limit {effect} {}: {limit:?} (named at {:?})",
                 c.param, set[0].1

@@ -4,9 +4,9 @@
 #![allow(dead_code)]
 
 use bouncelab_diagnose::{Diagnosis, SearchOptions, find_missing_effect};
-use bouncelab_fit::testutil::{Rng, simulate_shot};
+use bouncelab_fit::testutil::{FPS, Rng, simulate_shot};
 use bouncelab_fit::{MeasuredFrame, MeasuredShot, StartState};
-use bouncelab_model::{Model, ModelSpec, State, builtin};
+use bouncelab_model::{Model, ModelSpec, SimOptions, Simulation, State, builtin, simulate_drop};
 
 /// True tracking noise of the centre, m (0.03 px at 4e-4 m/px).
 pub const SIGMA: f64 = 0.03 * 4e-4;
@@ -99,11 +99,36 @@ impl Default for Tracking {
 /// 10 ms after separation, Gaussian noise [`SIGMA`] on the observed centre, an arbitrary x origin, and as
 /// the start the observed state at the first frame (what the estimator measures).
 pub fn session(model: &Model, seed: u64, tracking: Tracking) -> Vec<MeasuredShot> {
+    session_of(model, seed, tracking, simulate_shot)
+}
+
+/// [`session`] filmed `flight_s` before the touch and after the separation (10 ms in [`session`]), as the
+/// renderer films its drag sessions (35 ms).
+pub fn session_filmed(model: &Model, seed: u64, tracking: Tracking, flight_s: f64) -> Vec<MeasuredShot> {
+    session_of(model, seed, tracking, |model, h, a, rng| {
+        let opts = SimOptions::default();
+        let beta = a.to_radians();
+        let probe = simulate_drop(model, beta, h, &[], &opts).expect("synthetic drop simulates");
+        let (t_touch, t_sep) = (probe.impact.t_touch, probe.impact.t_separation);
+        let phase = 0.37 / FPS * rng.uniform();
+        let first = ((t_touch - flight_s) * FPS).ceil() as i64;
+        let last = ((t_sep + flight_s) * FPS).floor() as i64;
+        let times: Vec<f64> = (first..=last).map(|k| k as f64 / FPS + phase).collect();
+        simulate_drop(model, beta, h, &times, &opts).expect("synthetic drop simulates")
+    })
+}
+
+fn session_of(
+    model: &Model,
+    seed: u64,
+    tracking: Tracking,
+    simulate: impl Fn(&Model, f64, f64, &mut Rng) -> Simulation,
+) -> Vec<MeasuredShot> {
     let mut rng = Rng::new(seed);
     let mut shots = Vec::new();
     for &h in &HEIGHTS {
         for &a in &INCLINES {
-            let sim = simulate_shot(model, h, a, &mut rng);
+            let sim = simulate(model, h, a, &mut rng);
             let offset = 0.3 * (rng.uniform() - 0.5);
             let level = tracking.surface_level_m * (2.0 * rng.uniform() - 1.0);
             let (t_touch, t_sep) = (sim.impact.t_touch, sim.impact.t_separation);
