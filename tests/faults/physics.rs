@@ -43,18 +43,22 @@ fn saturated_frames_are_kept_out_of_the_fit() {
 }
 
 /// The reason should be the saturation itself, not its consequences.
+/// The shot is kept out (flagged, or failed with the saturation named) and the session exits 1 like any
+/// session with a shot it could not measure.
 #[test]
-#[ignore = "needs the tracker/estimator to detect saturation over the ball's rim and flag it by name (crates/track, crates/estimate)"]
 fn saturated_frames_are_flagged_as_saturated() {
     let dir = tempfile::tempdir().unwrap();
     let session = copy_session(dir.path());
     gain3(&session.join(CLIPS[0]));
     let out = dir.path().join("out");
-    expect(
+    let ran = expect(
         &mut analyze(&session, &out, &dir.path().join("s.sqlite")),
-        0,
-        &["saturat"],
+        1,
+        &["saturated"],
     );
+    assert!(ran.stderr.contains(CLIPS[0]), "{}", ran.stderr);
+    let fit = std::fs::read_to_string(out.join("fit.json")).unwrap();
+    assert!(!fit.contains(CLIPS[0]));
 }
 
 /// A ball leaving the frame gave frames marked `ok` far from the truth while it was out of view: every
@@ -118,7 +122,6 @@ fn ball_leaving_the_frame(top: u32) {
 
 /// Two moving balls in one clip were tracked without a word: the track warns that there are two.
 #[test]
-#[ignore = "needs the tracker to notice a second moving ball and warn (crates/track acquire.rs)"]
 fn two_moving_balls_are_reported() {
     let dir = tempfile::tempdir().unwrap();
     let session = copy_session(dir.path());

@@ -6,7 +6,7 @@
 //! run killed at any instant leaves each shot complete or absent and the next run resumes.
 
 use crate::{AnalyzeError, Progress, Stage};
-use bouncelab_estimate::{Conditions, Estimate, estimate_with_frames};
+use bouncelab_estimate::{Conditions, Estimate, estimate_with_frames, saturation_flag};
 use bouncelab_frames::{ClipEntry, Downslope, ReadOptions, Session};
 use bouncelab_store::{
     ClipFingerprint, EstimateRecord, Fingerprint, SessionRecord, ShotRecord, Store, TrackRecord, TrajectoryRecord,
@@ -244,7 +244,10 @@ fn measure_clip(entry: &ClipEntry, gravity: f64) -> Measured {
         record,
         estimate
             .map(|e| estimate_record(&e))
-            .map_err(|e| format!("estimating: {e}")),
+            .map_err(|e| match saturation_flag(&track) {
+                Some(why) => format!("estimating: {e}; {why}"),
+                None => format!("estimating: {e}"),
+            }),
     ))
 }
 

@@ -18,7 +18,8 @@ pub use ballistic::{BallisticFit, fit_ballistic, fit_free_acceleration};
 pub use contact::{HeightPoint, TrajectoryContact, find_impact, trajectory_contact};
 pub use roll::session_tilt_deg;
 pub use shot::{
-    Conditions, Estimate, EstimateError, GravityCheck, MIN_FLIGHT_FRAMES, MIN_SIGMA_PX, Measured, PhaseFrames, estimate,
+    Conditions, Estimate, EstimateError, GravityCheck, MIN_FLIGHT_FRAMES, MIN_SIGMA_PX, Measured, PhaseFrames,
+    estimate, saturation_flag,
 };
 pub use spin::{
     Rotation, Spin, SpinFrame, SpinOptions, estimate_with_frames, measure_spin, rotation_between, spin_from_frames,

@@ -401,6 +401,7 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
     let (t_max, delta_max) = deepest(contact, radius, sigma_level, rel_scale);
     let mut notes = choice.notes;
     let mut flags = impossible(vin[1].value, vout[1].value, cor, mu, t_touch.value, t_sep.value);
+    flags.extend(saturation_flag(track));
     let gravity = gravity_check(&incoming, &outgoing, a, c.gravity);
     if let Some(g) = &gravity {
         if !g.consistent {
@@ -468,6 +469,23 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
 /// What no bounce of a ball can give, each as a sentence: the ball must come in towards the surface and leave
 /// it, with COR in [0, 1.05] (a little over 1 for the measurement's error), a contact of 0.1–50 ms that
 /// starts before it ends, and |μ_eff| ≤ 1.5.
+/// Share of a shot's measured frames whose rim may be saturated before the shot is flagged: a few frames
+/// passing a hot spot bias a few centres, which the flight fits' scatter absorbs.
+const SATURATED_FRAMES_SHARE: f64 = 0.05;
+
+/// Why `track` cannot be trusted when more than [`SATURATED_FRAMES_SHARE`] of its measured frames have the
+/// ball's rim in saturated pixels (see [`Track::saturated_frames`]); `None` otherwise. A shot that fails
+/// for another reason is best explained by this too, since clipping is usually the cause.
+pub fn saturation_flag(track: &Track) -> Option<String> {
+    let measured = track.fixes.iter().filter(|f| f.status.measured()).count();
+    (track.saturated_frames > 0 && track.saturated_frames as f64 > SATURATED_FRAMES_SHARE * measured as f64).then(|| {
+        format!(
+            "the ball's rim is saturated in {} of {measured} measured frames (pixels at the file's full scale): its edge, centre and radius are biased there; lower the exposure or the gain",
+            track.saturated_frames
+        )
+    })
+}
+
 fn impossible(v_in_n: f64, v_out_n: f64, cor: f64, mu: f64, t_touch: f64, t_sep: f64) -> Vec<String> {
     let mut flags = Vec::new();
     if !(v_in_n < 0.0 && v_out_n > 0.0) {

@@ -86,6 +86,7 @@ fn shot(model: &Model, incline_deg: f64, drop_m: f64, after: f64, seed: u64) -> 
         seconds_tracking: 0.0,
         downslope_negative_x: false,
         camera: Default::default(),
+        saturated_frames: 0,
     };
     (track, sim.impact)
 }

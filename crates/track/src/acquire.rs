@@ -23,6 +23,8 @@ pub(crate) type Sighting = (f64, f64, f64);
 pub(crate) struct Acquired {
     pub radius: (f64, f64),
     pub seed: (Sighting, Sighting),
+    /// Another moving ball-like circle seen at acquisition: (frame index, x, y) px.
+    pub second: Option<(usize, f64, f64)>,
 }
 
 /// The smallest ball radius searched without a scale, px: below it a ball's rim has too few pixels for a
@@ -109,6 +111,11 @@ pub(crate) fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32, noise: f32) -
                         let b: Vec<Seen> = circles(k + gap)?.into_iter().filter(good).collect();
                         let (a_moved, a_static) = split_static(&a, &b);
                         let (b_moved, _) = split_static(&b, &a);
+                        let loose = |s: &Seen| s.circle.support > CANDIDATE_QUALITY;
+                        let a_all: Vec<Seen> = circles(k)?.into_iter().filter(loose).collect();
+                        let b_all: Vec<Seen> = circles(k + gap)?.into_iter().filter(loose).collect();
+                        let (a_loose, _) = split_static(&a_all, &b_all);
+                        let (b_loose, _) = split_static(&b_all, &a_all);
                         if threshold == CLEAN_QUALITY && votes == Votes::Frame && voters == Voters::Strongest {
                             for c in a_static.iter().map(|s| &s.circle) {
                                 if !still.iter().any(|s| (s.0 - c.x).hypot(s.1 - c.y) < 0.5 * c.r) {
@@ -116,20 +123,28 @@ pub(crate) fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32, noise: f32) -
                                 }
                             }
                         }
-                        if let Some((ca, cb)) = moving_pair(&a_moved, &b_moved, w as f64, |mx, my, r, reach| {
-                            Ok(gap < 2
-                                || circles(k + gap / 2)?.iter().map(|s| &s.circle).any(|c| {
-                                    c.support > threshold
-                                        && (c.x - mx).hypot(c.y - my) <= reach
-                                        && (c.r - r).abs() <= 0.05 * r + 1.0
-                                }))
-                        })? {
+                        if let Some(MovingPair { a: ca, b: cb, other }) = moving_pair(
+                            &a_moved,
+                            &b_moved,
+                            (&a_loose, &b_loose),
+                            w as f64,
+                            threshold,
+                            |mx, my, r, reach, least| {
+                                Ok(gap < 2
+                                    || circles(k + gap / 2)?.iter().map(|s| &s.circle).any(|c| {
+                                        c.support > least
+                                            && (c.x - mx).hypot(c.y - my) <= reach
+                                            && (c.r - r).abs() <= 0.05 * r + 1.0
+                                    }))
+                            },
+                        )? {
                             let r = 0.5 * (ca.r + cb.r);
                             // `k` counts files; time follows frame indices, which count dropped frames too.
                             let t = |pos: usize| clip.time_of(clip.files()[pos].index);
                             return Ok(Acquired {
                                 radius: (0.85 * r, 1.15 * r),
                                 seed: ((t(k), ca.x, ca.y), (t(k + gap), cb.x, cb.y)),
+                                second: other.map(|o| (clip.files()[k].index as usize, o.x, o.y)),
                             });
                         }
                         k += gap;
@@ -161,15 +176,33 @@ pub(crate) fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32, noise: f32) -
 /// The clearest pair (circle in the first frame, in the second) of the same size and of one ball (the same
 /// look, see [`look_correlation`], or, for a plain disc, one that stands out from its surroundings in both,
 /// see [`disc_contrast`]) that moved by more than a pixel and a half and less than half the frame's width, and
-/// that `halfway(x, y, r, reach)` finds again within `reach` of its middle: half-way, the ball is near the
-/// middle of its two sightings (a quarter of the distance covered allows for gravity and for a bounce between
-/// them).
+/// that `halfway(x, y, r, reach, least)` finds again within `reach` of its middle with a circle clearer than
+/// `least` (`threshold` for the ball): half-way, the ball is near the middle of its two sightings (a quarter of
+/// the distance covered allows for gravity and for a bounce between them). Of the `loose` circles (any above
+/// [`CANDIDATE_QUALITY`]), the first such pair clear of the ball (two radii away in both frames) is returned
+/// as a second ball: one cut by the frame's edge is less clear than the ball, but a ball all the same.
 fn moving_pair(
     a: &[Seen],
     b: &[Seen],
+    loose: (&[Seen], &[Seen]),
     width: f64,
-    mut halfway: impl FnMut(f64, f64, f64, f64) -> Result<bool, TrackError>,
-) -> Result<Option<(Circle, Circle)>, TrackError> {
+    threshold: f64,
+    mut halfway: impl FnMut(f64, f64, f64, f64, f64) -> Result<bool, TrackError>,
+) -> Result<Option<MovingPair>, TrackError> {
+    let Some((fa, fb)) = first_found(pairs(a, b, width), &mut halfway, threshold)? else {
+        return Ok(None);
+    };
+    // Another ball: a pair of the looser circles clear of the ball (two radii) in both frames.
+    let clear = |p: &(Circle, Circle)| {
+        (p.0.x - fa.x).hypot(p.0.y - fa.y) >= 2.0 * fa.r && (p.1.x - fb.x).hypot(p.1.y - fb.y) >= 2.0 * fb.r
+    };
+    let others: Vec<(Circle, Circle)> = pairs(loose.0, loose.1, width).into_iter().filter(clear).collect();
+    let other = first_found(others, &mut halfway, CANDIDATE_QUALITY)?.map(|(oa, _)| oa);
+    Ok(Some(MovingPair { a: fa, b: fb, other }))
+}
+
+/// The pairs of `a` × `b` of one size and one ball (see [`moving_pair`]) that moved, clearest first.
+fn pairs(a: &[Seen], b: &[Seen], width: f64) -> Vec<(Circle, Circle)> {
     let mut moving: Vec<(Circle, Circle)> = Vec::new();
     for sa in a {
         for sb in b {
@@ -184,13 +217,29 @@ fn moving_pair(
         }
     }
     moving.sort_by(|p, q| q.0.support.min(q.1.support).total_cmp(&p.0.support.min(p.1.support)));
-    for (ca, cb) in moving {
+    moving
+}
+
+/// The first of `pairs` that `halfway` finds again with a circle clearer than `least`.
+fn first_found(
+    pairs: Vec<(Circle, Circle)>,
+    halfway: &mut impl FnMut(f64, f64, f64, f64, f64) -> Result<bool, TrackError>,
+    least: f64,
+) -> Result<Option<(Circle, Circle)>, TrackError> {
+    for (ca, cb) in pairs {
         let reach = 0.25 * (ca.x - cb.x).hypot(ca.y - cb.y) + 2.0;
-        if halfway(0.5 * (ca.x + cb.x), 0.5 * (ca.y + cb.y), ca.r, reach)? {
+        if halfway(0.5 * (ca.x + cb.x), 0.5 * (ca.y + cb.y), ca.r, reach, least)? {
             return Ok(Some((ca, cb)));
         }
     }
     Ok(None)
+}
+
+/// The ball's two sightings, and a second moving ball-like circle (its first sighting) when there is one.
+struct MovingPair {
+    a: Circle,
+    b: Circle,
+    other: Option<Circle>,
 }
 
 /// The sightings of `here` that are not in `there` at the same place and size (within a pixel and a half or

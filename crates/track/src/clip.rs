@@ -151,6 +151,8 @@ pub struct Track {
     /// What the clip's camera file header says (model, rate, exposure, bit depth, trigger); for a folder of
     /// images only its format.
     pub camera: CameraInfo,
+    /// Measured frames whose rim lies in saturated pixels (at the file's full scale).
+    pub saturated_frames: usize,
 }
 
 impl Track {
@@ -283,7 +285,13 @@ pub fn track_clip(
             "the frames use little of their gray scale: levels stretched {gain:.1}× for the ball and line searches"
         ));
     }
-    let crate::acquire::Acquired { radius, seed } = crate::acquire::acquire(clip, opts, gain, noise)?;
+    let crate::acquire::Acquired { radius, seed, second } = crate::acquire::acquire(clip, opts, gain, noise)?;
+    if let Some((frame, x, y)) = second {
+        warnings.push(format!(
+            "a second moving ball-like circle at ({x:.0}, {y:.0}) in frame {frame}: tracking the clearer one, at ({:.0}, {:.0}) then (crop with --roi if that is the wrong one)",
+            seed.0.1, seed.0.2
+        ));
+    }
     let mut tracker = Tracker::new(TrackOptions {
         radius_px: Some(radius),
         ..opts.tracker.clone()
@@ -298,6 +306,7 @@ pub fn track_clip(
     if let Some(line) = given {
         tracker.set_surface(line);
     }
+    let mut saturated = 0;
     let (fixes, waiting, tracking) = stream_fixes(frames, clip.len(), &mut progress, |frame| {
         // Only a region is copied; a whole frame is read where it lies.
         let cut;
@@ -308,11 +317,15 @@ pub fn track_clip(
             }
             None => frame,
         };
-        with_plane(
+        let fix = with_plane(
             &frame.pixels,
             gain,
             |p| on_plane!(p, p => observe(&mut tracker, frame.index as usize, frame.t_s, &p)),
-        )
+        );
+        if fix.status.measured() && rim_saturated(&frame.pixels, &fix) {
+            saturated += 1;
+        }
+        fix
     })?;
     warnings.extend(tracker.warnings().iter().cloned());
     let mut fixes = fixes;
@@ -351,6 +364,11 @@ pub fn track_clip(
         ));
     }
     let measured = fixes.iter().filter(|f| f.status.measured()).count();
+    if saturated > 0 {
+        warnings.push(format!(
+            "the ball's rim is saturated (pixels at the file's full scale) in {saturated} of {measured} measured frames: its edge, and so the centre and radius there, are biased; lower the exposure or the gain"
+        ));
+    }
     if measured == 0 {
         return Err(TrackError::NoBall {
             clip: clip.dir().display().to_string(),
@@ -389,7 +407,35 @@ pub fn track_clip(
         seconds_tracking: tracking,
         downslope_negative_x: opts.downslope_negative_x,
         camera: clip.camera().clone(),
+        saturated_frames: saturated,
     })
+}
+
+/// Share of the samples around a rim at the file's full scale above which the rim counts as saturated.
+const SATURATED_SHARE: f64 = 0.1;
+
+/// Whether the ball's rim at `fix` lies in saturated pixels: of 64 samples just inside and just outside the
+/// rim (±2 px), more than [`SATURATED_SHARE`] at the pixel type's full scale (255, or 0xFFC0 and above in
+/// 16-bit files, which holds 10- and 12-bit data shifted up). A clipped edge has no gradient where the
+/// tracker looks for one, so the centre and radius there are biased. Cost: 64 pixel reads.
+fn rim_saturated(px: &bouncelab_frames::GrayPixels, fix: &BallFix) -> bool {
+    let (w, h) = (px.width() as f64, px.height() as f64);
+    let full = |x: u32, y: u32| match px {
+        bouncelab_frames::GrayPixels::U8(img) => img.get_pixel(x, y).0[0] == u8::MAX,
+        bouncelab_frames::GrayPixels::U16(img) => img.get_pixel(x, y).0[0] >= 0xFFC0,
+    };
+    let (mut seen, mut clipped) = (0u32, 0u32);
+    for k in 0..32 {
+        let a = std::f64::consts::TAU * k as f64 / 32.0;
+        for d in [-2.0, 2.0] {
+            let (x, y) = (fix.x_px + (fix.r_px + d) * a.cos(), fix.y_px + (fix.r_px + d) * a.sin());
+            if x >= 0.0 && y >= 0.0 && x < w && y < h {
+                seen += 1;
+                clipped += u32::from(full(x as u32, y as u32));
+            }
+        }
+    }
+    seen > 0 && f64::from(clipped) > SATURATED_SHARE * f64::from(seen)
 }
 
 /// Consecutive clean fixes (status ok, quality ≥ [`CLEAN_QUALITY`]) from which a track counts as settled.

@@ -404,6 +404,7 @@ pub fn track_clip_opencv(
         seconds_tracking: tracking,
         downslope_negative_x: opts.downslope_negative_x,
         camera: clip.camera().clone(),
+        saturated_frames: 0,
     })
 }
 
