@@ -6,6 +6,10 @@ use predicates::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
+#[path = "common/files.rs"]
+mod files;
+use files::copy_dir;
+
 fn bouncelab() -> Command {
     Command::cargo_bin("bouncelab").unwrap()
 }
@@ -30,19 +34,6 @@ fn copy_session(root: &Path) -> PathBuf {
     let to = root.join("session");
     copy_dir(&smoke().join("session"), &to);
     to
-}
-
-fn copy_dir(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for e in std::fs::read_dir(from).unwrap() {
-        let e = e.unwrap();
-        let target = to.join(e.file_name());
-        if e.file_type().unwrap().is_dir() {
-            copy_dir(&e.path(), &target);
-        } else {
-            std::fs::copy(e.path(), &target).unwrap();
-        }
-    }
 }
 
 fn analyze(session: &Path, out: &Path) -> Command {

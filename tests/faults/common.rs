@@ -4,6 +4,8 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 use std::time::Duration;
 
+pub use crate::files::copy_dir;
+
 /// Longest any one command may take before the case counts as a hang (debug build, 2 shared cores).
 pub const TIMEOUT: Duration = Duration::from_secs(180);
 
@@ -41,19 +43,6 @@ pub fn copy_session(root: &Path) -> PathBuf {
     let to = root.join("session");
     copy_dir(&smoke().join("session"), &to);
     to
-}
-
-pub fn copy_dir(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for e in std::fs::read_dir(from).unwrap() {
-        let e = e.unwrap();
-        let target = to.join(e.file_name());
-        if e.file_type().unwrap().is_dir() {
-            copy_dir(&e.path(), &target);
-        } else {
-            std::fs::copy(e.path(), &target).unwrap();
-        }
-    }
 }
 
 /// `bouncelab analyze SESSION --out OUT --store STORE --no-diagnose` (the search is not what is tested here,

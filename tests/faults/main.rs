@@ -10,6 +10,8 @@
 
 mod cli;
 mod common;
+#[path = "../common/files.rs"]
+mod files;
 mod kills;
 mod physics;
 mod props;
