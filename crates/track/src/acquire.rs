@@ -69,7 +69,7 @@ pub(crate) fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32, noise: f32) -
         }
         None => (MIN_BALL_RADIUS_PX, w.min(h) as f64 / 2.0),
     };
-    let gap = 10.min(n.saturating_sub(1)).max(1);
+    let gap = sighting_gap(clip.fps(), n);
     let bands = radius_bands(min_radius, max_radius);
     let mut frames = FrameCache::new(clip, opts, gain);
     let background = frames.background()?;
@@ -173,6 +173,27 @@ pub(crate) fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32, noise: f32) -
     })
 }
 
+/// The least distance between a pair's two sightings for it to count as moving, px.
+const MIN_PAIR_MOVE_PX: f64 = 1.5;
+
+/// How long apart the two sightings of a pair are, s: long enough for a falling ball to move clearly more
+/// than [`MIN_PAIR_MOVE_PX`] at the speeds and scales of drop tests, short enough for gravity to leave it near
+/// the middle of its path half-way.
+const SIGHTING_GAP_S: f64 = 1e-3;
+
+/// Files between the two sightings of a pair: [`SIGHTING_GAP_S`] at the clip's frame rate (10 frames at
+/// 10,000 fps, 300 at 300,000), at least 1 and less than the clip. A gap counted in frames instead would
+/// see a ball filmed at 40,000 fps move a pixel in it and take it for still.
+fn sighting_gap(fps: f64, files: usize) -> usize {
+    let frames = (SIGHTING_GAP_S * fps).round();
+    let frames = if frames.is_finite() && frames >= 1.0 {
+        frames as usize
+    } else {
+        1
+    };
+    frames.min(files.saturating_sub(1)).max(1)
+}
+
 /// The clearest pair (circle in the first frame, in the second) of the same size and of one ball (the same
 /// look, see [`look_correlation`], or, for a plain disc, one that stands out from its surroundings in both,
 /// see [`disc_contrast`]) that moved by more than a pixel and a half and less than half the frame's width, and
@@ -211,7 +232,7 @@ fn pairs(a: &[Seen], b: &[Seen], width: f64) -> Vec<(Circle, Circle)> {
             let moved = (ca.x - cb.x).hypot(ca.y - cb.y);
             let same_ball = look_correlation(&sa.look, &sb.look) >= MIN_LOOK_CORRELATION
                 || sa.contrast.min(sb.contrast) >= MIN_DISC_CONTRAST;
-            if same_size && moved > 1.5 && moved < 0.5 * width && same_ball {
+            if same_size && moved > MIN_PAIR_MOVE_PX && moved < 0.5 * width && same_ball {
                 moving.push((ca, cb));
             }
         }
@@ -247,10 +268,9 @@ struct MovingPair {
 fn split_static(here: &[Seen], there: &[Seen]) -> (Vec<Seen>, Vec<Seen>) {
     here.iter().cloned().partition(|s| {
         let c = &s.circle;
-        !there
-            .iter()
-            .map(|o| &o.circle)
-            .any(|o| (o.x - c.x).hypot(o.y - c.y) <= 1.5_f64.max(0.05 * c.r) && (o.r - c.r).abs() <= 0.05 * c.r + 1.0)
+        !there.iter().map(|o| &o.circle).any(|o| {
+            (o.x - c.x).hypot(o.y - c.y) <= MIN_PAIR_MOVE_PX.max(0.05 * c.r) && (o.r - c.r).abs() <= 0.05 * c.r + 1.0
+        })
     })
 }
 
@@ -478,6 +498,17 @@ impl<'a> FrameCache<'a> {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn the_sighting_gap_is_a_time_not_a_frame_count() {
+        use super::sighting_gap;
+        assert_eq!(sighting_gap(10_000.0, 400), 10);
+        assert_eq!(sighting_gap(40_000.0, 1600), 40);
+        assert_eq!(sighting_gap(500.0, 400), 1);
+        assert_eq!(sighting_gap(40_000.0, 15), 14);
+        assert_eq!(sighting_gap(f64::NAN, 15), 1);
+        assert_eq!(sighting_gap(10_000.0, 1), 1);
+    }
+
     use super::*;
     use crate::testutil::{Scene, render};
 
