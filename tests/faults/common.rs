@@ -59,6 +59,26 @@ pub fn analyze(session: &Path, out: &Path, store: &Path) -> assert_cmd::Command 
     c
 }
 
+/// The files whose bytes must match an uninterrupted run (report.html carries the time it was made).
+pub const COMPARED: [&str; 5] = [
+    "estimates.csv",
+    "comparison.csv",
+    "model_predictions.csv",
+    "surfaces.csv",
+    "fit.json",
+];
+
+/// The names starting `.partial` (a temporary output file) in `out` and `out/trajectories`.
+pub fn partial_files(out: &Path) -> Vec<String> {
+    [out.to_path_buf(), out.join("trajectories")]
+        .iter()
+        .filter_map(|d| std::fs::read_dir(d).ok())
+        .flatten()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with(".partial"))
+        .collect()
+}
+
 /// What a run did.
 pub struct Ran {
     pub code: i32,

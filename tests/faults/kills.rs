@@ -4,15 +4,6 @@
 use crate::common::*;
 use std::time::{Duration, Instant};
 
-/// The files whose bytes must match an uninterrupted run (report.html carries the time it was made).
-const COMPARED: [&str; 5] = [
-    "estimates.csv",
-    "comparison.csv",
-    "model_predictions.csv",
-    "surfaces.csv",
-    "fit.json",
-];
-
 #[test]
 fn killed_at_every_stage_it_resumes_to_identical_outputs() {
     let dir = tempfile::tempdir().unwrap();
@@ -60,12 +51,7 @@ fn killed_at_every_stage_it_resumes_to_identical_outputs() {
         assert_eq!(s.estimates(id).unwrap().len(), 3);
         assert_eq!(s.fits(None).unwrap().len(), 1, "kill at {fraction}: one fit row");
         // A temporary file the killed run left is cleared by the next.
-        let leftovers: Vec<_> = [out.clone(), out.join("trajectories")]
-            .iter()
-            .flat_map(|d| std::fs::read_dir(d).unwrap())
-            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-            .filter(|n| n.starts_with(".partial"))
-            .collect();
+        let leftovers = partial_files(&out);
         assert!(leftovers.is_empty(), "{leftovers:?}");
     }
 }

@@ -10,6 +10,7 @@
 
 mod cli;
 mod common;
+mod disk;
 #[path = "../common/files.rs"]
 mod files;
 mod kills;

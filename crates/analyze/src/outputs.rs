@@ -131,12 +131,19 @@ pub(crate) fn write_atomic(
     static COUNTER: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
     let n = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let tmp = path.with_file_name(format!(".partial-{}-{n}", std::process::id()));
-    {
-        let mut file = std::io::BufWriter::new(std::fs::File::create(&tmp).map_err(io)?);
-        write(&mut file).map_err(io)?;
-        file.flush().map_err(io)?;
+    let written = std::fs::File::create(&tmp).and_then(|file| {
+        let mut file = std::io::BufWriter::new(file);
+        write(&mut file)?;
+        file.flush()
+    });
+    // A failed write (a full disk, say) leaves no temporary file behind; the previous `path` is untouched.
+    match written.and_then(|()| std::fs::rename(&tmp, path)) {
+        Ok(()) => Ok(()),
+        Err(source) => {
+            let _ = std::fs::remove_file(&tmp);
+            Err(io(source))
+        }
     }
-    std::fs::rename(&tmp, path).map_err(io)
 }
 
 fn num(v: f64) -> String {

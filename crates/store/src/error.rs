@@ -30,6 +30,18 @@ pub enum StoreError {
         #[source]
         source: rusqlite::Error,
     },
+    /// The disk holding the database is full: the statement or transaction was rolled back, and what earlier
+    /// transactions stored is kept.
+    #[error(
+        "{}: the disk is full, so the results store could not be written (table `{table}`); what was stored before is kept: free space and run again",
+        .path.display()
+    )]
+    DiskFull {
+        /// The database file.
+        path: PathBuf,
+        /// The table the statement was about (`(transaction)` for the commit).
+        table: &'static str,
+    },
     /// A value is not acceptable for its column, or a stored value cannot be read back.
     #[error("{}: table `{table}`, field `{field}`: {message}", .path.display())]
     Field {

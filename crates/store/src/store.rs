@@ -39,7 +39,13 @@ pub struct Tx<'a> {
 
 fn sql(path: &Path, table: &'static str) -> impl FnOnce(rusqlite::Error) -> StoreError + use<> {
     let path = path.to_path_buf();
-    move |source| StoreError::Sql { path, table, source }
+    move |source| {
+        if source.sqlite_error_code() == Some(rusqlite::ErrorCode::DiskFull) {
+            StoreError::DiskFull { path, table }
+        } else {
+            StoreError::Sql { path, table, source }
+        }
+    }
 }
 
 /// NaN is stored as NULL.
