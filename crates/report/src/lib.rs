@@ -28,6 +28,7 @@ mod error;
 mod fit;
 mod fmt;
 mod force;
+mod html;
 mod page;
 mod shots;
 mod stats;
