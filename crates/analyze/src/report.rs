@@ -120,16 +120,59 @@ pub(crate) struct Predictions {
     pub failures: Vec<String>,
 }
 
+/// The fit's prediction of one impact as the report shows it. Like every mapper below, it names each of
+/// the producer's fields (no `..`), so a field the producer gains, loses or renames stops this crate
+/// compiling until it is shown here or left out on purpose (`field: _`).
 fn prediction(p: &bouncelab_fit::ImpactPrediction) -> r::ShotPrediction {
+    let bouncelab_fit::ImpactPrediction {
+        // The incoming velocity is the shot's measured one; the outgoing one is shown as COR and μ_eff.
+        v_in: _,
+        v_out: _,
+        cor,
+        mu_eff,
+        contact_time_s,
+        delta_max_m,
+        omega_out_rad_s,
+        peak_force_n,
+        peak_deceleration_m_s2,
+        // Shown for one shot only, as the contact force section.
+        force: _,
+    } = *p;
     r::ShotPrediction {
-        cor: p.cor,
-        mu_eff: p.mu_eff,
-        contact_time_s: p.contact_time_s,
-        delta_max_m: p.delta_max_m,
-        spin_out_rad_s: p.omega_out_rad_s,
-        peak_force_n: p.peak_force_n,
-        peak_deceleration_m_s2: p.peak_deceleration_m_s2,
+        cor,
+        mu_eff,
+        contact_time_s,
+        delta_max_m,
+        spin_out_rad_s: omega_out_rad_s,
+        peak_force_n,
+        peak_deceleration_m_s2,
     }
+}
+
+fn force_sample(f: &bouncelab_fit::ForceSample) -> r::ForceSample {
+    let bouncelab_fit::ForceSample { t_s, delta_m, force_n } = *f;
+    r::ForceSample { t_s, delta_m, force_n }
+}
+
+fn measured_point(f: &bouncelab_fit::MeasuredFrame) -> r::MeasuredPoint {
+    let bouncelab_fit::MeasuredFrame { t_s, x_m, y_m, sigma_m } = *f;
+    r::MeasuredPoint { t_s, x_m, y_m, sigma_m }
+}
+
+fn residual(p: &bouncelab_compare::ResidualPoint) -> r::Residual {
+    let bouncelab_compare::ResidualPoint {
+        t_s,
+        // Shown as the shot's phase spans.
+        phase: _,
+        dx_m,
+        dy_m,
+        // The tracking σ is drawn from the measured points.
+        sigma_m: _,
+        // Spin residuals are not plotted.
+        d_omega_rad_s: _,
+        sigma_omega_rad_s: _,
+    } = *p;
+    r::Residual { t_s, dx_m, dy_m }
 }
 
 /// The surfaces of `a`'s shots in order of first appearance.
@@ -148,33 +191,10 @@ fn surfaces_of(shots: &[ShotData]) -> Vec<String> {
 pub(crate) fn predictions(spec: &ModelSpec, fit: &FitResult, shots: &[ShotData]) -> Predictions {
     let sim = SimOptions::default();
     let mut failures = Vec::new();
-    let mut models: BTreeMap<String, Result<Model, String>> = BTreeMap::new();
-    for s in surfaces_of(shots) {
-        let m = fitted_model(spec, fit, &s).map_err(|e| e.to_string());
-        if let Err(e) = &m {
-            failures.push(format!("surface {s}: no fitted model to predict with: {e}"));
-        }
-        models.insert(s, m);
-    }
-    let at = |s: &ShotData, samples: usize| {
-        let model = models.get(&s.surface).and_then(|m| m.as_ref().ok())?;
-        let e = &s.estimate;
-        let v = [e.v_in[0].value, e.v_in[1].value];
-        Some(
-            predict_impact(
-                model,
-                s.angle_deg.to_radians(),
-                v,
-                e.spin_in.map_or(0.0, |w| w.value),
-                samples,
-                &sim,
-            )
-            .map_err(|err| format!("{}: the fitted model's prediction failed: {err}", s.clip)),
-        )
-    };
+    let models = surface_models(spec, fit, shots, &mut failures);
     let per_shot = shots
         .iter()
-        .map(|s| match at(s, 20)? {
+        .map(|s| match predict_shot(&models, s, PREDICTION_SAMPLES, &sim)? {
             Ok(p) => Some(prediction(&p)),
             Err(e) => {
                 failures.push(e);
@@ -182,76 +202,152 @@ pub(crate) fn predictions(spec: &ModelSpec, fit: &FitResult, shots: &[ShotData])
             }
         })
         .collect();
-    let mut curves = Vec::new();
-    for (surface, model) in &models {
-        let Ok(model) = model else { continue };
-        let of: Vec<&ShotData> = shots.iter().filter(|s| &s.surface == surface).collect();
-        let speeds: Vec<f64> = of
-            .iter()
-            .map(|s| s.estimate.v_in[1].value.abs())
-            .filter(|v| v.is_finite() && *v > 0.0)
-            .collect();
-        let (lo, hi) = speeds
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(*v), b.max(*v)));
-        if !lo.is_finite() {
-            continue;
-        }
-        let pad = ((hi - lo) * CURVE_MARGIN).max(0.05 * lo);
-        let (lo, hi) = ((lo - pad).max(0.05), hi + pad);
-        let mut angles: Vec<f64> = of.iter().map(|s| s.angle_deg).filter(|a| a.is_finite()).collect();
-        angles.sort_by(f64::total_cmp);
-        angles.dedup();
-        for angle in angles {
-            let beta = angle.to_radians();
-            let mut points = Vec::with_capacity(CURVE_POINTS);
-            for k in 0..CURVE_POINTS {
-                let v = lo + (hi - lo) * k as f64 / (CURVE_POINTS - 1) as f64;
-                // A vertical drop onto the incline: the tangential speed is v_n·tan β.
-                match predict_impact(model, beta, [v * beta.tan(), -v], 0.0, 20, &sim) {
-                    Ok(p) => points.push(r::CurvePoint {
-                        v_in_n_m_s: v,
-                        prediction: prediction(&p),
-                    }),
-                    Err(e) => failures.push(format!(
-                        "surface {surface} at {angle}°: the model's curve stops at {v:.3} m/s: {e}"
-                    )),
-                }
-            }
-            curves.push(r::ModelCurve {
-                surface: surface.clone(),
-                angle_deg: angle,
-                points,
-            });
-        }
-    }
-    let force = median_shot(shots)
-        .ok_or_else(|| "no shot with a measured impact speed".to_string())
-        .and_then(|s| {
-            let p = at(s, FORCE_SAMPLES).ok_or_else(|| format!("no fitted model for surface {}", s.surface))??;
-            Ok(r::ContactForce {
-                clip: s.clip.clone(),
-                surface: s.surface.clone(),
-                angle_deg: s.angle_deg,
-                v_in_n_m_s: s.estimate.v_in[1].value.abs(),
-                why: "the shot nearest the session's median impact speed".into(),
-                samples: p
-                    .force
-                    .iter()
-                    .map(|f| r::ForceSample {
-                        t_s: f.t_s,
-                        delta_m: f.delta_m,
-                        force_n: f.force_n,
-                    })
-                    .collect(),
-            })
-        });
+    let curves = model_curves(&models, shots, &sim, &mut failures);
+    let force = contact_force(&models, shots, &sim);
     Predictions {
         per_shot,
         curves,
         force,
         failures,
     }
+}
+
+/// Force samples of a prediction whose contact force is not shown (per shot, along the curves).
+const PREDICTION_SAMPLES: usize = 20;
+
+/// The fitted model of every surface of `shots`, or why there is none (also pushed to `failures`).
+fn surface_models(
+    spec: &ModelSpec,
+    fit: &FitResult,
+    shots: &[ShotData],
+    failures: &mut Vec<String>,
+) -> BTreeMap<String, Result<Model, String>> {
+    let mut models = BTreeMap::new();
+    for s in surfaces_of(shots) {
+        let m = fitted_model(spec, fit, &s).map_err(|e| e.to_string());
+        if let Err(e) = &m {
+            failures.push(format!("surface {s}: no fitted model to predict with: {e}"));
+        }
+        models.insert(s, m);
+    }
+    models
+}
+
+/// The fitted model hit at shot `s`'s measured incoming velocity and spin, with `samples` instants of its
+/// contact force; `None` when its surface has no fitted model.
+fn predict_shot(
+    models: &BTreeMap<String, Result<Model, String>>,
+    s: &ShotData,
+    samples: usize,
+    sim: &SimOptions,
+) -> Option<Result<bouncelab_fit::ImpactPrediction, String>> {
+    let model = models.get(&s.surface).and_then(|m| m.as_ref().ok())?;
+    let e = &s.estimate;
+    let v = [e.v_in[0].value, e.v_in[1].value];
+    Some(
+        predict_impact(
+            model,
+            s.angle_deg.to_radians(),
+            v,
+            e.spin_in.map_or(0.0, |w| w.value),
+            samples,
+            sim,
+        )
+        .map_err(|err| format!("{}: the fitted model's prediction failed: {err}", s.clip)),
+    )
+}
+
+/// One curve per surface with a fitted model and per incline of its shots, over the surface's measured
+/// normal speeds widened by [`CURVE_MARGIN`]; a point the model cannot predict ends up in `failures`.
+fn model_curves(
+    models: &BTreeMap<String, Result<Model, String>>,
+    shots: &[ShotData],
+    sim: &SimOptions,
+    failures: &mut Vec<String>,
+) -> Vec<r::ModelCurve> {
+    let mut curves = Vec::new();
+    for (surface, model) in models {
+        let Ok(model) = model else { continue };
+        let of: Vec<&ShotData> = shots.iter().filter(|s| &s.surface == surface).collect();
+        let Some((lo, hi)) = curve_speeds(&of) else {
+            continue;
+        };
+        let mut angles: Vec<f64> = of.iter().map(|s| s.angle_deg).filter(|a| a.is_finite()).collect();
+        angles.sort_by(f64::total_cmp);
+        angles.dedup();
+        for angle in angles {
+            curves.push(model_curve(model, surface, angle, (lo, hi), sim, failures));
+        }
+    }
+    curves
+}
+
+/// The normal speeds a surface's curves span: its shots' measured range widened by [`CURVE_MARGIN`] (at
+/// least 5 % of the lowest speed) and kept above 0.05 m/s; `None` when no shot has a measured speed.
+fn curve_speeds(of: &[&ShotData]) -> Option<(f64, f64)> {
+    let speeds: Vec<f64> = of
+        .iter()
+        .map(|s| s.estimate.v_in[1].value.abs())
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .collect();
+    let (lo, hi) = speeds
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(*v), b.max(*v)));
+    if !lo.is_finite() {
+        return None;
+    }
+    let pad = ((hi - lo) * CURVE_MARGIN).max(0.05 * lo);
+    Some(((lo - pad).max(0.05), hi + pad))
+}
+
+/// The model of `surface` at incline `angle` (degrees) over `speeds` (m/s), [`CURVE_POINTS`] evenly spaced.
+fn model_curve(
+    model: &Model,
+    surface: &str,
+    angle: f64,
+    (lo, hi): (f64, f64),
+    sim: &SimOptions,
+    failures: &mut Vec<String>,
+) -> r::ModelCurve {
+    let beta = angle.to_radians();
+    let mut points = Vec::with_capacity(CURVE_POINTS);
+    for k in 0..CURVE_POINTS {
+        let v = lo + (hi - lo) * k as f64 / (CURVE_POINTS - 1) as f64;
+        // A vertical drop onto the incline: the tangential speed is v_n·tan β.
+        match predict_impact(model, beta, [v * beta.tan(), -v], 0.0, PREDICTION_SAMPLES, sim) {
+            Ok(p) => points.push(r::CurvePoint {
+                v_in_n_m_s: v,
+                prediction: prediction(&p),
+            }),
+            Err(e) => failures.push(format!(
+                "surface {surface} at {angle}°: the model's curve stops at {v:.3} m/s: {e}"
+            )),
+        }
+    }
+    r::ModelCurve {
+        surface: surface.to_string(),
+        angle_deg: angle,
+        points,
+    }
+}
+
+/// The contact force over the impact of the shot nearest the session's median impact speed.
+fn contact_force(
+    models: &BTreeMap<String, Result<Model, String>>,
+    shots: &[ShotData],
+    sim: &SimOptions,
+) -> Result<r::ContactForce, String> {
+    let s = median_shot(shots).ok_or_else(|| "no shot with a measured impact speed".to_string())?;
+    let p = predict_shot(models, s, FORCE_SAMPLES, sim)
+        .ok_or_else(|| format!("no fitted model for surface {}", s.surface))??;
+    Ok(r::ContactForce {
+        clip: s.clip.clone(),
+        surface: s.surface.clone(),
+        angle_deg: s.angle_deg,
+        v_in_n_m_s: s.estimate.v_in[1].value.abs(),
+        why: "the shot nearest the session's median impact speed".into(),
+        samples: p.force.iter().map(force_sample).collect(),
+    })
 }
 
 /// The shot whose incoming normal speed is nearest the session's median (the lower median for an even
@@ -268,7 +364,8 @@ fn median_shot(shots: &[ShotData]) -> Option<&ShotData> {
 }
 
 fn measured(m: bouncelab_estimate::Measured) -> r::Measured {
-    r::Measured::new(m.value, m.se)
+    let bouncelab_estimate::Measured { value, se } = m;
+    r::Measured::new(value, se)
 }
 
 /// Every measured quantity of a shot, with the model's prediction for it; `ball_mass_kg` and `gravity`
@@ -311,6 +408,20 @@ pub(crate) fn shot_chi2_red(fit: &FitResult, shot: &str) -> Option<f64> {
     (nu > 0.0).then(|| s.chi2 / nu)
 }
 
+/// The page title: the session folder's name.
+fn title(session_dir: &Path) -> String {
+    let name = session_dir
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| session_dir.display().to_string());
+    format!("bouncelab report: {name}")
+}
+
+/// The program and version that made the report.
+fn generated_by() -> String {
+    format!("bouncelab {}", env!("CARGO_PKG_VERSION"))
+}
+
 /// Everything `report.html` shows about `a`.
 pub(crate) fn build(a: &Analysis, p: &Predictions, description: Option<&str>, warnings: &[String]) -> r::Report {
     let surfaces = surfaces_of(&a.shots);
@@ -328,19 +439,14 @@ pub(crate) fn build(a: &Analysis, p: &Predictions, description: Option<&str>, wa
             tilts.len()
         ));
     }
-    let session_name = a
-        .session_dir
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| a.session_dir.display().to_string());
     r::Report {
-        title: format!("bouncelab report: {session_name}"),
+        title: title(&a.session_dir),
         session: r::SessionInfo {
             path: a.session_dir.display().to_string(),
             description: description.unwrap_or_default().to_string(),
             shots: a.shots_listed,
             surfaces,
-            generated_by: format!("bouncelab {}", env!("CARGO_PKG_VERSION")),
+            generated_by: generated_by(),
             generated_at: a.fitted_at.clone(),
             metadata: vec![("Model".into(), a.model_origin.clone())],
         },
@@ -352,26 +458,21 @@ pub(crate) fn build(a: &Analysis, p: &Predictions, description: Option<&str>, wa
             .map(|(s, m)| measurement(s, *m, a.model.ball.mass_kg, a.model.gravity))
             .collect(),
         model_curves: p.curves.clone(),
-        contact_force: match &p.force {
-            Ok(f) => r::Section::Available(f.clone()),
-            Err(e) => r::Section::unavailable(e.clone()),
-        },
-        ancova: match &a.stats {
-            Ok(s) => r::Section::Available(s.ancova.clone()),
-            Err(e) => r::Section::unavailable(e.clone()),
-        },
-        inference: match &a.stats {
-            Ok(s) => match &s.inference {
-                Ok(i) => r::Section::Available(i.clone()),
-                Err(e) => r::Section::unavailable(e.clone()),
-            },
-            Err(e) => r::Section::unavailable(e.clone()),
-        },
+        contact_force: p.force.clone().into(),
+        ancova: a.stats.as_ref().map(|s| s.ancova.clone()).map_err(String::clone).into(),
+        inference: a
+            .stats
+            .as_ref()
+            .map_err(String::clone)
+            .and_then(|s| s.inference.clone())
+            .into(),
         fit: r::Section::Available(fit_summary(a)),
-        diagnosis: match &a.diagnosis {
-            Ok(d) => r::Section::Available(diagnosis(d, a)),
-            Err(why) => r::Section::unavailable(why.clone()),
-        },
+        diagnosis: a
+            .diagnosis
+            .as_ref()
+            .map(|d| diagnosis(d, a))
+            .map_err(String::clone)
+            .into(),
         model_change: match &a.before {
             Some(_) => r::Section::Available(model_change(a)),
             None => r::Section::unavailable("this is the first model fitted to this session in the store"),
@@ -450,26 +551,10 @@ fn shot_plot(a: &Analysis, c: &ShotComparison) -> r::ShotPlot {
         surface: c.surface.clone(),
         angle_deg: c.incline_deg,
         drop_height_m: c.drop_height_m,
-        measured: frames
-            .iter()
-            .map(|f| r::MeasuredPoint {
-                t_s: f.t_s,
-                x_m: f.x_m,
-                y_m: f.y_m,
-                sigma_m: f.sigma_m,
-            })
-            .collect(),
+        measured: frames.iter().map(measured_point).collect(),
         model,
         phases,
-        residuals: c
-            .residuals
-            .iter()
-            .map(|p| r::Residual {
-                t_s: p.t_s,
-                dx_m: p.dx_m,
-                dy_m: p.dy_m,
-            })
-            .collect(),
+        residuals: c.residuals.iter().map(residual).collect(),
         rms_m: Some(c.rms_m),
         chi2_red: shot_chi2_red(&a.fit, &c.shot),
         notes,
@@ -491,45 +576,76 @@ fn fit_summary(a: &Analysis) -> r::FitSummary {
     let f = &a.fit;
     r::FitSummary {
         model_name: a.model_origin.clone(),
-        parameters: f
-            .parameters
-            .iter()
-            .map(|p| r::FitParameter {
-                name: p.name.clone(),
-                value: p.value,
-                std_error: p.std_error,
-                interval: p.interval,
-                unit: unit(&p.effect, &p.param),
-                at_bound: p.at_bound,
-            })
-            .collect(),
+        parameters: f.parameters.iter().map(fit_parameter).collect(),
         confidence: f.confidence,
         reduced_chi2: Some(f.reduced_chi2),
         dof: Some(f.dof),
         rms_m: Some(f.rms_m),
         termination: format!("{} after {} iteration(s)", f.termination, f.iterations),
         mean_abs_error_pct: f.mean_abs_cor_error_pct,
-        by_surface: f
-            .cor_error_by_surface
-            .iter()
-            .map(|s| r::SurfaceError {
-                surface: s.surface.clone(),
-                shots: s.shots,
-                mean_abs_error_pct: s.mean_abs_error_pct,
-            })
-            .collect(),
-        oblique: f
-            .oblique
-            .iter()
-            .map(|o| r::ObliqueRow {
-                clip: o.shot.clone(),
-                surface: o.surface.clone(),
-                angle_deg: o.incline_deg,
-                v_out_measured: o.v_out_measured,
-                v_out_predicted: o.v_out_predicted,
-                error_pct: o.error_pct,
-            })
-            .collect(),
+        by_surface: f.cor_error_by_surface.iter().map(surface_error).collect(),
+        oblique: f.oblique.iter().map(oblique_row).collect(),
+    }
+}
+
+fn fit_parameter(p: &bouncelab_fit::FittedParam) -> r::FitParameter {
+    let bouncelab_fit::FittedParam {
+        name,
+        effect,
+        param,
+        // Part of the name already (`clay:spring.k`).
+        surface: _,
+        // The solver's start and bounds are the model file's, not results.
+        initial: _,
+        bounds: _,
+        value,
+        std_error,
+        interval,
+        at_bound,
+        // Not shown yet: the report shows such a parameter's value and its missing standard error.
+        not_identified: _,
+    } = p;
+    r::FitParameter {
+        name: name.clone(),
+        value: *value,
+        std_error: *std_error,
+        interval: *interval,
+        unit: unit(effect, param),
+        at_bound: *at_bound,
+    }
+}
+
+fn surface_error(e: &bouncelab_fit::SurfaceError) -> r::SurfaceError {
+    let bouncelab_fit::SurfaceError {
+        surface,
+        shots,
+        mean_abs_error_pct,
+    } = e;
+    r::SurfaceError {
+        surface: surface.clone(),
+        shots: *shots,
+        mean_abs_error_pct: *mean_abs_error_pct,
+    }
+}
+
+fn oblique_row(o: &bouncelab_fit::ObliqueRow) -> r::ObliqueRow {
+    let bouncelab_fit::ObliqueRow {
+        shot,
+        surface,
+        incline_deg,
+        // The shot's measured incoming velocity is in its measurements.
+        v_in: _,
+        v_out_measured,
+        v_out_predicted,
+        error_pct,
+    } = o;
+    r::ObliqueRow {
+        clip: shot.clone(),
+        surface: surface.clone(),
+        angle_deg: *incline_deg,
+        v_out_measured: *v_out_measured,
+        v_out_predicted: *v_out_predicted,
+        error_pct: *error_pct,
     }
 }
 
@@ -580,14 +696,37 @@ fn signature(d: &Diagnosis) -> Vec<r::SignatureRow> {
         .phases
         .iter()
         .filter(|p| p.component != Component::Spin)
-        .map(|p| r::SignatureRow {
-            phase: phase(p.phase),
-            normal: p.component == Component::Normal,
-            rms_m: p.rms_m,
-            systematic_m: p.systematic_m,
-            chi2_share: p.chi2_share,
+        .map(|p| {
+            let bouncelab_diagnose::PhaseResidual {
+                phase,
+                component,
+                // The counts and the reduced χ² are in the diagnosis' own output, not the report.
+                n: _,
+                rms_m,
+                systematic_m,
+                chi2_share,
+                chi2_red: _,
+            } = *p;
+            signature_row(phase, component, rms_m, systematic_m, chi2_share)
         })
         .collect()
+}
+
+/// One row of a residual's signature (position components only).
+fn signature_row(
+    p: ImpactPhase,
+    component: Component,
+    rms_m: f64,
+    systematic_m: f64,
+    chi2_share: f64,
+) -> r::SignatureRow {
+    r::SignatureRow {
+        phase: phase(p),
+        normal: component == Component::Normal,
+        rms_m,
+        systematic_m,
+        chi2_share,
+    }
 }
 
 /// The signature of the current fit from its comparison, when no diagnosis ran: the systematic part taken
@@ -610,12 +749,14 @@ fn signature_of_comparison(a: &Analysis) -> Vec<r::SignatureRow> {
         .overall
         .iter()
         .filter(|s| s.component != Component::Spin)
-        .map(|s| r::SignatureRow {
-            phase: phase(s.phase),
-            normal: s.component == Component::Normal,
-            rms_m: s.rms_m,
-            systematic_m: (s.rms_m * s.rms_m - noise2).max(0.0).sqrt(),
-            chi2_share: if chi2 > 0.0 { s.chi2 / chi2 } else { 0.0 },
+        .map(|s| {
+            signature_row(
+                s.phase,
+                s.component,
+                s.rms_m,
+                (s.rms_m * s.rms_m - noise2).max(0.0).sqrt(),
+                if chi2 > 0.0 { s.chi2 / chi2 } else { 0.0 },
+            )
         })
         .collect();
     rows.sort_by(|a, b| b.chi2_share.total_cmp(&a.chi2_share));
@@ -636,18 +777,7 @@ fn diagnosis(d: &Diagnosis, a: &Analysis) -> r::DiagnosisSection {
         evidence,
         signature: signature(d),
         error_metric: "position RMS of all frames (x and y), held-out by cross-validation across shots".into(),
-        candidates: d
-            .candidates
-            .iter()
-            .map(|c| r::Candidate {
-                effect: c.effect.clone(),
-                error_before: c.error_before,
-                error_after: c.evidence.as_ref().map_or(f64::NAN, |e| e.error_after),
-                delta_bic: c.evidence.as_ref().map_or(f64::NAN, |e| e.delta_bic),
-                heldout_before: Some(c.heldout_error_before),
-                heldout_after: c.evidence.as_ref().map(|e| e.heldout_error_after),
-            })
-            .collect(),
+        candidates: d.candidates.iter().map(candidate).collect(),
         model_history: a
             .history
             .iter()
@@ -662,6 +792,58 @@ fn diagnosis(d: &Diagnosis, a: &Analysis) -> r::DiagnosisSection {
                 })
             })
             .collect(),
+    }
+}
+
+/// One candidate's errors before and after; a failed fit shows NaN after.
+fn candidate(c: &bouncelab_diagnose::Candidate) -> r::Candidate {
+    let bouncelab_diagnose::Candidate {
+        effect,
+        // The table is in rank order already; the checks and reasons are in the verdict's evidence.
+        rank: _,
+        explains: _,
+        partly_explains: _,
+        checks: _,
+        reasons: _,
+        error_before,
+        heldout_error_before,
+        param: _,
+        neutral: _,
+        evidence,
+        failed: _,
+        seconds: _,
+    } = c;
+    let after = evidence.as_ref().map(|e| {
+        let bouncelab_diagnose::Evidence {
+            error_after,
+            delta_bic,
+            heldout_error_after,
+            // The rest supports the verdict, whose sentence and evidence the report shows.
+            error_fall: _,
+            heldout_log_ratio: _,
+            heldout_p: _,
+            heldout_p_holm: _,
+            shots_improved: _,
+            explained_fraction: _,
+            systematic_after_m: _,
+            chi2_red_after: _,
+            chi2_red_noise_after: _,
+            param_value: _,
+            param_interval: _,
+            param_z: _,
+            detection_limit: _,
+            cross_validated: _,
+            fit: _,
+        } = e;
+        (*error_after, *delta_bic, *heldout_error_after)
+    });
+    r::Candidate {
+        effect: effect.clone(),
+        error_before: *error_before,
+        error_after: after.map_or(f64::NAN, |a| a.0),
+        delta_bic: after.map_or(f64::NAN, |a| a.1),
+        heldout_before: Some(*heldout_error_before),
+        heldout_after: after.map(|a| a.2),
     }
 }
 
@@ -753,20 +935,15 @@ pub(crate) fn write_failure(
         };
         notes.push(format!("{clip}: not measured: {why} ({got})"));
     }
-    let name = session
-        .dir
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| session.dir.display().to_string());
     let none = "no shot could be measured (see the notes for each shot's reason)";
     let report = r::Report {
-        title: format!("bouncelab report: {name}"),
+        title: title(&session.dir),
         session: r::SessionInfo {
             path: session.dir.display().to_string(),
             description: String::new(),
             shots: session.listed().len(),
             surfaces: Vec::new(),
-            generated_by: format!("bouncelab {}", env!("CARGO_PKG_VERSION")),
+            generated_by: generated_by(),
             generated_at: None,
             metadata: vec![("shots measured".into(), "0".into())],
         },
@@ -933,6 +1110,122 @@ fn key_frame_strip(entry: &bouncelab_frames::ClipEntry, shot: &ShotData) -> Resu
 mod tests {
     use super::*;
     use bouncelab_fit::MeasuredFrame;
+    use serde::Serialize;
+
+    /// Every key of `mirror` (a report type, serialised) carries the producer's value under the same key,
+    /// or under the key `renamed` pairs it with; `derived` keys are filled from elsewhere. Catches a mapper
+    /// that puts a value in the wrong field or the wrong unit, and a mirror field without a source.
+    fn assert_mirrors(producer: &impl Serialize, mirror: &impl Serialize, renamed: &[(&str, &str)], derived: &[&str]) {
+        let p = serde_json::to_value(producer).unwrap();
+        let m = serde_json::to_value(mirror).unwrap();
+        let (p, m) = (p.as_object().unwrap(), m.as_object().unwrap());
+        for (key, value) in m {
+            if derived.contains(&key.as_str()) {
+                continue;
+            }
+            let from = renamed.iter().find(|r| r.0 == key).map_or(key.as_str(), |r| r.1);
+            assert_eq!(
+                p.get(from),
+                Some(value),
+                "report field `{key}` against producer field `{from}`"
+            );
+        }
+        for (to, from) in renamed {
+            assert!(
+                m.contains_key(*to) && p.contains_key(*from),
+                "stale rename {from} → {to}"
+            );
+        }
+    }
+
+    #[test]
+    fn the_report_mirrors_carry_the_producers_values() {
+        let force = bouncelab_fit::ForceSample {
+            t_s: 1e-4,
+            delta_m: 2e-4,
+            force_n: 310.0,
+        };
+        assert_mirrors(&force, &force_sample(&force), &[], &[]);
+        let p = bouncelab_fit::ImpactPrediction {
+            v_in: [0.5, -3.0],
+            v_out: [0.4, 2.2],
+            cor: 0.73,
+            mu_eff: 0.31,
+            contact_time_s: 4.5e-3,
+            delta_max_m: 2.1e-3,
+            omega_out_rad_s: -41.0,
+            peak_force_n: 820.0,
+            peak_deceleration_m_s2: 14_000.0,
+            force: vec![force],
+        };
+        assert_mirrors(&p, &prediction(&p), &[("spin_out_rad_s", "omega_out_rad_s")], &[]);
+        let f = MeasuredFrame {
+            t_s: 0.01,
+            x_m: 0.02,
+            y_m: 0.03,
+            sigma_m: 4e-5,
+        };
+        assert_mirrors(&f, &measured_point(&f), &[], &[]);
+        let rp = bouncelab_compare::ResidualPoint {
+            t_s: 0.01,
+            phase: ImpactPhase::Compression,
+            dx_m: 1e-5,
+            dy_m: -2e-5,
+            sigma_m: 4e-5,
+            d_omega_rad_s: Some(1.0),
+            sigma_omega_rad_s: Some(0.5),
+        };
+        assert_mirrors(&rp, &residual(&rp), &[], &[]);
+        let fp = bouncelab_fit::FittedParam {
+            name: "clay:spring.k".into(),
+            effect: "spring".into(),
+            param: "k".into(),
+            surface: Some("clay".into()),
+            initial: 20_000.0,
+            value: 25_650.0,
+            std_error: Some(300.0),
+            interval: Some([25_000.0, 26_300.0]),
+            bounds: [1.0, 1e7],
+            at_bound: true,
+            not_identified: None,
+        };
+        let mapped = fit_parameter(&fp);
+        assert_mirrors(&fp, &mapped, &[], &["unit"]);
+        assert_eq!(mapped.unit, "N/m", "the unit from the effect library");
+        let se = bouncelab_fit::SurfaceError {
+            surface: "clay".into(),
+            shots: 8,
+            mean_abs_error_pct: 2.5,
+        };
+        assert_mirrors(&se, &surface_error(&se), &[], &[]);
+        let o = bouncelab_fit::ObliqueRow {
+            shot: "S001".into(),
+            surface: "clay".into(),
+            incline_deg: 15.0,
+            v_in: [0.7, -2.9],
+            v_out_measured: [0.5, 2.1],
+            v_out_predicted: [0.52, 2.0],
+            error_pct: [4.0, 4.8],
+        };
+        assert_mirrors(
+            &o,
+            &oblique_row(&o),
+            &[("clip", "shot"), ("angle_deg", "incline_deg")],
+            &[],
+        );
+        let m = bouncelab_estimate::Measured { value: 0.73, se: 0.002 };
+        let mapped = measured(m);
+        assert_eq!((mapped.value, mapped.se), (m.value, Some(m.se)));
+    }
+
+    #[test]
+    fn the_phases_keep_their_names_and_order() {
+        let shown: Vec<r::Phase> = ImpactPhase::ALL.iter().map(|p| phase(*p)).collect();
+        assert_eq!(shown, r::Phase::ALL, "the same phases in the same time order");
+        for (p, q) in ImpactPhase::ALL.iter().zip(r::Phase::ALL) {
+            assert_eq!(serde_json::to_value(p).unwrap(), serde_json::to_value(q).unwrap());
+        }
+    }
 
     #[test]
     fn the_inverse_of_a_3x3_matrix() {

@@ -5,7 +5,7 @@
 
 use crate::data::{ModelCurve, ShotMeasurement, ShotPrediction};
 use crate::fmt::{fixed, num, pm_text, short};
-use crate::page::{Ctx, nc, table, tc, unavailable};
+use crate::html::{Ctx, nc, table, tc, unavailable};
 use crate::svg::{Chart, ErrorBar, Item, Key, Mark};
 
 /// A shot's value and standard error, in display units, if it has the quantity.
@@ -218,12 +218,23 @@ pub(crate) fn render(ctx: &mut Ctx) -> String {
         .filter(|s| all.iter().any(|p| &p.surface == *s) || ctx.report.model_curves.iter().any(|c| &c.surface == *s))
         .cloned()
         .collect();
-    let mut out = String::new();
+    let mut out = against_speed(ctx, &surfaces);
+    out.push_str(&curve_table(ctx));
+    if all.is_empty() {
+        return out;
+    }
+    out.push_str(&against_incline(ctx, &surfaces));
+    out
+}
+
+/// The measured quantities against the incoming normal speed with the model over them: one panel each.
+fn against_speed(ctx: &mut Ctx, surfaces: &[String]) -> String {
+    let all = &ctx.report.measurements;
     let (n, id) = ctx.next_figure();
     let charts: Vec<Chart> = PANELS
         .iter()
         .enumerate()
-        .filter_map(|(k, p)| panel_chart(ctx, format!("{id}{}", (b'a' + k as u8) as char), p, &surfaces))
+        .filter_map(|(k, p)| panel_chart(ctx, format!("{id}{}", (b'a' + k as u8) as char), p, surfaces))
         .collect();
     let track_decel = all.iter().any(|m| m.peak_deceleration_track_m_s2.is_some());
     let angles_note = if ctx.report.model_curves.iter().any(|c| c.angle_deg != 0.0) {
@@ -233,7 +244,7 @@ pub(crate) fn render(ctx: &mut Ctx) -> String {
     } else {
         ""
     };
-    out.push_str(&ctx.figure(
+    ctx.figure(
         n,
         &charts,
         &format!(
@@ -246,13 +257,12 @@ pub(crate) fn render(ctx: &mut Ctx) -> String {
                 ""
             }
         ),
-    ));
-    out.push_str(&curve_table(ctx));
+    )
+}
 
-    // COR vs angle, points offset by surface.
-    if all.is_empty() {
-        return out;
-    }
+/// COR against the incline, points of different surfaces offset at each incline.
+fn against_incline(ctx: &mut Ctx, surfaces: &[String]) -> String {
+    let all = &ctx.report.measurements;
     let mut angles: Vec<f64> = all.iter().map(|p| p.angle_deg).filter(|a| a.is_finite()).collect();
     angles.sort_by(f64::total_cmp);
     angles.dedup();
@@ -300,7 +310,7 @@ pub(crate) fn render(ctx: &mut Ctx) -> String {
         });
         c.legend.push((s.clone(), Key::Mark { color, shape }));
     }
-    out.push_str(&ctx.figure(
+    ctx.figure(
         n,
         &[c],
         &format!(
@@ -308,6 +318,5 @@ pub(crate) fn render(ctx: &mut Ctx) -> String {
              standard error bars. Points of different surfaces at one incline are offset by {}° for legibility.",
             fixed(step, 1)
         ),
-    ));
-    out
+    )
 }

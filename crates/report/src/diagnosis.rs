@@ -3,10 +3,9 @@
 
 use std::fmt::Write;
 
-use crate::change::{change_pct, row_label};
-use crate::data::{DiagnosisSection, VerdictKind};
+use crate::data::{DiagnosisSection, Phase, SignatureRow, VerdictKind};
 use crate::fmt::{esc, esc_code, fixed, opt, um};
-use crate::page::{Ctx, nc, table, tc};
+use crate::html::{Ctx, change_pct, nc, table, tc, unavailable};
 
 /// The CSS class of a verdict box.
 pub(crate) fn kind_class(k: VerdictKind) -> &'static str {
@@ -16,6 +15,16 @@ pub(crate) fn kind_class(k: VerdictKind) -> &'static str {
         VerdictKind::NoCandidateExplains => "no_candidate_explains",
         VerdictKind::Ambiguous => "ambiguous",
     }
+}
+
+/// A signature row's component and phase: "normal, flight out".
+pub(crate) fn row_label(r: &SignatureRow) -> String {
+    component_phase(r.normal, r.phase)
+}
+
+/// "normal, flight out" (`normal` false: "tangential, …").
+pub(crate) fn component_phase(normal: bool, phase: Phase) -> String {
+    format!("{}, {}", if normal { "normal" } else { "tangential" }, phase.label())
 }
 
 /// The diagnosis section.
@@ -40,103 +49,115 @@ pub(crate) fn render(_ctx: &mut Ctx, d: &DiagnosisSection) -> String {
     }
     if !d.signature.is_empty() {
         s.push_str("<h3>Where the current model's residual sits</h3>\n");
-        let rows: Vec<Vec<String>> = d
-            .signature
-            .iter()
-            .map(|r| {
-                vec![
-                    row_label(r),
-                    um(r.rms_m),
-                    um(r.systematic_m),
-                    fixed(100.0 * r.chi2_share, 1),
-                ]
-            })
-            .collect();
-        s.push_str(&table(
-            &[
-                tc("Component, phase"),
-                nc("RMS (µm)"),
-                nc("Systematic part (µm)"),
-                nc("Share of χ² (%)"),
-            ],
-            &rows,
-        ));
+        s.push_str(&signature_table(&d.signature));
     }
-
     s.push_str("<h3>Candidate effects</h3>\n");
-    if d.candidates.is_empty() {
-        s.push_str(&crate::page::unavailable("no candidate effect was tried"));
-    } else {
-        let metric = if d.error_metric.is_empty() {
-            "error".to_string()
-        } else {
-            d.error_metric.clone()
-        };
-        let _ = writeln!(
-            s,
-            "<p>Each candidate effect was added to the current model and fitted; best first. Errors are {}; \
-             ΔBIC &lt; 0 favours the effect.</p>",
-            esc(&metric)
-        );
-        let rows: Vec<Vec<String>> = d
-            .candidates
-            .iter()
-            .enumerate()
-            .map(|(i, c)| {
-                vec![
-                    (i + 1).to_string(),
-                    format!("<code>{}</code>", esc(&c.effect)),
-                    um(c.error_before),
-                    um(c.error_after),
-                    change_pct(c.error_before, c.error_after),
-                    fixed(c.delta_bic, 1),
-                    c.heldout_before.map_or("—".into(), um),
-                    c.heldout_after.map_or("—".into(), um),
-                ]
-            })
-            .collect();
-        s.push_str(&table(
-            &[
-                nc("Rank"),
-                tc("Effect"),
-                nc("Error before (µm)"),
-                nc("Error after (µm)"),
-                nc("Change (%)"),
-                nc("ΔBIC"),
-                nc("Held-out before (µm)"),
-                nc("Held-out after (µm)"),
-            ],
-            &rows,
-        ));
-    }
-
+    s.push_str(&candidates(d));
     s.push_str("<h3>Model history</h3>\n");
-    if d.model_history.is_empty() {
-        s.push_str(&crate::page::unavailable("no earlier model versions in the store"));
-    } else {
-        let rows: Vec<Vec<String>> = d
-            .model_history
-            .iter()
-            .map(|m| {
-                vec![
-                    m.version.to_string(),
-                    esc(&m.model),
-                    esc(&m.created),
-                    m.rms_m.map_or("—".into(), um),
-                    opt(m.chi2_red, 3),
-                ]
-            })
-            .collect();
-        s.push_str(&table(
-            &[
-                nc("Version"),
-                tc("Model"),
-                tc("Fitted"),
-                nc("RMS (µm)"),
-                nc("Reduced χ²"),
-            ],
-            &rows,
-        ));
-    }
+    s.push_str(&history(d));
     s
+}
+
+/// The residual per phase and component: RMS, its systematic part and its share of χ².
+fn signature_table(signature: &[SignatureRow]) -> String {
+    let rows: Vec<Vec<String>> = signature
+        .iter()
+        .map(|r| {
+            vec![
+                row_label(r),
+                um(r.rms_m),
+                um(r.systematic_m),
+                fixed(100.0 * r.chi2_share, 1),
+            ]
+        })
+        .collect();
+    table(
+        &[
+            tc("Component, phase"),
+            nc("RMS (µm)"),
+            nc("Systematic part (µm)"),
+            nc("Share of χ² (%)"),
+        ],
+        &rows,
+    )
+}
+
+/// The candidates tried, best first, with their errors before and after and ΔBIC.
+fn candidates(d: &DiagnosisSection) -> String {
+    if d.candidates.is_empty() {
+        return unavailable("no candidate effect was tried");
+    }
+    let mut s = String::new();
+    let metric = if d.error_metric.is_empty() {
+        "error".to_string()
+    } else {
+        d.error_metric.clone()
+    };
+    let _ = writeln!(
+        s,
+        "<p>Each candidate effect was added to the current model and fitted; best first. Errors are {}; \
+         ΔBIC &lt; 0 favours the effect.</p>",
+        esc(&metric)
+    );
+    let rows: Vec<Vec<String>> = d
+        .candidates
+        .iter()
+        .enumerate()
+        .map(|(i, c)| {
+            vec![
+                (i + 1).to_string(),
+                format!("<code>{}</code>", esc(&c.effect)),
+                um(c.error_before),
+                um(c.error_after),
+                change_pct(c.error_before, c.error_after),
+                fixed(c.delta_bic, 1),
+                c.heldout_before.map_or("—".into(), um),
+                c.heldout_after.map_or("—".into(), um),
+            ]
+        })
+        .collect();
+    s.push_str(&table(
+        &[
+            nc("Rank"),
+            tc("Effect"),
+            nc("Error before (µm)"),
+            nc("Error after (µm)"),
+            nc("Change (%)"),
+            nc("ΔBIC"),
+            nc("Held-out before (µm)"),
+            nc("Held-out after (µm)"),
+        ],
+        &rows,
+    ));
+    s
+}
+
+/// The store's model versions with their errors.
+fn history(d: &DiagnosisSection) -> String {
+    if d.model_history.is_empty() {
+        return unavailable("no earlier model versions in the store");
+    }
+    let rows: Vec<Vec<String>> = d
+        .model_history
+        .iter()
+        .map(|m| {
+            vec![
+                m.version.to_string(),
+                esc(&m.model),
+                esc(&m.created),
+                m.rms_m.map_or("—".into(), um),
+                opt(m.chi2_red, 3),
+            ]
+        })
+        .collect();
+    table(
+        &[
+            nc("Version"),
+            tc("Model"),
+            tc("Fitted"),
+            nc("RMS (µm)"),
+            nc("Reduced χ²"),
+        ],
+        &rows,
+    )
 }

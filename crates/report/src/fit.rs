@@ -3,11 +3,46 @@
 
 use crate::data::FitSummary;
 use crate::fmt::{esc, fixed, num, opt, short, um};
-use crate::page::{Ctx, nc, table, tc};
+use crate::html::{Ctx, facts, nc, section_or, table, tc, unavailable};
 use crate::svg::{Chart, Item, Key, Mark, Shape};
 
 /// The fit section.
 pub(crate) fn render(ctx: &mut Ctx, f: &FitSummary) -> String {
+    let mut s = facts(&fit_facts(f));
+    s.push_str(
+        "<p>The reduced χ² used throughout this report: χ²<sub>ν</sub> = χ²/ν, where χ² = Σ((model − measured)/σ)² \
+         over both coordinates of every fitted frame (σ the tracker's uncertainty of that frame) and ν = the number \
+         of those residuals − the fitted parameters (the shared ones and one surface level per shot). A shot's \
+         χ²<sub>ν</sub> is its own χ² over its share of ν, in proportion to its frames, so the shots' values \
+         average (weighted by frames) to the fit's. About 1 means the model follows the data to the tracking \
+         noise.</p>\n",
+    );
+    s.push_str("<h3>Parameters</h3>\n");
+    s.push_str(&parameters(f));
+    s.push_str("<h3>COR error per surface</h3>\n");
+    s.push_str(&cor_errors(ctx, f));
+    s.push_str("<h3>Contact force</h3>\n");
+    let report = ctx.report;
+    s.push_str(&section_or(&report.contact_force, |c| crate::force::render(ctx, c)));
+    s.push_str("<h3>Oblique validation</h3>\n");
+    if f.oblique.is_empty() {
+        s.push_str(&unavailable("no oblique shot with measured outgoing velocities"));
+        return s;
+    }
+    s.push_str(&oblique_table(ctx, f));
+    let (n, id) = ctx.next_figure();
+    let chart = oblique_chart(ctx, id, f);
+    s.push_str(&ctx.figure(
+        n,
+        &[chart],
+        "Oblique validation (the paper's Figure 9): outgoing velocity components predicted by the fitted model \
+         against the measured ones; points on the dashed line are predicted exactly.",
+    ));
+    s
+}
+
+/// The fit's facts: model, solver, reduced χ², RMS residual, mean absolute COR error (those known).
+fn fit_facts(f: &FitSummary) -> Vec<(String, String)> {
     let mut facts = vec![("Model".to_string(), esc(&f.model_name))];
     if !f.termination.is_empty() {
         facts.push(("Solver".into(), esc(&f.termination)));
@@ -22,17 +57,11 @@ pub(crate) fn render(ctx: &mut Ctx, f: &FitSummary) -> String {
     if let Some(e) = f.mean_abs_error_pct {
         facts.push(("Mean absolute COR error".into(), format!("{} %", num(e, 3))));
     }
-    let mut s = crate::page::facts(&facts);
-    s.push_str(
-        "<p>The reduced χ² used throughout this report: χ²<sub>ν</sub> = χ²/ν, where χ² = Σ((model − measured)/σ)² \
-         over both coordinates of every fitted frame (σ the tracker's uncertainty of that frame) and ν = the number \
-         of those residuals − the fitted parameters (the shared ones and one surface level per shot). A shot's \
-         χ²<sub>ν</sub> is its own χ² over its share of ν, in proportion to its frames, so the shots' values \
-         average (weighted by frames) to the fit's. About 1 means the model follows the data to the tracking \
-         noise.</p>\n",
-    );
+    facts
+}
 
-    s.push_str("<h3>Parameters</h3>\n");
+/// The fitted parameters with standard errors and intervals, or why there are none.
+fn parameters(f: &FitSummary) -> String {
     let level = if f.confidence > 0.0 && f.confidence < 1.0 {
         format!("{}%", fixed(100.0 * f.confidence, 0))
     } else {
@@ -64,62 +93,53 @@ pub(crate) fn render(ctx: &mut Ctx, f: &FitSummary) -> String {
         })
         .collect();
     if rows.is_empty() {
-        s.push_str(&crate::page::unavailable("the fit has no free parameters"));
-    } else {
-        s.push_str(&table(
-            &[
-                tc("Parameter"),
-                nc("Value"),
-                nc("SE"),
-                nc(&format!("{level} interval")),
-                tc("Unit"),
-                tc("Note"),
-            ],
-            &rows,
-        ));
+        return unavailable("the fit has no free parameters");
     }
+    table(
+        &[
+            tc("Parameter"),
+            nc("Value"),
+            nc("SE"),
+            nc(&format!("{level} interval")),
+            tc("Unit"),
+            tc("Note"),
+        ],
+        &rows,
+    )
+}
 
-    s.push_str("<h3>COR error per surface</h3>\n");
+/// The paper's mean absolute COR error per surface and over all shots.
+fn cor_errors(ctx: &Ctx, f: &FitSummary) -> String {
     if f.by_surface.is_empty() {
-        s.push_str(&crate::page::unavailable("no shot with a measured COR"));
-    } else {
-        let mut rows: Vec<Vec<String>> = f
-            .by_surface
-            .iter()
-            .map(|e| {
-                vec![
-                    ctx.surface_cell(&e.surface),
-                    e.shots.to_string(),
-                    num(e.mean_abs_error_pct, 3),
-                ]
-            })
-            .collect();
-        if let Some(e) = f.mean_abs_error_pct {
-            let n: usize = f.by_surface.iter().map(|e| e.shots).sum();
-            rows.push(vec!["\u{0}All".into(), n.to_string(), num(e, 3)]);
-        }
-        s.push_str(&table(
-            &[
-                tc("Surface"),
-                nc("Shots"),
-                nc("Mean |e<sub>sim</sub> − e<sub>meas</sub>| / e<sub>meas</sub> (%)"),
-            ],
-            &rows,
-        ));
+        return unavailable("no shot with a measured COR");
     }
+    let mut rows: Vec<Vec<String>> = f
+        .by_surface
+        .iter()
+        .map(|e| {
+            vec![
+                ctx.surface_cell(&e.surface),
+                e.shots.to_string(),
+                num(e.mean_abs_error_pct, 3),
+            ]
+        })
+        .collect();
+    if let Some(e) = f.mean_abs_error_pct {
+        let n: usize = f.by_surface.iter().map(|e| e.shots).sum();
+        rows.push(vec!["\u{0}All".into(), n.to_string(), num(e, 3)]);
+    }
+    table(
+        &[
+            tc("Surface"),
+            nc("Shots"),
+            nc("Mean |e<sub>sim</sub> − e<sub>meas</sub>| / e<sub>meas</sub> (%)"),
+        ],
+        &rows,
+    )
+}
 
-    s.push_str("<h3>Contact force</h3>\n");
-    let report = ctx.report;
-    s.push_str(&crate::page::section_or(&report.contact_force, |c| {
-        crate::force::render(ctx, c)
-    }));
-    s.push_str("<h3>Oblique validation</h3>\n");
-    if f.oblique.is_empty() {
-        s.push_str(&crate::page::unavailable(
-            "no oblique shot with measured outgoing velocities",
-        ));
-        return s;
-    }
+/// The oblique shots' outgoing velocity, measured against predicted, per component.
+fn oblique_table(ctx: &Ctx, f: &FitSummary) -> String {
     let rows: Vec<Vec<String>> = f
         .oblique
         .iter()
@@ -137,7 +157,7 @@ pub(crate) fn render(ctx: &mut Ctx, f: &FitSummary) -> String {
             ]
         })
         .collect();
-    s.push_str(&table(
+    table(
         &[
             tc("Clip"),
             tc("Surface"),
@@ -150,8 +170,11 @@ pub(crate) fn render(ctx: &mut Ctx, f: &FitSummary) -> String {
             nc("error (%)"),
         ],
         &rows,
-    ));
-    let (n, id) = ctx.next_figure();
+    )
+}
+
+/// Predicted against measured outgoing velocity, both components, over the line of equality.
+fn oblique_chart(ctx: &Ctx, id: String, f: &FitSummary) -> Chart {
     let mut c = Chart::new(id, 560.0, 460.0);
     c.title = "Outgoing velocity, predicted against measured".into();
     c.x_label = "measured (m/s)".into();
@@ -209,11 +232,5 @@ pub(crate) fn render(ctx: &mut Ctx, f: &FitSummary) -> String {
         });
         c.legend.push((label.into(), Key::Mark { color, shape }));
     }
-    s.push_str(&ctx.figure(
-        n,
-        &[c],
-        "Oblique validation (the paper's Figure 9): outgoing velocity components predicted by the fitted model \
-         against the measured ones; points on the dashed line are predicted exactly.",
-    ));
-    s
+    c
 }

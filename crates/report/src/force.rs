@@ -4,7 +4,7 @@
 
 use crate::data::ContactForce;
 use crate::fmt::{esc, num, short};
-use crate::page::Ctx;
+use crate::html::Ctx;
 use crate::svg::{Chart, Item, Key};
 
 /// The figure.

@@ -28,11 +28,15 @@ mod error;
 mod fit;
 mod fmt;
 mod force;
+mod html;
 mod page;
 mod shots;
 mod stats;
 mod summary;
 mod svg;
+/// Synthetic reports for tests, examples and the browser check; not part of the library (enable the
+/// `testutil` feature in `[dev-dependencies]` to use it from another crate's tests).
+#[cfg(any(test, feature = "testutil"))]
 pub mod testutil;
 mod thin;
 

@@ -7,7 +7,7 @@ use std::fmt::Write;
 
 use crate::data::{Phase, Report, ShotMeasurement, ShotPlot};
 use crate::fmt::{esc, num, opt, short, um};
-use crate::page::{Ctx, nc, pm_cell, tc, wc};
+use crate::html::{Ctx, nc, pm_cell, tc, wc};
 use crate::svg::{Bar, Chart, Item, Key, Mark, Shape};
 use crate::thin::thin_indices;
 
@@ -214,7 +214,7 @@ fn measured_table(ctx: &Ctx) -> String {
             ]
         })
         .collect();
-    crate::page::table_with_class(
+    crate::html::table_with_class(
         "stacked",
         &[
             nc("#"),
@@ -267,7 +267,7 @@ fn model_table(ctx: &Ctx, worst: &[usize], best: &[usize], shared: &[String]) ->
             esc(&own_notes(sh, shared).join("; ")),
         ]);
     }
-    crate::page::table_with_class(
+    crate::html::table_with_class(
         "stacked",
         &[
             tc("Clip"),
@@ -290,7 +290,7 @@ fn model_table(ctx: &Ctx, worst: &[usize], best: &[usize], shared: &[String]) ->
 pub(crate) fn render(ctx: &mut Ctx) -> String {
     let r = ctx.report;
     if r.shots.is_empty() && r.measurements.is_empty() {
-        return crate::page::unavailable("no shot was tracked");
+        return crate::html::unavailable("no shot was tracked");
     }
     let shared = shared_notes(r);
     let (worst, best) = featured(ctx);
@@ -317,7 +317,28 @@ pub(crate) fn render(ctx: &mut Ctx) -> String {
     if !shared.is_empty() {
         s.push_str(r##"<p class="notes">Notes every shot carries are listed once under <a href="#warnings">Warnings and notes</a>.</p>"##);
     }
-    // Fit error per shot.
+    s.push_str(&fit_error_figure(ctx));
+    s.push_str("<h3>Trajectories and residuals</h3>\n");
+    s.push_str(&open_and_selector(ctx, &worst, &best));
+    let budget = (POINT_BUDGET / r.shots.len()).clamp(60, 250);
+    for i in 0..r.shots.len() {
+        let open = worst.contains(&i) || best.contains(&i);
+        s.push_str(&shot_block(
+            ctx,
+            i,
+            open,
+            budget,
+            worst.contains(&i),
+            best.contains(&i),
+            &shared,
+        ));
+    }
+    s
+}
+
+/// The bar chart of every shot's fit error; nothing when no shot has one.
+fn fit_error_figure(ctx: &mut Ctx) -> String {
+    let r = ctx.report;
     let rows: Vec<BarRow> = r
         .shots
         .iter()
@@ -329,24 +350,30 @@ pub(crate) fn render(ctx: &mut Ctx) -> String {
             })
         })
         .collect();
-    if !rows.is_empty() {
-        let (n, id) = ctx.next_figure();
-        let mut chart = per_shot_bars(
-            ctx,
-            id,
-            &rows,
-            &[("RMS".into(), "#0072B2")],
-            "RMS position residual (µm)",
-        );
-        chart.title = "Fit error per shot".into();
-        s.push_str(&ctx.figure(
-            n,
-            &[chart],
-            "RMS of the position residuals (measured − model, x and y together) per shot, coloured by surface. \
-             Each bar links to the shot's plots.",
-        ));
+    if rows.is_empty() {
+        return String::new();
     }
-    s.push_str("<h3>Trajectories and residuals</h3>\n");
+    let (n, id) = ctx.next_figure();
+    let mut chart = per_shot_bars(
+        ctx,
+        id,
+        &rows,
+        &[("RMS".into(), "#0072B2")],
+        "RMS position residual (µm)",
+    );
+    chart.title = "Fit error per shot".into();
+    ctx.figure(
+        n,
+        &[chart],
+        "RMS of the position residuals (measured − model, x and y together) per shot, coloured by surface. \
+         Each bar links to the shot's plots.",
+    )
+}
+
+/// Which shots' plots are open, and the shot selector (shown by the script only).
+fn open_and_selector(ctx: &Ctx, worst: &[usize], best: &[usize]) -> String {
+    let r = ctx.report;
+    let mut s = String::new();
     let link = |i: usize| {
         format!(
             r##"<a href="#{}">{}</a>"##,
@@ -362,7 +389,6 @@ pub(crate) fn render(ctx: &mut Ctx) -> String {
         }
         s.push_str(" Their plots are open below; every other shot's plots open from its name.</p>\n");
     }
-    // Selector (shown by the script only).
     s.push_str(
         r#"<p id="shot-selector" hidden><label>Go to shot: <select id="shot-select"><option value="">choose…</option>"#,
     );
@@ -376,19 +402,6 @@ pub(crate) fn render(ctx: &mut Ctx) -> String {
         );
     }
     s.push_str("</select></label></p>\n");
-    let budget = (POINT_BUDGET / r.shots.len()).clamp(60, 250);
-    for i in 0..r.shots.len() {
-        let open = worst.contains(&i) || best.contains(&i);
-        s.push_str(&shot_block(
-            ctx,
-            i,
-            open,
-            budget,
-            worst.contains(&i),
-            best.contains(&i),
-            &shared,
-        ));
-    }
     s
 }
 
@@ -453,7 +466,7 @@ fn shot_block(
     }
     s.push_str(&frame_strip(sh));
     if sh.measured.is_empty() && sh.model.is_empty() {
-        s.push_str(&crate::page::unavailable(
+        s.push_str(&crate::html::unavailable(
             "no tracked frames and no model for this shot",
         ));
     } else {
@@ -480,154 +493,208 @@ fn median(mut v: Vec<f64>) -> Option<f64> {
     Some(v[v.len() / 2])
 }
 
+/// Colour of the fitted model's line in a shot's plots.
+const MODEL_COLOR: &str = "#D55E00";
+/// Colour of the measured centres.
+const DATA_COLOR: &str = "#7a7a7a";
+/// Width of a shot's plots, px.
+const SHOT_PLOT_W: f64 = 540.0;
+
+/// Seconds to milliseconds (the plots' time axis).
+fn ms(t: f64) -> f64 {
+    t * 1e3
+}
+
+/// What a shot's plots share: the time axis, the phase shading and its legend.
+struct ShotAxes {
+    /// Time range, ms, padded by 1 %; `None` fits the data.
+    x_range: Option<(f64, f64)>,
+    /// One band per phase span.
+    bands: Vec<Item>,
+    /// A swatch for each phase the shot has.
+    phase_legend: Vec<(String, Key)>,
+}
+
+impl ShotAxes {
+    fn of(sh: &ShotPlot) -> ShotAxes {
+        let times = sh
+            .measured
+            .iter()
+            .map(|p| p.t_s)
+            .chain(sh.model.iter().map(|p| p.t_s))
+            .chain(sh.residuals.iter().map(|p| p.t_s))
+            .filter(|t| t.is_finite() && t.abs() < 1e12);
+        let (lo, hi) = times.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), t| (a.min(t), b.max(t)));
+        let x_range = (lo.is_finite() && hi > lo).then(|| {
+            let pad = (hi - lo) * 0.01;
+            (ms(lo - pad), ms(hi + pad))
+        });
+        let bands = sh
+            .phases
+            .iter()
+            .map(|p| Item::XBand {
+                x0: ms(p.t0_s),
+                x1: ms(p.t1_s),
+                fill: phase_fill(p.phase),
+            })
+            .collect();
+        let phase_legend = Phase::ALL
+            .iter()
+            .filter(|p| sh.phases.iter().any(|s| s.phase == **p))
+            .map(|p| (p.label().to_string(), Key::Swatch { fill: phase_fill(*p) }))
+            .collect();
+        ShotAxes {
+            x_range,
+            bands,
+            phase_legend,
+        }
+    }
+
+    /// An empty chart on the shot's time axis with the phases shaded.
+    fn chart(&self, id: String, height: f64) -> Chart {
+        let mut c = Chart::new(id, SHOT_PLOT_W, height);
+        c.x_label = "t (ms)".into();
+        c.x_range = self.x_range;
+        c.items.extend(self.bands.iter().cloned());
+        c
+    }
+}
+
 /// One shot's figure (the paper's Figure 9): per component a column, the trajectory with the model
 /// drawn over the measured centres on top, the residual measured − model below on the same time axis,
 /// both shaded by phase.
 fn shot_figure(ctx: &mut Ctx, i: usize, budget: usize) -> String {
-    const W: f64 = 540.0;
     let sh = &ctx.report.shots[i];
-    let ms = |t: f64| t * 1e3;
-    let times = sh
-        .measured
-        .iter()
-        .map(|p| p.t_s)
-        .chain(sh.model.iter().map(|p| p.t_s))
-        .chain(sh.residuals.iter().map(|p| p.t_s))
-        .filter(|t| t.is_finite() && t.abs() < 1e12);
-    let (lo, hi) = times.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), t| (a.min(t), b.max(t)));
-    let x_range = (lo.is_finite() && hi > lo).then(|| {
-        let pad = (hi - lo) * 0.01;
-        (ms(lo - pad), ms(hi + pad))
-    });
-    let bands: Vec<Item> = sh
-        .phases
-        .iter()
-        .map(|p| Item::XBand {
-            x0: ms(p.t0_s),
-            x1: ms(p.t1_s),
-            fill: phase_fill(p.phase),
-        })
-        .collect();
-    let phase_legend: Vec<(String, Key)> = Phase::ALL
-        .iter()
-        .filter(|p| sh.phases.iter().any(|s| s.phase == **p))
-        .map(|p| (p.label().to_string(), Key::Swatch { fill: phase_fill(*p) }))
-        .collect();
+    let axes = ShotAxes::of(sh);
     let idx = thin_indices(sh.measured.len(), budget, |k| in_contact(sh, sh.measured[k].t_s));
     let ridx = thin_indices(sh.residuals.len(), budget, |k| in_contact(sh, sh.residuals[k].t_s));
-    let sigma = median(sh.measured.iter().map(|p| p.sigma_m).collect());
-    let model_color = "#D55E00";
-    let data_color = "#7a7a7a";
     let (n, id) = ctx.next_figure();
-    let mut charts = Vec::new();
-    for (k, (title, label, normal)) in [
-        ("Height above the surface", "y", true),
-        ("Position along the surface (down-slope)", "x", false),
-    ]
-    .into_iter()
-    .enumerate()
-    {
-        let coord = |p: (f64, f64)| if normal { p.1 } else { p.0 };
-        let mut c = Chart::new(format!("{id}{}", ['a', 'b'][k]), W, 250.0);
-        c.title = title.into();
-        c.y_label = format!("{label} (mm)");
-        c.x_label = "t (ms)".into();
-        c.x_range = x_range;
-        c.items.extend(bands.iter().cloned());
-        // Measured centres first, small and hollow; the model's line over them, so both stay visible.
-        c.items.push(Item::Marks {
-            marks: idx
+    let mut charts = vec![
+        trajectory_chart(&axes, format!("{id}a"), sh, &idx, true),
+        trajectory_chart(&axes, format!("{id}b"), sh, &idx, false),
+    ];
+    if !sh.residuals.is_empty() {
+        // Column order in the grid: y trajectory, x trajectory, y residual, x residual.
+        let sigma = median(sh.measured.iter().map(|p| p.sigma_m).collect());
+        charts.push(residual_chart(&axes, format!("{id}c"), sh, &ridx, sigma, true));
+        charts.push(residual_chart(&axes, format!("{id}d"), sh, &ridx, sigma, false));
+    }
+    let caption = shot_caption(sh, idx.len());
+    ctx.figure(n, &charts, &caption)
+}
+
+/// A shot's trajectory, one component (`normal`: the height y, else x along the surface): the measured
+/// centres at `idx` with the model's line over them.
+fn trajectory_chart(axes: &ShotAxes, id: String, sh: &ShotPlot, idx: &[usize], normal: bool) -> Chart {
+    let (title, label) = if normal {
+        ("Height above the surface", "y")
+    } else {
+        ("Position along the surface (down-slope)", "x")
+    };
+    let coord = |p: (f64, f64)| if normal { p.1 } else { p.0 };
+    let mut c = axes.chart(id, 250.0);
+    c.title = title.into();
+    c.y_label = format!("{label} (mm)");
+    // Measured centres first, small and hollow; the model's line over them, so both stay visible.
+    c.items.push(Item::Marks {
+        marks: idx
+            .iter()
+            .map(|&j| {
+                let p = &sh.measured[j];
+                Mark::at(ms(p.t_s), coord((p.x_m, p.y_m)) * 1e3)
+            })
+            .collect(),
+        color: DATA_COLOR,
+        shape: Shape::Circle,
+        size: 4.6,
+    });
+    // Thinner than the dots, so where they coincide both stay visible.
+    if !sh.model.is_empty() {
+        c.items.push(Item::Line {
+            pts: sh
+                .model
                 .iter()
-                .map(|&j| {
-                    let p = &sh.measured[j];
-                    Mark::at(ms(p.t_s), coord((p.x_m, p.y_m)) * 1e3)
-                })
+                .map(|p| (ms(p.t_s), coord((p.x_m, p.y_m)) * 1e3))
                 .collect(),
-            color: data_color,
-            shape: Shape::Circle,
-            size: 4.6,
+            color: MODEL_COLOR,
+            width: 1.4,
+            dash: false,
         });
-        // Thinner than the dots, so where they coincide both stay visible.
-        if !sh.model.is_empty() {
-            c.items.push(Item::Line {
-                pts: sh
-                    .model
-                    .iter()
-                    .map(|p| (ms(p.t_s), coord((p.x_m, p.y_m)) * 1e3))
-                    .collect(),
-                color: model_color,
-                width: 1.4,
-                dash: false,
-            });
-        }
+    }
+    c.legend.push((
+        "measured".into(),
+        Key::Mark {
+            color: DATA_COLOR,
+            shape: Shape::Circle,
+        },
+    ));
+    if !sh.model.is_empty() {
         c.legend.push((
-            "measured".into(),
-            Key::Mark {
-                color: data_color,
-                shape: Shape::Circle,
+            "fitted model".into(),
+            Key::Line {
+                color: MODEL_COLOR,
+                dash: false,
             },
         ));
-        if !sh.model.is_empty() {
-            c.legend.push((
-                "fitted model".into(),
-                Key::Line {
-                    color: model_color,
-                    dash: false,
-                },
-            ));
-        }
-        if k == 0 {
-            c.legend.extend(phase_legend.iter().cloned());
-        }
-        charts.push(c);
     }
-    if !sh.residuals.is_empty() {
-        for (k, normal) in [true, false].into_iter().enumerate() {
-            let mut c = Chart::new(format!("{id}{}", ['c', 'd'][k]), W, 210.0);
-            c.title = format!("Residual, measured − model, {}", if normal { "y" } else { "x" });
-            c.y_label = "residual (µm)".into();
-            c.x_label = "t (ms)".into();
-            c.x_range = x_range;
-            c.items.extend(bands.iter().cloned());
-            if let Some(sg) = sigma {
-                c.items.push(Item::YBand {
-                    y0: -sg * 1e6,
-                    y1: sg * 1e6,
-                    fill: "#cfcfcf",
-                });
-            }
-            c.items.push(Item::HRule {
-                y: 0.0,
-                color: "#555",
-                dash: false,
-            });
-            c.y_include.push(0.0);
-            c.items.push(Item::Marks {
-                marks: ridx
-                    .iter()
-                    .map(|&j| {
-                        let r = &sh.residuals[j];
-                        Mark::at(ms(r.t_s), if normal { r.dy_m } else { r.dx_m } * 1e6)
-                    })
-                    .collect(),
-                color: if normal { "#0072B2" } else { "#D55E00" },
-                shape: Shape::Circle,
-                size: 3.2,
-            });
-            if sigma.is_some() {
-                c.legend.push(("±1σ tracking".into(), Key::Swatch { fill: "#cfcfcf" }));
-            }
-            charts.push(c);
-        }
-        // Column order in the grid: y trajectory, x trajectory, y residual, x residual.
+    if normal {
+        c.legend.extend(axes.phase_legend.iter().cloned());
     }
+    c
+}
+
+/// A shot's residual measured − model, one component, at `ridx`, over the ±1σ tracking band.
+fn residual_chart(
+    axes: &ShotAxes,
+    id: String,
+    sh: &ShotPlot,
+    ridx: &[usize],
+    sigma: Option<f64>,
+    normal: bool,
+) -> Chart {
+    let mut c = axes.chart(id, 210.0);
+    c.title = format!("Residual, measured − model, {}", if normal { "y" } else { "x" });
+    c.y_label = "residual (µm)".into();
+    if let Some(sg) = sigma {
+        c.items.push(Item::YBand {
+            y0: -sg * 1e6,
+            y1: sg * 1e6,
+            fill: "#cfcfcf",
+        });
+    }
+    c.items.push(Item::HRule {
+        y: 0.0,
+        color: "#555",
+        dash: false,
+    });
+    c.y_include.push(0.0);
+    c.items.push(Item::Marks {
+        marks: ridx
+            .iter()
+            .map(|&j| {
+                let r = &sh.residuals[j];
+                Mark::at(ms(r.t_s), if normal { r.dy_m } else { r.dx_m } * 1e6)
+            })
+            .collect(),
+        color: if normal { "#0072B2" } else { "#D55E00" },
+        shape: Shape::Circle,
+        size: 3.2,
+    });
+    if sigma.is_some() {
+        c.legend.push(("±1σ tracking".into(), Key::Swatch { fill: "#cfcfcf" }));
+    }
+    c
+}
+
+/// The caption of a shot's figure, `shown` of its measured frames drawn.
+fn shot_caption(sh: &ShotPlot, shown: usize) -> String {
     let mut caption = format!(
         "Shot {} on {} at {}° (the paper's Figure 9): tracked ball centre (dots; {} of {} frames shown, every frame \
          near contact) ",
         esc(&sh.clip),
         esc(&sh.surface),
         short(sh.angle_deg, 3),
-        idx.len(),
+        shown,
         sh.measured.len()
     );
     caption.push_str(if sh.model.is_empty() {
@@ -643,7 +710,7 @@ fn shot_figure(ctx: &mut Ctx, i: usize, budget: usize) -> String {
              The background is shaded by phase: flight in, compression, restitution, flight out.",
         );
     }
-    ctx.figure(n, &charts, &caption)
+    caption
 }
 
 #[cfg(test)]

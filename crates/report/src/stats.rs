@@ -6,13 +6,14 @@
 use std::fmt::Write;
 
 use bouncelab_stats::{
-    Ancova, AncovaInference, AnovaRow, AnovaTable, FTest, MarginalComparison, MarginalMeans, TestOutcome,
+    Ancova, AncovaInference, AnovaRow, AnovaTable, Diagnostics, FTest, MarginalComparison, MarginalMeans,
+    ResidualTests, TestOutcome,
 };
 
 use crate::data::Section;
 
 use crate::fmt::{esc, fixed, num, opt, p_value, short};
-use crate::page::{Ctx, nc, table, tc};
+use crate::html::{Ctx, nc, table, tc, unavailable};
 use crate::svg::{Chart, ErrorBar, Item, Key, Mark, Shape};
 
 fn anova_rows(t: &AnovaTable) -> Vec<Vec<String>> {
@@ -43,7 +44,7 @@ fn anova_table(t: &AnovaTable) -> String {
 pub(crate) fn ancova_section(ctx: &Ctx) -> String {
     let r = ctx.report;
     let Some(a) = r.ancova.get() else {
-        return crate::page::section_or(&r.ancova, |_| String::new());
+        return crate::html::section_or(&r.ancova, |_| String::new());
     };
     let fit = &a.fit;
     let total_ss = a.type1.total.ss;
@@ -116,7 +117,7 @@ pub(crate) fn ancova_section(ctx: &Ctx) -> String {
                 .collect();
             s.push_str(&table(&[tc("Coefficient"), nc("Estimate")], &rows));
             if let Section::Unavailable(why) = &r.inference {
-                s.push_str(&crate::page::unavailable(&format!("standard errors and tests: {why}")));
+                s.push_str(&unavailable(&format!("standard errors and tests: {why}")));
             }
         }
     }
@@ -130,6 +131,31 @@ fn factor_comparisons(ctx: &mut Ctx, m: &MarginalMeans) -> String {
     } else {
         String::new()
     };
+    let mut s = means_intro(m, &level);
+    s.push_str(&means_table(ctx, m, &level));
+    if m.pairs.is_empty() {
+        s.push_str(&unavailable("fewer than two levels to compare"));
+        return s;
+    }
+    s.push_str(&pairs_table(m, &level));
+    let (n, id) = ctx.next_figure();
+    let chart = pairs_chart(id, m, &level);
+    s.push_str(&ctx.figure(
+        n,
+        &[chart],
+        &format!(
+            "Tukey–Kramer simultaneous {level}intervals of the differences between adjusted mean COR by {} (the paper's \
+             Figure 10, on covariate-adjusted means). An interval that does not cross the dashed zero line marks a \
+             difference at the family-wise level α = {}.",
+            esc(&m.factor),
+            short(m.alpha, 3)
+        ),
+    ));
+    s
+}
+
+/// The heading and the sentence saying where the means are taken and how pairs are compared.
+fn means_intro(m: &MarginalMeans, level: &str) -> String {
     let at: Vec<String> = m
         .covariates_at
         .iter()
@@ -147,14 +173,7 @@ fn factor_comparisons(ctx: &mut Ctx, m: &MarginalMeans) -> String {
         )
     };
     let is_surface = m.factor == "surface";
-    let label = |l: &str| {
-        if is_surface {
-            ctx.surface_cell(l)
-        } else {
-            format!("{}°", esc(l))
-        }
-    };
-    let mut s = format!(
+    format!(
         "<h3>By {}</h3>\n<p>Estimated marginal means of the COR from the same ANCOVA fit: each {} at {}{over}. Pairs \
          are compared on these adjusted means with the fit's residual mean square ({}) and df ({}); p-values are \
          adjusted for the {} pairs by Tukey–Kramer (simultaneous {level}intervals, critical q = {}) and by \
@@ -170,7 +189,19 @@ fn factor_comparisons(ctx: &mut Ctx, m: &MarginalMeans) -> String {
         m.df,
         m.pairs.len(),
         num(m.q_crit, 4),
-    );
+    )
+}
+
+/// The adjusted mean of every level with its interval, beside the raw mean.
+fn means_table(ctx: &Ctx, m: &MarginalMeans, level: &str) -> String {
+    let is_surface = m.factor == "surface";
+    let label = |l: &str| {
+        if is_surface {
+            ctx.surface_cell(l)
+        } else {
+            format!("{}°", esc(l))
+        }
+    };
     let rows: Vec<Vec<String>> = m
         .means
         .iter()
@@ -179,12 +210,12 @@ fn factor_comparisons(ctx: &mut Ctx, m: &MarginalMeans) -> String {
                 label(&g.level),
                 g.n.to_string(),
                 fixed(g.raw_mean, 4),
-                crate::page::pm_cell(g.estimate, Some(g.se), 4),
+                crate::html::pm_cell(g.estimate, Some(g.se), 4),
                 format!("{} to {}", fixed(g.lower, 4), fixed(g.upper, 4)),
             ]
         })
         .collect();
-    s.push_str(&table(
+    table(
         &[
             tc(if is_surface { "Surface" } else { "Incline" }),
             nc("Shots"),
@@ -193,19 +224,18 @@ fn factor_comparisons(ctx: &mut Ctx, m: &MarginalMeans) -> String {
             nc(&format!("{level}interval")),
         ],
         &rows,
-    ));
-    if m.pairs.is_empty() {
-        s.push_str(&crate::page::unavailable("fewer than two levels to compare"));
-        return s;
-    }
-    let name = |p: &MarginalComparison| format!("{} − {}", p.level2, p.level1);
+    )
+}
+
+/// Every pair's difference with its unadjusted, Tukey and Holm p-values.
+fn pairs_table(m: &MarginalMeans, level: &str) -> String {
     let rows: Vec<Vec<String>> = m
         .pairs
         .iter()
         .map(|p| {
             vec![
-                esc(&name(p)),
-                crate::page::pm_cell(p.estimate, Some(p.se), 3),
+                esc(&pair_name(p)),
+                crate::html::pm_cell(p.estimate, Some(p.se), 3),
                 num(p.t, 3),
                 p_value(p.p),
                 p_value(p.p_tukey),
@@ -219,7 +249,7 @@ fn factor_comparisons(ctx: &mut Ctx, m: &MarginalMeans) -> String {
             ]
         })
         .collect();
-    s.push_str(&table(
+    table(
         &[
             tc("Difference"),
             nc("Estimate ± SE"),
@@ -231,12 +261,20 @@ fn factor_comparisons(ctx: &mut Ctx, m: &MarginalMeans) -> String {
             tc("Differ?"),
         ],
         &rows,
-    ));
-    let (n, id) = ctx.next_figure();
+    )
+}
+
+/// "level2 − level1".
+fn pair_name(p: &MarginalComparison) -> String {
+    format!("{} − {}", p.level2, p.level1)
+}
+
+/// The Tukey intervals of the differences, those that exclude zero in their own colour.
+fn pairs_chart(id: String, m: &MarginalMeans, level: &str) -> Chart {
     let mut c = Chart::new(id, 760.0, 110.0 + 30.0 * m.pairs.len() as f64);
     c.title = format!("Differences of adjusted mean COR by {}", m.factor);
     c.x_label = format!("difference in adjusted mean COR, with Tukey {level}simultaneous interval");
-    c.y_categories = m.pairs.iter().map(name).collect();
+    c.y_categories = m.pairs.iter().map(pair_name).collect();
     c.x_include.push(0.0);
     c.items.push(Item::VRule {
         x: 0.0,
@@ -275,7 +313,7 @@ fn factor_comparisons(ctx: &mut Ctx, m: &MarginalMeans) -> String {
                         y: i as f64,
                         tip: Some(format!(
                             "{}: {} [{}, {}], p (Tukey) = {}",
-                            name(p),
+                            pair_name(p),
                             num(p.estimate, 3),
                             num(p.lower, 3),
                             num(p.upper, 3),
@@ -297,18 +335,7 @@ fn factor_comparisons(ctx: &mut Ctx, m: &MarginalMeans) -> String {
             },
         ));
     }
-    s.push_str(&ctx.figure(
-        n,
-        &[c],
-        &format!(
-            "Tukey–Kramer simultaneous {level}intervals of the differences between adjusted mean COR by {} (the paper's \
-             Figure 10, on covariate-adjusted means). An interval that does not cross the dashed zero line marks a \
-             difference at the family-wise level α = {}.",
-            esc(&m.factor),
-            short(m.alpha, 3)
-        ),
-    ));
-    s
+    c
 }
 
 /// The comparisons section: every factor of the fit, surfaces first.
@@ -321,9 +348,7 @@ pub(crate) fn comparisons(ctx: &mut Ctx, inf: &AncovaInference) -> String {
     let mut ordered: Vec<&MarginalMeans> = inf.marginal_means.iter().filter(|m| m.factor == "surface").collect();
     ordered.extend(inf.marginal_means.iter().filter(|m| m.factor != "surface"));
     if ordered.is_empty() {
-        s.push_str(&crate::page::unavailable(
-            "the fit has no factor with two or more levels",
-        ));
+        s.push_str(&unavailable("the fit has no factor with two or more levels"));
     }
     for m in ordered {
         s.push_str(&factor_comparisons(ctx, m));
@@ -343,10 +368,32 @@ fn obs_label(ctx: &Ctx, n: usize, i: usize) -> (String, Option<String>) {
 /// The residual diagnostics section.
 pub(crate) fn diagnostics(ctx: &mut Ctx, a: &Ancova) -> String {
     let d = &a.diagnostics;
-    let n = d.fitted.len();
     let (fig, id) = ctx.next_figure();
-    // Studentized residuals against fitted values.
-    let mut c1 = Chart::new(format!("{id}a"), 500.0, 360.0);
+    let c1 = studentized_chart(ctx, format!("{id}a"), d);
+    let c2 = normal_plot_chart(ctx, format!("{id}b"), d);
+    let found = match ctx.report.inference.get() {
+        Some(i) => esc(&i.residual_tests.caption()),
+        None => "Curvature and normality were not tested.".into(),
+    };
+    let mut s = ctx.figure(
+        fig,
+        &[c1, c2],
+        &format!(
+            "Residual diagnostics of the ANCOVA (the paper's Figure 11): externally studentized residuals against the \
+             fitted COR, and the normal probability plot of the raw residuals. {found}"
+        ),
+    );
+    if let Some(i) = ctx.report.inference.get() {
+        s.push_str(&residual_tests(&i.residual_tests));
+    }
+    s.push_str(&residual_statistics(ctx, d));
+    s
+}
+
+/// Studentized residuals against fitted values, with the ±2 band.
+fn studentized_chart(ctx: &Ctx, id: String, d: &Diagnostics) -> Chart {
+    let n = d.fitted.len();
+    let mut c1 = Chart::new(id, 500.0, 360.0);
     c1.title = "Studentized residuals against fitted".into();
     c1.x_label = "fitted COR".into();
     c1.y_label = "externally studentized residual".into();
@@ -391,8 +438,17 @@ pub(crate) fn diagnostics(ctx: &mut Ctx, a: &Ancova) -> String {
             dash: true,
         },
     ));
-    // Normal probability plot.
-    let mut c2 = Chart::new(format!("{id}b"), 500.0, 360.0);
+    c1
+}
+
+/// The standard normal's upper quartile Φ⁻¹(0.75): the quartiles of normal residuals lie this many σ from the
+/// centre.
+const NORMAL_Q3: f64 = 0.674_489_750_196_081_7;
+
+/// The normal probability plot of the raw residuals, with the line through their quartiles.
+fn normal_plot_chart(ctx: &Ctx, id: String, d: &Diagnostics) -> Chart {
+    let n = d.fitted.len();
+    let mut c2 = Chart::new(id, 500.0, 360.0);
     c2.title = "Normal probability plot of the residuals".into();
     c2.x_label = "residual (COR)".into();
     c2.y_label = "standard normal quantile".into();
@@ -427,7 +483,7 @@ pub(crate) fn diagnostics(ctx: &mut Ctx, a: &Ancova) -> String {
             sorted[i] + f * (sorted[(i + 1).min(sorted.len() - 1)] - sorted[i])
         };
         let (q1, q3) = (q(0.25), q(0.75));
-        let z = 0.674_489_750_196_081_7;
+        let z = NORMAL_Q3;
         if q3 > q1 {
             let slope = (q3 - q1) / (2.0 * z);
             let zs = [-3.0, 3.0];
@@ -455,67 +511,62 @@ pub(crate) fn diagnostics(ctx: &mut Ctx, a: &Ancova) -> String {
         shape: Shape::Circle,
         size: 6.0,
     });
-    let found = match ctx.report.inference.get() {
-        Some(i) => esc(&i.residual_tests.caption()),
-        None => "Curvature and normality were not tested.".into(),
+    c2
+}
+
+/// The curvature and normality tests of the residuals, each at its own α.
+fn residual_tests(t: &ResidualTests) -> String {
+    let ftest = |what: String, o: &TestOutcome<FTest>| match o {
+        TestOutcome::Ran(f) => vec![
+            what,
+            format!("F({}, {}) = {}", f.df_num, f.df_den, num(f.f, 3)),
+            p_value(f.p),
+            if f.p < t.alpha {
+                "curvature".into()
+            } else {
+                "none found".into()
+            },
+        ],
+        TestOutcome::NotRun { reason } => vec![what, "—".into(), "—".into(), format!("not run: {}", esc(reason))],
     };
-    let mut s = ctx.figure(
-        fig,
-        &[c1, c2],
-        &format!(
-            "Residual diagnostics of the ANCOVA (the paper's Figure 11): externally studentized residuals against the \
-             fitted COR, and the normal probability plot of the raw residuals. {found}"
-        ),
-    );
-    if let Some(i) = ctx.report.inference.get() {
-        let t = &i.residual_tests;
-        let ftest = |what: String, o: &TestOutcome<FTest>| match o {
-            TestOutcome::Ran(f) => vec![
-                what,
-                format!("F({}, {}) = {}", f.df_num, f.df_den, num(f.f, 3)),
-                p_value(f.p),
-                if f.p < t.alpha {
-                    "curvature".into()
-                } else {
-                    "none found".into()
-                },
-            ],
-            TestOutcome::NotRun { reason } => vec![what, "—".into(), "—".into(), format!("not run: {}", esc(reason))],
-        };
-        let mut rows = vec![ftest("RESET (squared fitted values)".into(), &t.reset)];
-        for q in &t.quadratic {
-            rows.push(ftest(format!("quadratic term in {}", esc(&q.covariate)), &q.test));
-        }
-        rows.push(match &t.normality {
-            TestOutcome::Ran(n) => vec![
-                "D'Agostino–Pearson normality".into(),
-                format!(
-                    "K² = {} (skew {}, kurtosis {})",
-                    num(n.k2, 3),
-                    num(n.skewness, 3),
-                    num(n.kurtosis, 3)
-                ),
-                p_value(n.p),
-                if n.p < t.alpha {
-                    "not normal".into()
-                } else {
-                    "consistent with normal".into()
-                },
-            ],
-            TestOutcome::NotRun { reason } => vec![
-                "D'Agostino–Pearson normality".into(),
-                "—".into(),
-                "—".into(),
-                format!("not run: {}", esc(reason)),
-            ],
-        });
-        let _ = writeln!(
-            s,
-            "<p>Tests of the residuals, each at α = {} on its own:</p>",
-            short(t.alpha, 3)
-        );
-        s.push_str(&table(&[tc("Test"), nc("Statistic"), nc("p"), tc("Finding")], &rows));
+    let mut rows = vec![ftest("RESET (squared fitted values)".into(), &t.reset)];
+    for q in &t.quadratic {
+        rows.push(ftest(format!("quadratic term in {}", esc(&q.covariate)), &q.test));
     }
+    rows.push(match &t.normality {
+        TestOutcome::Ran(n) => vec![
+            "D'Agostino–Pearson normality".into(),
+            format!(
+                "K² = {} (skew {}, kurtosis {})",
+                num(n.k2, 3),
+                num(n.skewness, 3),
+                num(n.kurtosis, 3)
+            ),
+            p_value(n.p),
+            if n.p < t.alpha {
+                "not normal".into()
+            } else {
+                "consistent with normal".into()
+            },
+        ],
+        TestOutcome::NotRun { reason } => vec![
+            "D'Agostino–Pearson normality".into(),
+            "—".into(),
+            "—".into(),
+            format!("not run: {}", esc(reason)),
+        ],
+    });
+    let mut s = format!(
+        "<p>Tests of the residuals, each at α = {} on its own:</p>\n",
+        short(t.alpha, 3)
+    );
+    s.push_str(&table(&[tc("Test"), nc("Statistic"), nc("p"), tc("Finding")], &rows));
+    s
+}
+
+/// Skewness, kurtosis, the number of observations and the largest studentized residual.
+fn residual_statistics(ctx: &Ctx, d: &Diagnostics) -> String {
+    let n = d.fitted.len();
     let (worst_i, worst) = d
         .studentized_external
         .iter()
@@ -543,6 +594,5 @@ pub(crate) fn diagnostics(ctx: &mut Ctx, a: &Ancova) -> String {
         ]);
         let _ = write!(rows.last_mut().expect("just pushed")[0], " ({label})");
     }
-    s.push_str(&table(&[tc("Residual statistic"), nc("Value"), nc("If normal")], &rows));
-    s
+    table(&[tc("Residual statistic"), nc("Value"), nc("If normal")], &rows)
 }

@@ -3,9 +3,9 @@
 
 use std::fmt::Write;
 
-use crate::data::{ShotMeasurement, VerdictKind};
+use crate::data::{Report, ShotMeasurement, VerdictKind};
 use crate::fmt::{esc, num, p_value};
-use crate::page::{Ctx, facts, nc, table_with_class, tc};
+use crate::html::{Ctx, facts, nc, table_with_class, tc};
 
 /// One quantity of the per-surface and per-shot tables: heading (HTML), unit, factor from SI to the unit,
 /// significant digits without an error, the value.
@@ -153,7 +153,7 @@ pub(crate) fn mean_sd(v: &[f64]) -> (f64, f64, usize) {
 pub(crate) fn by_surface(ctx: &Ctx) -> String {
     let ms = &ctx.report.measurements;
     if ms.is_empty() {
-        return crate::page::unavailable("no shot was measured");
+        return crate::html::unavailable("no shot was measured");
     }
     let surfaces: Vec<&String> = ctx
         .surfaces
@@ -185,7 +185,7 @@ pub(crate) fn by_surface(ctx: &Ctx) -> String {
                 let sd = sd.is_finite().then_some(sd);
                 format!(
                     r#"{} <span class="se">(n = {n})</span>"#,
-                    crate::page::pm_cell(mean, sd, q.sig)
+                    crate::html::pm_cell(mean, sd, q.sig)
                 )
             });
         }
@@ -207,98 +207,11 @@ pub(crate) fn by_surface(ctx: &Ctx) -> String {
 /// The summary section.
 pub(crate) fn render(ctx: &mut Ctx) -> String {
     let r = ctx.report;
-    let mut rows: Vec<(String, String)> = Vec::new();
-    match r.diagnosis.get() {
-        Some(d) => {
-            let class = match d.verdict_kind {
-                VerdictKind::NoMissingEffect => "good",
-                _ => "bad",
-            };
-            let text = if d.headline.is_empty() {
-                &d.verdict_text
-            } else {
-                &d.headline
-            };
-            rows.push((
-                "Verdict".into(),
-                format!(
-                    r##"<a href="#diagnosis"><b class="{class}">{}</b></a>: {}"##,
-                    d.verdict_kind.label(),
-                    crate::fmt::esc_code(text)
-                ),
-            ));
-        }
-        None => rows.push(("Verdict".into(), "no diagnosis in this report".into())),
-    }
-    if let Some(c) = r.model_change.get() {
-        let added = if c.effects_added.is_empty() {
-            String::new()
-        } else {
-            let names: Vec<String> = c
-                .effects_added
-                .iter()
-                .map(|e| format!("<code>{}</code>", esc(e)))
-                .collect();
-            format!("added {} to {}; ", names.join(", "), esc(&c.model_before))
-        };
-        rows.push((
-            "Model change".into(),
-            format!(
-                r##"<a href="#model-change">{added}position RMS {} → {} µm</a>"##,
-                crate::fmt::um(c.total_rms_before_m),
-                crate::fmt::um(c.total_rms_after_m)
-            ),
-        ));
-    }
-    if let Some(f) = r.fit.get() {
-        let mut s = format!(r##"<a href="#fit">{}</a>"##, esc(&f.model_name));
-        if let Some(e) = f.rms_m {
-            let _ = write!(s, "; position RMS {} µm", crate::fmt::um(e));
-        }
-        if let Some(c) = f.reduced_chi2 {
-            let _ = write!(s, "; reduced χ² {}", num(c, 3));
-        }
-        if let Some(e) = f.mean_abs_error_pct {
-            let _ = write!(s, "; mean absolute COR error {} %", num(e, 3));
-        }
-        rows.push(("Model".into(), s));
-    }
-    if let Some(row) = r
-        .ancova
-        .get()
-        .and_then(|a| a.type1.terms.iter().find(|t| t.source == "surface"))
-    {
-        rows.push((
-            "Surface effect on COR".into(),
-            format!(
-                r##"F = {}, p = {} (<a href="#ancova">ANCOVA, Type I, impact speed as covariate</a>)"##,
-                crate::fmt::opt(row.f, 3),
-                row.p.map_or("—".into(), p_value)
-            ),
-        ));
-    }
-    if let Some(m) = r.inference.get().and_then(|i| i.means_of("surface")) {
-        let differ: Vec<String> = m
-            .pairs
-            .iter()
-            .filter(|p| p.reject_tukey)
-            .map(|p| format!("{} − {}", esc(&p.level2), esc(&p.level1)))
-            .collect();
-        rows.push((
-            "Surfaces at equal impact speed".into(),
-            format!(
-                r##"pairs that differ: {} of {} (Tukey–Kramer, α = {}){} (<a href="#comparisons">adjusted means</a>)"##,
-                differ.len(),
-                m.pairs.len(),
-                crate::fmt::short(m.alpha, 3),
-                if differ.is_empty() {
-                    String::new()
-                } else {
-                    format!(": {}", differ.join(", "))
-                }
-            ),
-        ));
-    }
+    let mut rows: Vec<(String, String)> = vec![verdict_row(r)];
+    rows.extend(model_change_row(r));
+    rows.extend(model_row(r));
+    rows.extend(surface_effect_row(r));
+    rows.extend(surface_pairs_row(r));
     rows.push((
         "Warnings".into(),
         if r.warnings.is_empty() {
@@ -310,4 +223,110 @@ pub(crate) fn render(ctx: &mut Ctx) -> String {
     let mut s = facts(&rows);
     s.push_str(&by_surface(ctx));
     s
+}
+
+/// The verdict in a few words, linked to the diagnosis.
+fn verdict_row(r: &Report) -> (String, String) {
+    match r.diagnosis.get() {
+        Some(d) => {
+            let class = match d.verdict_kind {
+                VerdictKind::NoMissingEffect => "good",
+                _ => "bad",
+            };
+            let text = if d.headline.is_empty() {
+                &d.verdict_text
+            } else {
+                &d.headline
+            };
+            (
+                "Verdict".into(),
+                format!(
+                    r##"<a href="#diagnosis"><b class="{class}">{}</b></a>: {}"##,
+                    d.verdict_kind.label(),
+                    crate::fmt::esc_code(text)
+                ),
+            )
+        }
+        None => ("Verdict".into(), "no diagnosis in this report".into()),
+    }
+}
+
+/// The effects added and the error before and after, when the model changed.
+fn model_change_row(r: &Report) -> Option<(String, String)> {
+    let c = r.model_change.get()?;
+    let added = if c.effects_added.is_empty() {
+        String::new()
+    } else {
+        let names: Vec<String> = c
+            .effects_added
+            .iter()
+            .map(|e| format!("<code>{}</code>", esc(e)))
+            .collect();
+        format!("added {} to {}; ", names.join(", "), esc(&c.model_before))
+    };
+    Some((
+        "Model change".into(),
+        format!(
+            r##"<a href="#model-change">{added}position RMS {} → {} µm</a>"##,
+            crate::fmt::um(c.total_rms_before_m),
+            crate::fmt::um(c.total_rms_after_m)
+        ),
+    ))
+}
+
+/// The fitted model and how well it fits.
+fn model_row(r: &Report) -> Option<(String, String)> {
+    let f = r.fit.get()?;
+    let mut s = format!(r##"<a href="#fit">{}</a>"##, esc(&f.model_name));
+    if let Some(e) = f.rms_m {
+        let _ = write!(s, "; position RMS {} µm", crate::fmt::um(e));
+    }
+    if let Some(c) = f.reduced_chi2 {
+        let _ = write!(s, "; reduced χ² {}", num(c, 3));
+    }
+    if let Some(e) = f.mean_abs_error_pct {
+        let _ = write!(s, "; mean absolute COR error {} %", num(e, 3));
+    }
+    Some(("Model".into(), s))
+}
+
+/// The ANCOVA's test of the surface.
+fn surface_effect_row(r: &Report) -> Option<(String, String)> {
+    let row = r
+        .ancova
+        .get()
+        .and_then(|a| a.type1.terms.iter().find(|t| t.source == "surface"))?;
+    Some((
+        "Surface effect on COR".into(),
+        format!(
+            r##"F = {}, p = {} (<a href="#ancova">ANCOVA, Type I, impact speed as covariate</a>)"##,
+            crate::fmt::opt(row.f, 3),
+            row.p.map_or("—".into(), p_value)
+        ),
+    ))
+}
+
+/// The pairs of surfaces whose adjusted means differ.
+fn surface_pairs_row(r: &Report) -> Option<(String, String)> {
+    let m = r.inference.get().and_then(|i| i.means_of("surface"))?;
+    let differ: Vec<String> = m
+        .pairs
+        .iter()
+        .filter(|p| p.reject_tukey)
+        .map(|p| format!("{} − {}", esc(&p.level2), esc(&p.level1)))
+        .collect();
+    Some((
+        "Surfaces at equal impact speed".into(),
+        format!(
+            r##"pairs that differ: {} of {} (Tukey–Kramer, α = {}){} (<a href="#comparisons">adjusted means</a>)"##,
+            differ.len(),
+            m.pairs.len(),
+            crate::fmt::short(m.alpha, 3),
+            if differ.is_empty() {
+                String::new()
+            } else {
+                format!(": {}", differ.join(", "))
+            }
+        ),
+    ))
 }

@@ -524,32 +524,34 @@ impl Chart {
         (pos, rows)
     }
 
-    /// The chart as an `<svg>` element.
-    pub(crate) fn render(&self) -> Rendered {
+    /// The y axis: categories (the first at the top) or linear over the data.
+    fn y_axis(&self, h: f64) -> Axis {
+        if self.y_categories.is_empty() {
+            return Axis::fit(self.y_values(), self.y_range, self.y_range.is_none(), (h - 70.0) / 45.0);
+        }
+        let n = self.y_categories.len() as f64;
+        Axis {
+            lo: -0.6,
+            hi: n - 0.4,
+            ticks: self
+                .y_categories
+                .iter()
+                .enumerate()
+                .map(|(i, s)| (i as f64, s.clone()))
+                .collect(),
+        }
+    }
+
+    /// The axes, and the plot area within margins made from the text they hold.
+    fn layout(&self) -> Layout {
         let (w, h) = (self.width.max(120.0), self.height.max(80.0));
-        let cats = !self.y_categories.is_empty();
         let xa = Axis::fit(
             self.x_values(),
             self.x_range,
             self.x_range.is_none(),
             (w - 100.0) / 90.0,
         );
-        let ya = if cats {
-            let n = self.y_categories.len() as f64;
-            Axis {
-                lo: -0.6,
-                hi: n - 0.4,
-                ticks: self
-                    .y_categories
-                    .iter()
-                    .enumerate()
-                    .map(|(i, s)| (i as f64, s.clone()))
-                    .collect(),
-            }
-        } else {
-            Axis::fit(self.y_values(), self.y_range, self.y_range.is_none(), (h - 70.0) / 45.0)
-        };
-        // Margins from the text they hold.
+        let ya = self.y_axis(h);
         let y_tick_w = ya
             .ticks
             .iter()
@@ -569,9 +571,27 @@ impl Chart {
             y1: (h - bottom).max(top + 20.0),
             xa,
             ya,
-            y_down: cats,
+            y_down: !self.y_categories.is_empty(),
         };
         let h = h.max(f.y1 + bottom);
+        Layout {
+            w,
+            h,
+            f,
+            title_h,
+            legend_pos,
+        }
+    }
+
+    /// The chart as an `<svg>` element.
+    pub(crate) fn render(&self) -> Rendered {
+        let Layout {
+            w,
+            h,
+            f,
+            title_h,
+            legend_pos,
+        } = self.layout();
         let mut dropped = 0usize;
         let mut s = String::with_capacity(4096);
         let title_id = format!("{}-t", self.id);
@@ -598,25 +618,7 @@ impl Chart {
             coord(f.x1 - f.x0),
             coord(f.y1 - f.y0)
         );
-        // Grid and ticks.
-        let mut grid = String::new();
-        let mut tick_marks = String::new();
-        for (v, _) in &f.ya.ticks {
-            let y = f.py(*v);
-            let _ = write!(grid, "M{} {}H{}", coord(f.x0), coord(y), coord(f.x1));
-            let _ = write!(tick_marks, "M{} {}h4", coord(f.x0 - 4.0), coord(y));
-        }
-        for (v, _) in f.xa.ticks.iter().filter(|_| self.x_ticks) {
-            let x = f.px(*v);
-            if !cats {
-                let _ = write!(grid, "M{} {}V{}", coord(x), coord(f.y0), coord(f.y1));
-            }
-            let _ = write!(tick_marks, "M{} {}v4", coord(x), coord(f.y1));
-        }
-        let _ = write!(
-            s,
-            r##"<path d="{grid}" stroke="#e6e6e6" stroke-width="1" fill="none"/>"##
-        );
+        let tick_marks = self.grid(&mut s, &f);
         // Data, clipped to the plot area.
         let _ = write!(s, r#"<g clip-path="url(#{})">"#, esc(&clip));
         for item in &self.items {
@@ -632,6 +634,38 @@ impl Chart {
             y1 = coord(f.y1),
             x1 = coord(f.x1),
         );
+        self.tick_labels(&mut s, &f, w);
+        self.labels(&mut s, &f);
+        self.legend_entries(&mut s, &f, title_h, &legend_pos);
+        s.push_str("</svg>");
+        Rendered { svg: s, dropped }
+    }
+
+    /// Writes the grid lines; returns the tick marks' path, drawn with the axes.
+    fn grid(&self, s: &mut String, f: &Frame) -> String {
+        let mut grid = String::new();
+        let mut tick_marks = String::new();
+        for (v, _) in &f.ya.ticks {
+            let y = f.py(*v);
+            let _ = write!(grid, "M{} {}H{}", coord(f.x0), coord(y), coord(f.x1));
+            let _ = write!(tick_marks, "M{} {}h4", coord(f.x0 - 4.0), coord(y));
+        }
+        for (v, _) in f.xa.ticks.iter().filter(|_| self.x_ticks) {
+            let x = f.px(*v);
+            if !f.y_down {
+                let _ = write!(grid, "M{} {}V{}", coord(x), coord(f.y0), coord(f.y1));
+            }
+            let _ = write!(tick_marks, "M{} {}v4", coord(x), coord(f.y1));
+        }
+        let _ = write!(
+            s,
+            r##"<path d="{grid}" stroke="#e6e6e6" stroke-width="1" fill="none"/>"##
+        );
+        tick_marks
+    }
+
+    /// The tick labels; a y label too long for 40 % of the width `w` is cut, in full in its tooltip.
+    fn tick_labels(&self, s: &mut String, f: &Frame, w: f64) {
         if self.x_ticks {
             let _ = write!(s, r##"<g fill="#333" text-anchor="middle">"##);
             for (v, label) in &f.xa.ticks {
@@ -668,6 +702,10 @@ impl Chart {
             s.push_str("</text>");
         }
         s.push_str("</g>");
+    }
+
+    /// The axis labels and the title.
+    fn labels(&self, s: &mut String, f: &Frame) {
         if !self.x_label.is_empty() {
             let _ = write!(
                 s,
@@ -695,11 +733,15 @@ impl Chart {
                 rich(&self.title)
             );
         }
+    }
+
+    /// The legend above the plot area, entries placed by [`Chart::legend_layout`].
+    fn legend_entries(&self, s: &mut String, f: &Frame, title_h: f64, legend_pos: &[(f64, usize)]) {
         if !self.legend.is_empty() {
             s.push_str(r#"<g dominant-baseline="middle">"#);
-            for ((label, key), (dx, row)) in self.legend.iter().zip(&legend_pos) {
+            for ((label, key), (dx, row)) in self.legend.iter().zip(legend_pos) {
                 let (x, y) = (f.x0 + dx, title_h + 8.0 + *row as f64 * 17.0);
-                key_glyph(&mut s, *key, x, y);
+                key_glyph(s, *key, x, y);
                 let _ = write!(
                     s,
                     r#"<text x="{}" y="{}">{}</text>"#,
@@ -710,224 +752,264 @@ impl Chart {
             }
             s.push_str("</g>");
         }
-        s.push_str("</svg>");
-        Rendered { svg: s, dropped }
     }
 
     /// Draws one item; returns how many values it could not draw.
     fn render_item(&self, s: &mut String, f: &Frame, item: &Item) -> usize {
-        let mut dropped = 0;
-        match item {
+        match *item {
             Item::Line {
-                pts,
+                ref pts,
                 color,
                 width,
                 dash,
-            } => {
-                let mut d = String::new();
-                let mut run: Vec<(f64, f64)> = Vec::new();
-                let flush = |run: &mut Vec<(f64, f64)>, d: &mut String| {
-                    for (i, (x, y)) in simplify(run, 0.3).into_iter().enumerate() {
-                        d.push(if i == 0 { 'M' } else { 'L' });
-                        push_coord(d, x);
-                        d.push(' ');
-                        push_coord(d, y);
-                    }
-                    run.clear();
-                };
-                for &(x, y) in pts {
-                    if usable(x) && usable(y) {
-                        run.push((f.px(x), f.py(y)));
-                    } else {
-                        dropped += 1;
-                        flush(&mut run, &mut d);
-                    }
-                }
-                flush(&mut run, &mut d);
-                if !d.is_empty() {
-                    let dash = if *dash { r#" stroke-dasharray="5 3""# } else { "" };
-                    let _ = write!(
-                        s,
-                        r#"<path d="{d}" fill="none" stroke="{color}" stroke-width="{}" stroke-linejoin="round"{dash}/>"#,
-                        coord(*width)
-                    );
-                }
-            }
+            } => draw_line(s, f, pts, color, width, dash),
             Item::Marks {
-                marks,
+                ref marks,
                 color,
                 shape,
                 size,
-            } => {
-                let style = marker_style(*shape, color, *size);
-                let r = size / 2.0;
-                let mut plain = String::new();
-                let mut linked = String::new();
-                for m in marks {
-                    if !(usable(m.x) && usable(m.y)) {
-                        dropped += 1;
-                        continue;
-                    }
-                    let (x, y) = (f.px(m.x), f.py(m.y));
-                    if m.tip.is_none() && m.href.is_none() {
-                        marker_path(&mut plain, *shape, x, y, r);
-                        continue;
-                    }
-                    let mut d = String::new();
-                    marker_path(&mut d, *shape, x, y, r);
-                    if let Some(href) = &m.href {
-                        let _ = write!(linked, r##"<a href="#{}">"##, esc(href));
-                    }
-                    let _ = write!(linked, r#"<path d="{d}">"#);
-                    if let Some(tip) = &m.tip {
-                        let _ = write!(linked, "<title>{}</title>", esc(tip));
-                    }
-                    linked.push_str("</path>");
-                    if m.href.is_some() {
-                        linked.push_str("</a>");
-                    }
-                }
-                if !plain.is_empty() {
-                    let _ = write!(s, r#"<path d="{plain}" {style}/>"#);
-                }
-                if !linked.is_empty() {
-                    let _ = write!(s, "<g {style}>{linked}</g>");
-                }
+            } => draw_marks(s, f, marks, color, shape, size),
+            Item::ErrorBars { ref bars, color } => draw_error_bars(s, f, bars, color),
+            Item::Bars { ref bars } => draw_bars(s, f, bars),
+            ref other => {
+                draw_guide(s, f, other);
+                0
             }
-            Item::ErrorBars { bars, color } => {
-                let mut d = String::new();
-                for b in bars {
-                    if !(usable(b.x) && usable(b.y)) {
-                        continue;
-                    }
-                    if let Some((a, c)) = b.y_span {
-                        if usable(a) && usable(c) {
-                            let x = f.px(b.x);
-                            let (ya, yc) = (f.py(a), f.py(c));
-                            let _ = write!(
-                                d,
-                                "M{x} {ya}V{yc}M{xl} {ya}h5M{xl} {yc}h5",
-                                x = coord(x),
-                                ya = coord(ya),
-                                yc = coord(yc),
-                                xl = coord(x - 2.5)
-                            );
-                        } else {
-                            dropped += 1;
-                        }
-                    }
-                    if let Some((a, c)) = b.x_span {
-                        if usable(a) && usable(c) {
-                            let y = f.py(b.y);
-                            let (xa, xc) = (f.px(a), f.px(c));
-                            let _ = write!(
-                                d,
-                                "M{xa} {y}H{xc}M{xa} {yt}v5M{xc} {yt}v5",
-                                xa = coord(xa),
-                                xc = coord(xc),
-                                y = coord(y),
-                                yt = coord(y - 2.5)
-                            );
-                        } else {
-                            dropped += 1;
-                        }
-                    }
-                }
-                if !d.is_empty() {
-                    let _ = write!(s, r#"<path d="{d}" fill="none" stroke="{color}" stroke-width="1"/>"#);
-                }
+        }
+    }
+}
+
+/// A chart's computed geometry.
+struct Layout {
+    /// Width and height of the whole chart, px.
+    w: f64,
+    h: f64,
+    /// The plot area and its axes.
+    f: Frame,
+    /// Height of the title row, px (the legend rows start below it).
+    title_h: f64,
+    /// (x offset, row) of every legend entry.
+    legend_pos: Vec<(f64, usize)>,
+}
+
+/// A polyline in runs of usable points (a break at each unusable one), each run simplified to 0.3 px.
+fn draw_line(s: &mut String, f: &Frame, pts: &[(f64, f64)], color: &str, width: f64, dash: bool) -> usize {
+    let mut dropped = 0;
+    let mut d = String::new();
+    let mut run: Vec<(f64, f64)> = Vec::new();
+    let flush = |run: &mut Vec<(f64, f64)>, d: &mut String| {
+        for (i, (x, y)) in simplify(run, 0.3).into_iter().enumerate() {
+            d.push(if i == 0 { 'M' } else { 'L' });
+            push_coord(d, x);
+            d.push(' ');
+            push_coord(d, y);
+        }
+        run.clear();
+    };
+    for &(x, y) in pts {
+        if usable(x) && usable(y) {
+            run.push((f.px(x), f.py(y)));
+        } else {
+            dropped += 1;
+            flush(&mut run, &mut d);
+        }
+    }
+    flush(&mut run, &mut d);
+    if !d.is_empty() {
+        let dash = if dash { r#" stroke-dasharray="5 3""# } else { "" };
+        let _ = write!(
+            s,
+            r#"<path d="{d}" fill="none" stroke="{color}" stroke-width="{}" stroke-linejoin="round"{dash}/>"#,
+            coord(width)
+        );
+    }
+    dropped
+}
+
+/// Markers: plain ones as one path, those with a tooltip or link each in its own element.
+fn draw_marks(s: &mut String, f: &Frame, marks: &[Mark], color: &str, shape: Shape, size: f64) -> usize {
+    let mut dropped = 0;
+    let style = marker_style(shape, color, size);
+    let r = size / 2.0;
+    let mut plain = String::new();
+    let mut linked = String::new();
+    for m in marks {
+        if !(usable(m.x) && usable(m.y)) {
+            dropped += 1;
+            continue;
+        }
+        let (x, y) = (f.px(m.x), f.py(m.y));
+        if m.tip.is_none() && m.href.is_none() {
+            marker_path(&mut plain, shape, x, y, r);
+            continue;
+        }
+        let mut d = String::new();
+        marker_path(&mut d, shape, x, y, r);
+        if let Some(href) = &m.href {
+            let _ = write!(linked, r##"<a href="#{}">"##, esc(href));
+        }
+        let _ = write!(linked, r#"<path d="{d}">"#);
+        if let Some(tip) = &m.tip {
+            let _ = write!(linked, "<title>{}</title>", esc(tip));
+        }
+        linked.push_str("</path>");
+        if m.href.is_some() {
+            linked.push_str("</a>");
+        }
+    }
+    if !plain.is_empty() {
+        let _ = write!(s, r#"<path d="{plain}" {style}/>"#);
+    }
+    if !linked.is_empty() {
+        let _ = write!(s, "<g {style}>{linked}</g>");
+    }
+    dropped
+}
+
+/// Error bars with end caps, vertical and horizontal, as one path.
+fn draw_error_bars(s: &mut String, f: &Frame, bars: &[ErrorBar], color: &str) -> usize {
+    let mut dropped = 0;
+    let mut d = String::new();
+    for b in bars {
+        if !(usable(b.x) && usable(b.y)) {
+            continue;
+        }
+        if let Some((a, c)) = b.y_span {
+            if usable(a) && usable(c) {
+                let x = f.px(b.x);
+                let (ya, yc) = (f.py(a), f.py(c));
+                let _ = write!(
+                    d,
+                    "M{x} {ya}V{yc}M{xl} {ya}h5M{xl} {yc}h5",
+                    x = coord(x),
+                    ya = coord(ya),
+                    yc = coord(yc),
+                    xl = coord(x - 2.5)
+                );
+            } else {
+                dropped += 1;
             }
-            Item::Bars { bars } => {
-                for b in bars {
-                    if ![b.x0, b.x1, b.y0, b.y1].iter().all(|v| usable(*v)) {
-                        dropped += 1;
-                        continue;
-                    }
-                    let (xa, xb) = (f.px(b.x0), f.px(b.x1));
-                    let (ya, yb) = (f.py(b.y0), f.py(b.y1));
-                    let (x, y) = (xa.min(xb).max(f.x0 - 1.0), ya.min(yb).max(f.y0 - 1.0));
-                    let (x_end, y_end) = (xa.max(xb).min(f.x1 + 1.0), ya.max(yb).min(f.y1 + 1.0));
-                    if let Some(href) = &b.href {
-                        let _ = write!(s, r##"<a href="#{}">"##, esc(href));
-                    }
+        }
+        if let Some((a, c)) = b.x_span {
+            if usable(a) && usable(c) {
+                let y = f.py(b.y);
+                let (xa, xc) = (f.px(a), f.px(c));
+                let _ = write!(
+                    d,
+                    "M{xa} {y}H{xc}M{xa} {yt}v5M{xc} {yt}v5",
+                    xa = coord(xa),
+                    xc = coord(xc),
+                    y = coord(y),
+                    yt = coord(y - 2.5)
+                );
+            } else {
+                dropped += 1;
+            }
+        }
+    }
+    if !d.is_empty() {
+        let _ = write!(s, r#"<path d="{d}" fill="none" stroke="{color}" stroke-width="1"/>"#);
+    }
+    dropped
+}
+
+/// Bars clipped to a pixel beyond the plot area, each with its tooltip and link.
+fn draw_bars(s: &mut String, f: &Frame, bars: &[Bar]) -> usize {
+    let mut dropped = 0;
+    for b in bars {
+        if ![b.x0, b.x1, b.y0, b.y1].iter().all(|v| usable(*v)) {
+            dropped += 1;
+            continue;
+        }
+        let (xa, xb) = (f.px(b.x0), f.px(b.x1));
+        let (ya, yb) = (f.py(b.y0), f.py(b.y1));
+        let (x, y) = (xa.min(xb).max(f.x0 - 1.0), ya.min(yb).max(f.y0 - 1.0));
+        let (x_end, y_end) = (xa.max(xb).min(f.x1 + 1.0), ya.max(yb).min(f.y1 + 1.0));
+        if let Some(href) = &b.href {
+            let _ = write!(s, r##"<a href="#{}">"##, esc(href));
+        }
+        let _ = write!(
+            s,
+            r#"<rect x="{}" y="{}" width="{}" height="{}" fill="{}">"#,
+            coord(x),
+            coord(y),
+            coord((x_end - x).max(0.0)),
+            coord((y_end - y).max(0.0)),
+            b.color
+        );
+        if let Some(tip) = &b.tip {
+            let _ = write!(s, "<title>{}</title>", esc(tip));
+        }
+        s.push_str("</rect>");
+        if b.href.is_some() {
+            s.push_str("</a>");
+        }
+    }
+    dropped
+}
+
+/// Bands and rules: drawn where usable and inside the plot area, never counted as dropped.
+fn draw_guide(s: &mut String, f: &Frame, item: &Item) {
+    match item {
+        Item::XBand { x0, x1, fill } => {
+            if usable(*x0) && usable(*x1) {
+                let (a, b) = (f.px(*x0).clamp(f.x0, f.x1), f.px(*x1).clamp(f.x0, f.x1));
+                let (a, b) = (a.min(b), a.max(b));
+                if b > a {
                     let _ = write!(
                         s,
-                        r#"<rect x="{}" y="{}" width="{}" height="{}" fill="{}">"#,
-                        coord(x),
-                        coord(y),
-                        coord((x_end - x).max(0.0)),
-                        coord((y_end - y).max(0.0)),
-                        b.color
-                    );
-                    if let Some(tip) = &b.tip {
-                        let _ = write!(s, "<title>{}</title>", esc(tip));
-                    }
-                    s.push_str("</rect>");
-                    if b.href.is_some() {
-                        s.push_str("</a>");
-                    }
-                }
-            }
-            Item::XBand { x0, x1, fill } => {
-                if usable(*x0) && usable(*x1) {
-                    let (a, b) = (f.px(*x0).clamp(f.x0, f.x1), f.px(*x1).clamp(f.x0, f.x1));
-                    let (a, b) = (a.min(b), a.max(b));
-                    if b > a {
-                        let _ = write!(
-                            s,
-                            r#"<rect x="{}" y="{}" width="{}" height="{}" fill="{fill}"/>"#,
-                            coord(a),
-                            coord(f.y0),
-                            coord(b - a),
-                            coord(f.y1 - f.y0)
-                        );
-                    }
-                }
-            }
-            Item::YBand { y0, y1, fill } => {
-                if usable(*y0) && usable(*y1) {
-                    let (a, b) = (f.py(*y0).clamp(f.y0, f.y1), f.py(*y1).clamp(f.y0, f.y1));
-                    let (a, b) = (a.min(b), a.max(b));
-                    if b > a {
-                        let _ = write!(
-                            s,
-                            r#"<rect x="{}" y="{}" width="{}" height="{}" fill="{fill}"/>"#,
-                            coord(f.x0),
-                            coord(a),
-                            coord(f.x1 - f.x0),
-                            coord(b - a)
-                        );
-                    }
-                }
-            }
-            Item::HRule { y, color, dash } => {
-                let py = f.py(*y);
-                if usable(*y) && py >= f.y0 && py <= f.y1 {
-                    let dash = if *dash { r#" stroke-dasharray="4 3""# } else { "" };
-                    let _ = write!(
-                        s,
-                        r#"<path d="M{} {}H{}" stroke="{color}" stroke-width="1"{dash}/>"#,
-                        coord(f.x0),
-                        coord(py),
-                        coord(f.x1)
-                    );
-                }
-            }
-            Item::VRule { x, color, dash } => {
-                let px = f.px(*x);
-                if usable(*x) && px >= f.x0 && px <= f.x1 {
-                    let dash = if *dash { r#" stroke-dasharray="4 3""# } else { "" };
-                    let _ = write!(
-                        s,
-                        r#"<path d="M{} {}V{}" stroke="{color}" stroke-width="1"{dash}/>"#,
-                        coord(px),
+                        r#"<rect x="{}" y="{}" width="{}" height="{}" fill="{fill}"/>"#,
+                        coord(a),
                         coord(f.y0),
-                        coord(f.y1)
+                        coord(b - a),
+                        coord(f.y1 - f.y0)
                     );
                 }
             }
         }
-        dropped
+        Item::YBand { y0, y1, fill } => {
+            if usable(*y0) && usable(*y1) {
+                let (a, b) = (f.py(*y0).clamp(f.y0, f.y1), f.py(*y1).clamp(f.y0, f.y1));
+                let (a, b) = (a.min(b), a.max(b));
+                if b > a {
+                    let _ = write!(
+                        s,
+                        r#"<rect x="{}" y="{}" width="{}" height="{}" fill="{fill}"/>"#,
+                        coord(f.x0),
+                        coord(a),
+                        coord(f.x1 - f.x0),
+                        coord(b - a)
+                    );
+                }
+            }
+        }
+        Item::HRule { y, color, dash } => {
+            let py = f.py(*y);
+            if usable(*y) && py >= f.y0 && py <= f.y1 {
+                let dash = if *dash { r#" stroke-dasharray="4 3""# } else { "" };
+                let _ = write!(
+                    s,
+                    r#"<path d="M{} {}H{}" stroke="{color}" stroke-width="1"{dash}/>"#,
+                    coord(f.x0),
+                    coord(py),
+                    coord(f.x1)
+                );
+            }
+        }
+        Item::VRule { x, color, dash } => {
+            let px = f.px(*x);
+            if usable(*x) && px >= f.x0 && px <= f.x1 {
+                let dash = if *dash { r#" stroke-dasharray="4 3""# } else { "" };
+                let _ = write!(
+                    s,
+                    r#"<path d="M{} {}V{}" stroke="{color}" stroke-width="1"{dash}/>"#,
+                    coord(px),
+                    coord(f.y0),
+                    coord(f.y1)
+                );
+            }
+        }
+        Item::Line { .. } | Item::Marks { .. } | Item::ErrorBars { .. } | Item::Bars { .. } => {}
     }
 }
 
