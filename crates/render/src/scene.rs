@@ -8,7 +8,7 @@ use std::f64::consts::TAU;
 
 /// A rendered frame.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Frame {
+pub struct RenderedFrame {
     /// Width, pixels.
     pub width: u32,
     /// Height, pixels.
@@ -26,7 +26,7 @@ pub enum Pixels {
     Gray16(Vec<u16>),
 }
 
-impl Frame {
+impl RenderedFrame {
     /// The gray level at (x, y) on the 8-bit scale (16-bit frames divided by 257; 12-bit data in 16-bit
     /// frames comes out within 0.4 % of it).
     pub fn get(&self, x: u32, y: u32) -> f64 {
@@ -570,7 +570,7 @@ impl<'a> ShotRenderer<'a> {
     /// # Panics
     /// If `i` is not a frame of the shot.
     #[allow(clippy::needless_range_loop)] // x indexes four parallel arrays
-    pub fn frame(&self, i: usize) -> Frame {
+    pub fn frame(&self, i: usize) -> RenderedFrame {
         let plan = self.plan;
         let cam = &plan.camera;
         let (w, h) = (self.w, self.h);
@@ -662,7 +662,7 @@ impl<'a> ShotRenderer<'a> {
                 }
             }
         }
-        Frame {
+        RenderedFrame {
             width: w as u32,
             height: h as u32,
             pixels: if sixteen {
