@@ -23,7 +23,7 @@ fn render(scenario: &Scenario, root: &Path) -> PathBuf {
         scenario,
         &root.join("render"),
         &RenderOptions::default(),
-        &bouncelab_render::Silent,
+        &bouncelab_render::NoRenderProgress,
     )
     .unwrap_or_else(|e| panic!("rendering {}: {e}", scenario.origin));
     out.session_dir

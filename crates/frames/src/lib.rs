@@ -34,6 +34,7 @@ pub mod init;
 mod pixels;
 mod session;
 mod settings;
+#[cfg(any(test, feature = "testutil"))]
 #[doc(hidden)]
 pub mod testutil;
 #[cfg(feature = "opencv")]

@@ -406,6 +406,30 @@ fn unterminated_quote(text: &str) -> Option<u64> {
     open_at
 }
 
+/// A `csv` error as the session's error: the line, and a field-count mismatch said plainly.
+fn csv_error(path: &Path, e: csv::Error) -> FramesError {
+    FramesError::Csv {
+        path: path.into(),
+        line: e.position().map(csv::Position::line),
+        message: match e.kind() {
+            csv::ErrorKind::UnequalLengths { expected_len, len, .. } => {
+                format!("{len} fields where the header has {expected_len}")
+            }
+            _ => e.to_string(),
+        },
+    }
+}
+
+/// What one data row of `clips.csv` is.
+enum RowRead {
+    /// A complete row.
+    Clip(Row),
+    /// A row with some required cells empty (collected, then reported together).
+    Unfilled(UnfilledRow),
+}
+
+/// The rows of `clips.csv`: each clip named once, every required cell filled, every number finite and its
+/// incline and drop height in range.
 fn read_clips_csv(path: &Path) -> Result<Vec<Row>> {
     let text = std::fs::read(path).map_err(|source| FramesError::Io {
         path: path.into(),
@@ -418,120 +442,32 @@ fn read_clips_csv(path: &Path) -> Result<Vec<Row>> {
             message: "a quoted field opens here and never closes (a missing `\"`)".into(),
         });
     }
-    let csv_err = |e: csv::Error| FramesError::Csv {
-        path: path.into(),
-        line: e.position().map(csv::Position::line),
-        message: match e.kind() {
-            csv::ErrorKind::UnequalLengths { expected_len, len, .. } => {
-                format!("{len} fields where the header has {expected_len}")
-            }
-            _ => e.to_string(),
-        },
-    };
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .comment(Some(b'#'))
         .from_reader(text.as_slice());
-    let headers = reader.headers().map_err(csv_err)?.clone();
-    let column = |name: &str| -> Result<usize> {
-        headers
-            .iter()
-            .position(|h| h == name)
-            .ok_or_else(|| FramesError::MissingColumn {
-                path: path.into(),
-                column: name.into(),
-            })
-    };
-    let idx: Vec<usize> = REQUIRED_COLUMNS.iter().map(|c| column(c)).collect::<Result<_>>()?;
+    let headers = reader.headers().map_err(|e| csv_error(path, e))?.clone();
+    let idx: Vec<usize> = REQUIRED_COLUMNS
+        .iter()
+        .map(|name| {
+            headers
+                .iter()
+                .position(|h| h == *name)
+                .ok_or_else(|| FramesError::MissingColumn {
+                    path: path.into(),
+                    column: (*name).into(),
+                })
+        })
+        .collect::<Result<_>>()?;
     let mut rows: Vec<Row> = Vec::new();
     let mut seen: HashMap<String, u64> = HashMap::new();
     let mut unfilled = Vec::new();
     for record in reader.records() {
-        let record = record.map_err(csv_err)?;
-        let line = record.position().map_or(0, csv::Position::line);
-        let cell = |i: usize| record.get(idx[i]).unwrap_or_default();
-        let number = |i: usize| -> Result<f64> {
-            let text = cell(i);
-            text.parse::<f64>()
-                .ok()
-                .filter(|x| x.is_finite())
-                .ok_or_else(|| FramesError::BadNumber {
-                    path: path.into(),
-                    line,
-                    column: REQUIRED_COLUMNS[i].into(),
-                    value: text.into(),
-                })
-        };
-        let name = cell(0).to_string();
-        if name.is_empty() {
-            return Err(FramesError::Csv {
-                path: path.into(),
-                line: Some(line),
-                message: "empty `clip` cell".into(),
-            });
+        let record = record.map_err(|e| csv_error(path, e))?;
+        match read_row(path, &headers, &idx, &record, &mut seen)? {
+            RowRead::Clip(row) => rows.push(row),
+            RowRead::Unfilled(u) => unfilled.push(u),
         }
-        if let Some(&first_line) = seen.get(&name) {
-            return Err(FramesError::DuplicateClip {
-                path: path.into(),
-                clip: name,
-                first_line,
-                second_line: line,
-            });
-        }
-        seen.insert(name.clone(), line);
-        let empty: Vec<String> = (1..REQUIRED_COLUMNS.len())
-            .filter(|&i| cell(i).is_empty())
-            .map(|i| REQUIRED_COLUMNS[i].to_string())
-            .collect();
-        if !empty.is_empty() {
-            unfilled.push(UnfilledRow {
-                line,
-                clip: name,
-                columns: empty,
-            });
-            continue;
-        }
-        let metadata = headers
-            .iter()
-            .zip(record.iter())
-            .enumerate()
-            .filter(|(i, _)| !idx.contains(i))
-            .map(|(_, (h, v))| (h.to_string(), v.to_string()))
-            .collect();
-        let (angle_deg, drop_height_m) = (number(2)?, number(3)?);
-        let bad = |column: &str, problem: String| FramesError::BadValue {
-            path: path.into(),
-            field: format!("line {line}, {column}"),
-            problem,
-        };
-        if angle_deg.abs() >= 90.0 {
-            return Err(bad(
-                "angle_deg",
-                format!(
-                    "{} is not an incline: it must lie between −90 and 90 degrees",
-                    crate::settings::short_number(angle_deg)
-                ),
-            ));
-        }
-        if !(DROP_HEIGHT_RANGE_M.0..=DROP_HEIGHT_RANGE_M.1).contains(&drop_height_m) {
-            return Err(bad(
-                "drop_height_m",
-                format!(
-                    "{} is outside the accepted range {}–{} m",
-                    crate::settings::short_number(drop_height_m),
-                    DROP_HEIGHT_RANGE_M.0,
-                    DROP_HEIGHT_RANGE_M.1
-                ),
-            ));
-        }
-        rows.push(Row {
-            name,
-            surface: cell(1).to_string(),
-            angle_deg,
-            drop_height_m,
-            metadata,
-            line,
-        });
     }
     if !unfilled.is_empty() {
         return Err(FramesError::UnfilledColumns {
@@ -547,4 +483,103 @@ fn read_clips_csv(path: &Path) -> Result<Vec<Row>> {
         });
     }
     Ok(rows)
+}
+
+/// One data row: `idx` gives the required columns' positions, `seen` the line of every clip named so far.
+fn read_row(
+    path: &Path,
+    headers: &csv::StringRecord,
+    idx: &[usize],
+    record: &csv::StringRecord,
+    seen: &mut HashMap<String, u64>,
+) -> Result<RowRead> {
+    let line = record.position().map_or(0, csv::Position::line);
+    let cell = |i: usize| record.get(idx[i]).unwrap_or_default();
+    let number = |i: usize| -> Result<f64> {
+        let text = cell(i);
+        text.parse::<f64>()
+            .ok()
+            .filter(|x| x.is_finite())
+            .ok_or_else(|| FramesError::BadNumber {
+                path: path.into(),
+                line,
+                column: REQUIRED_COLUMNS[i].into(),
+                value: text.into(),
+            })
+    };
+    let name = cell(0).to_string();
+    if name.is_empty() {
+        return Err(FramesError::Csv {
+            path: path.into(),
+            line: Some(line),
+            message: "empty `clip` cell".into(),
+        });
+    }
+    if let Some(&first_line) = seen.get(&name) {
+        return Err(FramesError::DuplicateClip {
+            path: path.into(),
+            clip: name,
+            first_line,
+            second_line: line,
+        });
+    }
+    seen.insert(name.clone(), line);
+    let empty: Vec<String> = (1..REQUIRED_COLUMNS.len())
+        .filter(|&i| cell(i).is_empty())
+        .map(|i| REQUIRED_COLUMNS[i].to_string())
+        .collect();
+    if !empty.is_empty() {
+        return Ok(RowRead::Unfilled(UnfilledRow {
+            line,
+            clip: name,
+            columns: empty,
+        }));
+    }
+    let metadata = headers
+        .iter()
+        .zip(record.iter())
+        .enumerate()
+        .filter(|(i, _)| !idx.contains(i))
+        .map(|(_, (h, v))| (h.to_string(), v.to_string()))
+        .collect();
+    let (angle_deg, drop_height_m) = (number(2)?, number(3)?);
+    check_drop(path, line, angle_deg, drop_height_m)?;
+    Ok(RowRead::Clip(Row {
+        name,
+        surface: cell(1).to_string(),
+        angle_deg,
+        drop_height_m,
+        metadata,
+        line,
+    }))
+}
+
+/// The incline must be one (|β| < 90°) and the drop height within the accepted range.
+fn check_drop(path: &Path, line: u64, angle_deg: f64, drop_height_m: f64) -> Result<()> {
+    let bad = |column: &str, problem: String| FramesError::BadValue {
+        path: path.into(),
+        field: format!("line {line}, {column}"),
+        problem,
+    };
+    if angle_deg.abs() >= 90.0 {
+        return Err(bad(
+            "angle_deg",
+            format!(
+                "{} is not an incline: it must lie between −90 and 90 degrees",
+                crate::settings::short_number(angle_deg)
+            ),
+        ));
+    }
+    if !(DROP_HEIGHT_RANGE_M.0..=DROP_HEIGHT_RANGE_M.1).contains(&drop_height_m) {
+        return Err(bad(
+            "drop_height_m",
+            format!(
+                "{} is outside the accepted range {}–{} m",
+                crate::settings::short_number(drop_height_m),
+                DROP_HEIGHT_RANGE_M.0,
+                DROP_HEIGHT_RANGE_M.1
+            ),
+        ));
+    }
+    Ok(())
 }

@@ -370,6 +370,16 @@ impl Event {
         }
     }
 
+    /// The phase a phase event starts (none for stick/slip events).
+    fn next_phase(self) -> Option<Phase> {
+        match self {
+            Event::Touch => Some(Phase::Compression),
+            Event::MaxCompression => Some(Phase::Restitution),
+            Event::ForceVanishes | Event::PenetrationVanishes => Some(Phase::Flight),
+            Event::SlipStops | Event::GripLost => None,
+        }
+    }
+
     fn active(mode: &Mode) -> &'static [Event] {
         use Event::*;
         match (mode.phase, mode.friction) {
@@ -381,6 +391,77 @@ impl Event {
             (Phase::Restitution, Friction::Stick) => &[ForceVanishes, PenetrationVanishes, GripLost],
             (Phase::Restitution, Friction::None) => &[ForceVanishes, PenetrationVanishes],
         }
+    }
+}
+
+/// The values of the active `events` at state `y` (with its quantities `aux`), in the order listed.
+fn event_values<const N: usize>(events: &[Event], y: &Y<N>, aux: &Aux, mode: &Mode, r: f64) -> [f64; MAX_EVENTS] {
+    let mut g = [0.0; MAX_EVENTS];
+    for (gk, e) in g.iter_mut().zip(events) {
+        *gk = e.value(y, aux, mode, r);
+    }
+    g
+}
+
+/// A compliant patch's switch leaves the new mode's stick/slip event function at zero (the force is
+/// continuous): count it as just positive so that the next crossing is seen, and one at once (the other
+/// mode was due right away) is found at the start.
+fn patch_switch_just_positive(g: &mut [f64; MAX_EVENTS], events: &[Event]) {
+    for (gk, e) in g.iter_mut().zip(events) {
+        if matches!(e, Event::SlipStops | Event::GripLost) && *gk <= 0.0 {
+            *gk = f64::MIN_POSITIVE;
+        }
+    }
+}
+
+/// An accepted step must end on finite numbers and, in contact, with the centre above the surface.
+fn check_accepted<const N: usize>(step: &Step<N>, mode: &Mode, r: f64) -> Result<(), ModelError> {
+    let (t, h) = (step.t0, step.h);
+    if !step.y1.iter().all(|v| v.is_finite()) {
+        return Err(ModelError::NonFinite {
+            t_s: t + h,
+            phase: mode.phase.name(),
+        });
+    }
+    if mode.phase.in_contact() && step.y1[1] < 0.0 {
+        return Err(ModelError::SankThrough {
+            t_s: t + h,
+            depth_m: r - step.y1[1],
+        });
+    }
+    Ok(())
+}
+
+impl Dynamics<'_> {
+    /// The earliest event whose function falls through zero in `step` (from `g` at its start to `g1` at its
+    /// end), located on the step's dense output: its time and which.
+    fn earliest_event<const N: usize>(
+        &self,
+        events: &[Event],
+        step: &Step<N>,
+        g: &[f64; MAX_EVENTS],
+        g1: &[f64; MAX_EVENTS],
+        m: &Mode,
+        r: f64,
+    ) -> Option<(f64, Event)> {
+        let (t, h) = (step.t0, step.h);
+        let mut hit: Option<(f64, Event)> = None;
+        for (k, ev) in events.iter().enumerate() {
+            if g[k] > 0.0 && g1[k] <= 0.0 {
+                let gf = |tt: f64| {
+                    let yy = step.at(tt);
+                    let a = self.eval(tt, &yy, m).1;
+                    ev.value(&yy, &a, m, r)
+                };
+                let te = find_root(gf, t, g[k], t + h, g1[k], 1e-14 * t.abs().max(1e-3));
+                // Phase events are listed first and win ties, so a slip event at the same instant as
+                // separation does not hide the separation.
+                if hit.is_none_or(|(th, _)| te < th - 1e-13 * th.abs().max(1e-3)) {
+                    hit = Some((te, *ev));
+                }
+            }
+        }
+        hit
     }
 }
 
@@ -749,23 +830,9 @@ impl<'a> Run<'a> {
             dy
         };
         let (mut f, aux) = dynamics.eval(t, &y, &m);
-        let values = |y: &Y<N>, aux: &Aux| {
-            let mut g = [0.0; MAX_EVENTS];
-            for (gk, e) in g.iter_mut().zip(events) {
-                *gk = e.value(y, aux, &m, r);
-            }
-            g
-        };
-        let mut g = values(&y, &aux);
+        let mut g = event_values(events, &y, &aux, &m, r);
         if m.patch {
-            // A compliant patch's switch leaves the new mode's event function at zero (the force is
-            // continuous): count it as just positive so that the next crossing is seen, and one at once
-            // (the other mode was due right away) is found at the start.
-            for (gk, e) in g.iter_mut().zip(events) {
-                if matches!(e, Event::SlipStops | Event::GripLost) && *gk <= 0.0 {
-                    *gk = f64::MIN_POSITIVE;
-                }
-            }
+            patch_switch_just_positive(&mut g, events);
         }
         let scale = dynamics.model.ball.radius_m.max(1e-3) / y[3].hypot(y[4]).max(0.1);
         let mut h = (1e-3 * scale).min(self.opts.max_step_s);
@@ -795,37 +862,9 @@ impl<'a> Run<'a> {
                 }
                 continue;
             }
-            if !step.y1.iter().all(|v| v.is_finite()) {
-                return Err(ModelError::NonFinite {
-                    t_s: t + h,
-                    phase: m.phase.name(),
-                });
-            }
-            if m.phase.in_contact() && step.y1[1] < 0.0 {
-                return Err(ModelError::SankThrough {
-                    t_s: t + h,
-                    depth_m: r - step.y1[1],
-                });
-            }
-            let g1 = values(&step.y1, &last_aux.get());
-            // The earliest event whose function falls through zero in this step.
-            let mut hit: Option<(f64, Event)> = None;
-            for (k, ev) in events.iter().enumerate() {
-                if g[k] > 0.0 && g1[k] <= 0.0 {
-                    let gf = |tt: f64| {
-                        let yy = step.at(tt);
-                        let a = dynamics.eval(tt, &yy, &m).1;
-                        ev.value(&yy, &a, &m, r)
-                    };
-                    let te = find_root(gf, t, g[k], t + h, g1[k], 1e-14 * t.abs().max(1e-3));
-                    // Phase events are listed first and win ties, so a slip event at the same instant as
-                    // separation does not hide the separation.
-                    if hit.is_none_or(|(th, _)| te < th - 1e-13 * th.abs().max(1e-3)) {
-                        hit = Some((te, *ev));
-                    }
-                }
-            }
-            if let Some((te, ev)) = hit {
+            check_accepted(&step, &m, r)?;
+            let g1 = event_values(events, &step.y1, &last_aux.get(), &m, r);
+            if let Some((te, ev)) = dynamics.earliest_event(events, &step, &g, &g1, &m, r) {
                 // Re-step exactly to the event so its state has the integrator's full accuracy.
                 let he = te - t;
                 let (ye, at) = if he > 0.0 {
@@ -838,11 +877,8 @@ impl<'a> Run<'a> {
                     self.recorder
                         .record_until(te, &m, |tt| s.at(tt), |tt, yy| dynamics.patch_displacement(tt, yy, &m));
                 }
-                match ev {
-                    Event::Touch => mode.phase = Phase::Compression,
-                    Event::MaxCompression => mode.phase = Phase::Restitution,
-                    Event::ForceVanishes | Event::PenetrationVanishes => mode.phase = Phase::Flight,
-                    Event::SlipStops | Event::GripLost => {}
+                if let Some(phase) = ev.next_phase() {
+                    mode.phase = phase;
                 }
                 return Ok((te, ye));
             }

@@ -4,9 +4,9 @@
 //! preset (render-clay.png, render-white_tape.png, render-green_tape.png) and a 2× close-up of the clay
 //! contact at maximum compression (render-contact.png).
 
-use bouncelab_render::{Frame, Pixels, Scenario, ShotPlan, encode};
+use bouncelab_render::{Pixels, RenderedFrame, Scenario, ShotPlan, encode};
 
-fn save(frame: &Frame, path: &std::path::Path) {
+fn save(frame: &RenderedFrame, path: &std::path::Path) {
     std::fs::write(path, encode(frame, bouncelab_render::Format::Png).unwrap()).unwrap();
     println!("{}", path.display());
 }
@@ -43,7 +43,7 @@ fn main() {
             crop.push(px[((y0 + y / 2) * f.width + x0 + x / 2) as usize]);
         }
     }
-    let close = Frame {
+    let close = RenderedFrame {
         width: 2 * cw,
         height: 2 * ch,
         pixels: Pixels::Gray8(crop),

@@ -5,11 +5,11 @@
 //! shot's frame 3 ms before the touch scaled to a 300 × 300 tile, and `render-looks-edges.png`, 1:1 crops
 //! of the band's edge under the ball at the touch. Prints each tile's families.
 
-use bouncelab_render::{Frame, Pixels, Scenario, ShotPlan, encode};
+use bouncelab_render::{Pixels, RenderedFrame, Scenario, ShotPlan, encode};
 use std::collections::BTreeSet;
 
 /// The frame as 8-bit gray (16-bit and 12-in-16 data scaled down).
-fn gray8(f: &Frame, bit_depth: u8) -> Vec<u8> {
+fn gray8(f: &RenderedFrame, bit_depth: u8) -> Vec<u8> {
     match &f.pixels {
         Pixels::Gray8(v) => v.clone(),
         Pixels::Gray16(v) if bit_depth == 12 => v
@@ -116,7 +116,7 @@ fn main() {
         );
     }
     let save = |name: &str, w: usize, h: usize, v: Vec<u8>| {
-        let f = Frame {
+        let f = RenderedFrame {
             width: w as u32,
             height: h as u32,
             pixels: Pixels::Gray8(v),

@@ -3,7 +3,7 @@
 //! Renders a whole session as `bouncelab render` does (shots and frames in parallel on every core) and
 //! prints the wall time, the frames written and the disk used.
 
-use bouncelab_render::{RenderOptions, Scenario, Silent, render_with};
+use bouncelab_render::{NoRenderProgress, RenderOptions, Scenario, render_with};
 use std::time::Instant;
 
 fn du(p: &std::path::Path) -> u64 {
@@ -36,7 +36,7 @@ fn main() {
         overwrite: true,
     };
     let t = Instant::now();
-    let r = render_with(&s, out, &opts, &Silent).expect("render");
+    let r = render_with(&s, out, &opts, &NoRenderProgress).expect("render");
     let secs = t.elapsed().as_secs_f64();
     println!(
         "{name}: {} clips, {} frames in {secs:.1} s on {} threads ({:.2} ms per frame), {:.2} GB on disk",

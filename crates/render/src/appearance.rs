@@ -8,7 +8,7 @@
 //! `texture_dn`, and the edge profile over the visible width has mean zero and RMS exactly the look's
 //! roughness: the truth describes the pixels, not the random numbers behind them.
 
-use crate::look::{BallLook, Item, ItemKind, Look, SurfaceLook};
+use crate::look::{BallLook, HotSpot, Item, ItemKind, Look, SurfaceLook};
 use crate::rng::{Rng, ValueNoise};
 use crate::scene::{Layers, Shading, hash01, ramp};
 use crate::shot::{Geometry, ShotPlan};
@@ -243,6 +243,30 @@ struct Canvas<'a> {
 }
 
 impl Canvas<'_> {
+    /// Adds a hot spot's Gaussian glare (under the lighting) to the backdrop and the band alike.
+    fn glare(&mut self, hs: &HotSpot) {
+        let (wf, hf) = (self.w as f64, self.h as f64);
+        let reach = 3.0 * hs.sigma_px;
+        let two_s2 = 2.0 * hs.sigma_px * hs.sigma_px;
+        let (x0, x1) = (
+            (hs.x_px - reach).max(0.0) as usize,
+            (hs.x_px + reach).min(wf - 1.0).max(0.0) as usize,
+        );
+        let (y0, y1) = (
+            (hs.y_px - reach).max(0.0) as usize,
+            (hs.y_px + reach).min(hf - 1.0).max(0.0) as usize,
+        );
+        for y in y0..=y1 {
+            for x in x0..=x1 {
+                let i = y * self.w + x;
+                let r2 = (x as f64 - hs.x_px).powi(2) + (y as f64 - hs.y_px).powi(2);
+                let add = (hs.peak_dn * (-r2 / two_s2).exp() * self.vig[i] as f64) as f32;
+                self.back[i] += add;
+                self.band[i] += add;
+            }
+        }
+    }
+
     /// Paints inside the box centred on (cx, cy) of half-size `reach`: `f(dx, dy)` gives (coverage, DN
     /// before lighting) at an offset from the centre.
     fn paint(&mut self, layer: Layer, cx: f64, cy: f64, reach: f64, f: impl Fn(f64, f64) -> Option<(f64, f64)>) {
@@ -303,164 +327,229 @@ fn glyph(code: u64, u: f64, v: f64) -> bool {
     })
 }
 
+/// Paints one clutter item into the layers.
 fn paint_item(c: &mut Canvas, it: &Item, g: Geometry, look: &Look, light: [f64; 3], shading: Shading) {
-    let (cx, cy, r) = (it.x_px, it.y_px, it.r_px);
-    let line_y = |x: f64| g.ty + g.sin * (x - g.tx) / (g.dir * g.cos);
-    let edge = |d: f64| ramp(d + 0.5);
     match it.kind {
-        ItemKind::Screw => {
-            let ly = line_y(cx);
-            let layer = if cy - r > ly {
-                Layer::Band
-            } else if cy + r < ly {
-                Layer::Back
-            } else {
-                Layer::Both
-            };
-            let (ss, sc) = it.angle_rad.sin_cos();
-            c.paint(layer, cx, cy, r, |dx, dy| {
-                let q = dx.hypot(dy);
-                let (u, v) = (dx / r, -dy / r);
-                let across = (-ss * dx + sc * dy).abs();
-                let val = if it.bright {
-                    let mut val = 60.0 + 130.0 * sphere(u, v, light, Shading::LAMBERT);
-                    val *= 1.0 - 0.65 * ramp(0.2 * r + 0.5 - across);
-                    val * (1.0 - 0.35 * ramp(q / r * 8.0 - 7.0))
-                } else {
-                    // A dark socket head: a bright chamfer around a dark hexagonal recess.
-                    let hex = (0..3)
-                        .map(|k| {
-                            let a = it.angle_rad + k as f64 * PI / 3.0;
-                            (dx * a.cos() + dy * a.sin()).abs()
-                        })
-                        .fold(0.0f64, f64::max);
-                    let chamfer = ramp((q - 0.8 * r) * 2.0);
-                    25.0 + 90.0 * chamfer - 12.0 * ramp(0.45 * r - hex + 0.5)
-                };
-                Some((edge(r - q), val))
-            });
-        }
-        ItemKind::Fixture => {
-            let (bevel, gap) = (it.width_px.max(1.0), it.spacing_px.max(2.0));
-            c.paint(Layer::Back, cx, cy, r, |dx, dy| {
-                let q = dx.hypot(dy);
-                let body = 46.0 - 10.0 * dy / r;
-                let rim = ramp(q - (r - bevel) + 0.5);
-                let mut ring = 0.0f64;
-                let mut rr = 0.62 * r;
-                while rr > 0.3 * r {
-                    ring = ring.max(ramp(1.2 - (q - rr).abs()));
-                    rr -= gap;
-                }
-                let bore = ramp(0.25 * r - q + 0.5);
-                Some((edge(r - q), body + rim * (150.0 - body) + 45.0 * ring - 20.0 * bore))
-            });
-        }
-        ItemKind::Ruler => {
-            let (sa, ca) = it.angle_rad.sin_cos();
-            let (half, width, tick) = (it.r_px, it.width_px, it.spacing_px.max(2.0));
-            let (body, ink) = if it.bright { (215.0, 35.0) } else { (40.0, 200.0) };
-            let seed = (cx.to_bits() ^ cy.to_bits()).rotate_left(17);
-            c.paint(Layer::Back, cx, cy, half + width, |dx, dy| {
-                let along = dx * ca - dy * sa + half;
-                let across = dx * sa + dy * ca + 0.5 * width;
-                let cov = edge(along.min(2.0 * half - along)) * edge(across.min(width - across));
-                if cov <= 0.0 {
-                    return None;
-                }
-                let k = (along / tick).round();
-                let off = (along - k * tick).abs();
-                let len = if k as i64 % 10 == 0 {
-                    0.6
-                } else if k as i64 % 5 == 0 {
-                    0.4
-                } else {
-                    0.25
-                } * width;
-                let line_w = (0.12 * tick).max(0.6);
-                let mut ink_cov = ramp(line_w - off + 0.5) * ramp(len - across + 0.5);
-                // Digit-like marks beside every tenth tick.
-                let k10 = (along / (10.0 * tick)).floor();
-                let (gu, gv) = (
-                    (along - k10 * 10.0 * tick - 0.15 * width) / (0.18 * width),
-                    (across - 0.62 * width) / (0.15 * width),
-                );
-                let code = crate::rng::mix(seed ^ k10.to_bits()) | 1;
-                if (0.0..=1.0).contains(&gu) && (0.0..=2.0).contains(&gv) && glyph(code, gu, gv) {
-                    ink_cov = 1.0;
-                }
-                Some((cov, body + (ink - body) * ink_cov))
-            });
-        }
-        ItemKind::RestingBall => {
-            // Shaded like the moving ball (a backlit look gives a dark silhouette), without its seam.
-            let seed = cx.to_bits() ^ 0x5EED;
-            c.paint(Layer::Back, cx, cy, r, |dx, dy| {
-                let q = dx.hypot(dy);
-                let fuzz = 1.0 + 0.07 * (hash01(seed, dx.floor() as i64, dy.floor() as i64) - 0.5);
-                let val = look.ball_dn * sphere(dx / r, -dy / r, light, shading) * fuzz;
-                Some((ramp((r - q) / 1.3 + 0.5), val))
-            });
-        }
-        ItemKind::Ring => {
-            let t = it.width_px.max(1.5);
-            let val = if it.bright { 205.0 } else { 30.0 };
-            c.paint(Layer::Back, cx, cy, r, |dx, dy| {
-                let q = dx.hypot(dy);
-                let cov = edge(r - q) * edge(q - (r - t));
-                Some((cov, val * (1.0 - 0.15 * dy / r)))
-            });
-        }
-        ItemKind::Lamp => {
-            // A bright disc with a glow that fades over a quarter of its radius.
-            c.paint(Layer::Back, cx, cy, 1.6 * r, |dx, dy| {
-                let q = dx.hypot(dy);
-                let glow = (-(q - r).max(0.0) / (0.25 * r)).exp();
-                Some((edge(r - q).max(0.6 * glow), 245.0))
-            });
-        }
-        ItemKind::Hand => {
-            let size = r / 1.3;
-            let fw = it.width_px.max(2.0);
-            let (sa, ca) = it.angle_rad.sin_cos();
-            let level = 30.0;
-            c.paint(Layer::Both, cx, cy, r, |dx, dy| {
-                // Along the fingers (into the frame) and across them, y up.
-                let along = dx * ca - dy * sa;
-                let across = dx * sa + dy * ca;
-                let palm = 1.0 - ((along / (0.55 * size)).powi(2) + (across / (0.45 * size)).powi(2)).sqrt();
-                let mut d = palm * 0.45 * size;
-                for k in 0..4 {
-                    let off = (k as f64 - 1.5) * 0.24 * size;
-                    let len = size * [0.7, 0.8, 0.78, 0.62][k];
-                    let t = ((along - 0.35 * size) / len).clamp(0.0, 1.0) * len + 0.35 * size;
-                    d = d.max(0.5 * fw - (along - t).hypot(across - off));
-                }
-                let thumb_t = (along / (0.5 * size)).clamp(0.0, 1.0) * 0.5 * size;
-                d = d.max(0.6 * fw - (along - thumb_t).hypot(across + 0.45 * size + 0.3 * along));
-                let cov = ramp(d / 2.0 + 0.5);
-                Some((cov, level + 8.0 * (along / size).clamp(-1.0, 1.0)))
-            });
-        }
+        ItemKind::Screw => paint_screw(c, it, g, light),
+        ItemKind::Fixture => paint_fixture(c, it),
+        ItemKind::Ruler => paint_ruler(c, it),
+        ItemKind::RestingBall => paint_resting_ball(c, it, look.ball_dn, light, shading),
+        ItemKind::Ring => paint_ring(c, it),
+        ItemKind::Lamp => paint_lamp(c, it),
+        ItemKind::Hand => paint_hand(c, it),
     }
+}
+
+/// Coverage of a pixel whose centre lies `d` px inside an edge (a 1-px ramp).
+fn edge(d: f64) -> f64 {
+    ramp(d + 0.5)
+}
+
+/// A screw head, bright (slotted, domed) or dark (a socket head), in the band, the backdrop or both as it
+/// sits below, above or on the line.
+fn paint_screw(c: &mut Canvas, it: &Item, g: Geometry, light: [f64; 3]) {
+    let (cx, cy, r) = (it.x_px, it.y_px, it.r_px);
+    // The surface line (the contact plane) at the screw's column.
+    let ly = g.ty + g.sin * (cx - g.tx) / (g.dir * g.cos);
+    let layer = if cy - r > ly {
+        Layer::Band
+    } else if cy + r < ly {
+        Layer::Back
+    } else {
+        Layer::Both
+    };
+    let (ss, sc) = it.angle_rad.sin_cos();
+    c.paint(layer, cx, cy, r, |dx, dy| {
+        let q = dx.hypot(dy);
+        let (u, v) = (dx / r, -dy / r);
+        let across = (-ss * dx + sc * dy).abs();
+        let val = if it.bright {
+            let mut val = 60.0 + 130.0 * sphere(u, v, light, Shading::LAMBERT);
+            val *= 1.0 - 0.65 * ramp(0.2 * r + 0.5 - across);
+            val * (1.0 - 0.35 * ramp(q / r * 8.0 - 7.0))
+        } else {
+            // A dark socket head: a bright chamfer around a dark hexagonal recess.
+            let hex = (0..3)
+                .map(|k| {
+                    let a = it.angle_rad + k as f64 * PI / 3.0;
+                    (dx * a.cos() + dy * a.sin()).abs()
+                })
+                .fold(0.0f64, f64::max);
+            let chamfer = ramp((q - 0.8 * r) * 2.0);
+            25.0 + 90.0 * chamfer - 12.0 * ramp(0.45 * r - hex + 0.5)
+        };
+        Some((edge(r - q), val))
+    });
+}
+
+/// A dark anodised round fixture with a bright bevel, rings and a bore.
+fn paint_fixture(c: &mut Canvas, it: &Item) {
+    let (cx, cy, r) = (it.x_px, it.y_px, it.r_px);
+    let (bevel, gap) = (it.width_px.max(1.0), it.spacing_px.max(2.0));
+    c.paint(Layer::Back, cx, cy, r, |dx, dy| {
+        let q = dx.hypot(dy);
+        let body = 46.0 - 10.0 * dy / r;
+        let rim = ramp(q - (r - bevel) + 0.5);
+        let mut ring = 0.0f64;
+        let mut rr = 0.62 * r;
+        while rr > 0.3 * r {
+            ring = ring.max(ramp(1.2 - (q - rr).abs()));
+            rr -= gap;
+        }
+        let bore = ramp(0.25 * r - q + 0.5);
+        Some((edge(r - q), body + rim * (150.0 - body) + 45.0 * ring - 20.0 * bore))
+    });
+}
+
+/// A ruler: a bright or dark strip with ticks (longer every 5 and 10) and digit-like marks.
+fn paint_ruler(c: &mut Canvas, it: &Item) {
+    let (cx, cy) = (it.x_px, it.y_px);
+    let (sa, ca) = it.angle_rad.sin_cos();
+    let (half, width, tick) = (it.r_px, it.width_px, it.spacing_px.max(2.0));
+    let (body, ink) = if it.bright { (215.0, 35.0) } else { (40.0, 200.0) };
+    let seed = (cx.to_bits() ^ cy.to_bits()).rotate_left(17);
+    c.paint(Layer::Back, cx, cy, half + width, |dx, dy| {
+        let along = dx * ca - dy * sa + half;
+        let across = dx * sa + dy * ca + 0.5 * width;
+        let cov = edge(along.min(2.0 * half - along)) * edge(across.min(width - across));
+        if cov <= 0.0 {
+            return None;
+        }
+        let k = (along / tick).round();
+        let off = (along - k * tick).abs();
+        let len = if k as i64 % 10 == 0 {
+            0.6
+        } else if k as i64 % 5 == 0 {
+            0.4
+        } else {
+            0.25
+        } * width;
+        let line_w = (0.12 * tick).max(0.6);
+        let mut ink_cov = ramp(line_w - off + 0.5) * ramp(len - across + 0.5);
+        // Digit-like marks beside every tenth tick.
+        let k10 = (along / (10.0 * tick)).floor();
+        let (gu, gv) = (
+            (along - k10 * 10.0 * tick - 0.15 * width) / (0.18 * width),
+            (across - 0.62 * width) / (0.15 * width),
+        );
+        let code = crate::rng::mix(seed ^ k10.to_bits()) | 1;
+        if (0.0..=1.0).contains(&gu) && (0.0..=2.0).contains(&gv) && glyph(code, gu, gv) {
+            ink_cov = 1.0;
+        }
+        Some((cov, body + (ink - body) * ink_cov))
+    });
+}
+
+/// A ball at rest, shaded like the moving ball (a backlit look gives a dark silhouette), without its seam.
+fn paint_resting_ball(c: &mut Canvas, it: &Item, ball_dn: f64, light: [f64; 3], shading: Shading) {
+    let (cx, cy, r) = (it.x_px, it.y_px, it.r_px);
+    // Shaded like the moving ball (a backlit look gives a dark silhouette), without its seam.
+    let seed = cx.to_bits() ^ 0x5EED;
+    c.paint(Layer::Back, cx, cy, r, |dx, dy| {
+        let q = dx.hypot(dy);
+        let fuzz = 1.0 + 0.07 * (hash01(seed, dx.floor() as i64, dy.floor() as i64) - 0.5);
+        let val = ball_dn * sphere(dx / r, -dy / r, light, shading) * fuzz;
+        Some((ramp((r - q) / 1.3 + 0.5), val))
+    });
+}
+
+/// A thin ring, bright or dark, lit from above.
+fn paint_ring(c: &mut Canvas, it: &Item) {
+    let (cx, cy, r) = (it.x_px, it.y_px, it.r_px);
+    let t = it.width_px.max(1.5);
+    let val = if it.bright { 205.0 } else { 30.0 };
+    c.paint(Layer::Back, cx, cy, r, |dx, dy| {
+        let q = dx.hypot(dy);
+        let cov = edge(r - q) * edge(q - (r - t));
+        Some((cov, val * (1.0 - 0.15 * dy / r)))
+    });
+}
+
+/// A lamp: a bright disc with a glow that fades over a quarter of its radius.
+fn paint_lamp(c: &mut Canvas, it: &Item) {
+    let (cx, cy, r) = (it.x_px, it.y_px, it.r_px);
+    // A bright disc with a glow that fades over a quarter of its radius.
+    c.paint(Layer::Back, cx, cy, 1.6 * r, |dx, dy| {
+        let q = dx.hypot(dy);
+        let glow = (-(q - r).max(0.0) / (0.25 * r)).exp();
+        Some((edge(r - q).max(0.6 * glow), 245.0))
+    });
+}
+
+/// A dark hand-like blob reaching in from a frame edge: a palm, four fingers and a thumb.
+fn paint_hand(c: &mut Canvas, it: &Item) {
+    let (cx, cy, r) = (it.x_px, it.y_px, it.r_px);
+    let size = r / 1.3;
+    let fw = it.width_px.max(2.0);
+    let (sa, ca) = it.angle_rad.sin_cos();
+    let level = 30.0;
+    c.paint(Layer::Both, cx, cy, r, |dx, dy| {
+        // Along the fingers (into the frame) and across them, y up.
+        let along = dx * ca - dy * sa;
+        let across = dx * sa + dy * ca;
+        let palm = 1.0 - ((along / (0.55 * size)).powi(2) + (across / (0.45 * size)).powi(2)).sqrt();
+        let mut d = palm * 0.45 * size;
+        for k in 0..4 {
+            let off = (k as f64 - 1.5) * 0.24 * size;
+            let len = size * [0.7, 0.8, 0.78, 0.62][k];
+            let t = ((along - 0.35 * size) / len).clamp(0.0, 1.0) * len + 0.35 * size;
+            d = d.max(0.5 * fw - (along - t).hypot(across - off));
+        }
+        let thumb_t = (along / (0.5 * size)).clamp(0.0, 1.0) * 0.5 * size;
+        d = d.max(0.6 * fw - (along - thumb_t).hypot(across + 0.45 * size + 0.3 * along));
+        let cov = ramp(d / 2.0 + 0.5);
+        Some((cov, level + 8.0 * (along / size).clamp(-1.0, 1.0)))
+    });
 }
 
 /// Builds the static layers of a shot with a look.
 pub(crate) fn build(plan: &ShotPlan, look: &Look) -> Layers {
     let cam = &plan.camera;
     let (w, h) = (cam.width as usize, cam.height as usize);
-    let (wf, hf) = (w as f64, h as f64);
     let g = plan.geom;
-    let d = &look.draft;
-    let mut rng = Rng::new(d.seed);
-    let n = w * h;
+    let mut rng = Rng::new(look.draft.seed);
+    let vig = illumination(look, w, h);
+    let mut back = backdrop(look, g, w, h, &mut rng);
+    let surface = Band::draw(look, g, w, h, &mut rng);
+    let (mut band, front) = surface.shade(look, g, &surface.cover(g, w, h), w, h);
+    for i in 0..w * h {
+        back[i] *= vig[i];
+        band[i] *= vig[i];
+    }
+    let (light, shading) = ball_light(look);
 
-    // Illumination: vignetting × a linear gradient, applied to every light in the scene.
+    // Clutter, then glare on top.
+    let mut canvas = Canvas {
+        w,
+        h,
+        back: &mut back,
+        band: &mut band,
+        vig: &vig,
+    };
+    for it in &look.items {
+        paint_item(&mut canvas, it, g, look, light, shading);
+    }
+    for hs in &look.hot_spots {
+        canvas.glare(hs);
+    }
+    Layers {
+        back,
+        band,
+        front,
+        vig,
+        light,
+        shading,
+    }
+}
+
+/// Illumination: vignetting × a linear gradient, applied to every light in the scene.
+fn illumination(look: &Look, w: usize, h: usize) -> Vec<f32> {
+    let (wf, hf) = (w as f64, h as f64);
     let (cx, cy) = ((wf - 1.0) / 2.0, (hf - 1.0) / 2.0);
     let rmax2 = cx * cx + cy * cy;
     let rmax = rmax2.sqrt();
     let (gs, gc) = look.gradient_dir_deg.to_radians().sin_cos();
-    let mut vig = vec![0f32; n];
+    let mut vig = vec![0f32; w * h];
     for y in 0..h {
         for x in 0..w {
             let (dx, dy) = (x as f64 - cx, y as f64 - cy);
@@ -469,12 +558,17 @@ pub(crate) fn build(plan: &ShotPlan, look: &Look) -> Layers {
             vig[y * w + x] = (v * (1.0 + look.gradient * u)) as f32;
         }
     }
+    vig
+}
 
-    // Backdrop: the level just above the line, a ramp toward the top, blotches and a fine grain.
-    let blotch = ValueNoise::new(&mut rng, 16);
-    let fine = ValueNoise::new(&mut rng, 64);
+/// Backdrop before lighting: the level just above the line, a ramp toward the top, blotches and a fine grain.
+fn backdrop(look: &Look, g: Geometry, w: usize, h: usize, rng: &mut Rng) -> Vec<f32> {
+    let d = &look.draft;
+    let hf = h as f64;
+    let blotch = ValueNoise::new(rng, 16);
+    let fine = ValueNoise::new(rng, 64);
     let line_y = |x: f64| g.ty + g.sin * (x - g.tx) / (g.dir * g.cos);
-    let mut back = vec![0f32; n];
+    let mut back = vec![0f32; w * h];
     for y in 0..h {
         for x in 0..w {
             let (xf, yf) = (x as f64, y as f64);
@@ -485,127 +579,194 @@ pub(crate) fn build(plan: &ShotPlan, look: &Look) -> Layers {
             back[y * w + x] = v as f32;
         }
     }
+    back
+}
 
-    // The surface: its edge profiles over the visible width, then the layers.
-    let corners = [(0.0, 0.0), (wf - 1.0, 0.0), (0.0, hf - 1.0), (wf - 1.0, hf - 1.0)];
-    let (s_lo, s_hi) = corners
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &(x, y)| {
-            let s = g.to_local_px(x, y).0;
-            (a.min(s), b.max(s))
+/// The surface band of a shot: the edge profiles and textures of its clay and tape (each absent when the
+/// look has none) and where the tape lies.
+struct Band {
+    clay_edge: Option<EdgeProfile>,
+    tape_edge: Option<EdgeProfile>,
+    clay: Option<Clay>,
+    tape: Option<Tape>,
+    /// The surface line's extent in the frame, pixels along the surface.
+    visible: (f64, f64),
+    /// How far the tape stands above the clay's mean edge, pixels.
+    thick: f64,
+    /// Depth the tape reaches below the line, pixels (infinite when the band is all tape).
+    tape_depth: f64,
+    /// The tape's ends along the surface, pixels (infinite when the band is all tape).
+    tape_s: (f64, f64),
+}
+
+/// Per pixel, for clay (`_c`) and tape (`_t`): coverage (0–1), depth below the layer's own edge (px) and
+/// raw texture; and the pixels of each layer's top strip, over which its texture is normalised.
+struct Coverage {
+    cov_c: Vec<f32>,
+    dep_c: Vec<f32>,
+    tex_c: Vec<f32>,
+    cov_t: Vec<f32>,
+    dep_t: Vec<f32>,
+    tex_t: Vec<f32>,
+    top_c: Vec<usize>,
+    top_t: Vec<usize>,
+}
+
+impl Band {
+    /// Draws the edge profiles over the visible width, then the clay's and the tape's textures.
+    fn draw(look: &Look, g: Geometry, w: usize, h: usize, rng: &mut Rng) -> Band {
+        let d = &look.draft;
+        let (wf, hf) = (w as f64, h as f64);
+        let line_y = |x: f64| g.ty + g.sin * (x - g.tx) / (g.dir * g.cos);
+        let corners = [(0.0, 0.0), (wf - 1.0, 0.0), (0.0, hf - 1.0), (wf - 1.0, hf - 1.0)];
+        let (s_lo, s_hi) = corners
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &(x, y)| {
+                let s = g.to_local_px(x, y).0;
+                (a.min(s), b.max(s))
+            });
+        let visible = {
+            let (a, b) = (
+                g.to_local_px(0.0, line_y(0.0)).0,
+                g.to_local_px(wf - 1.0, line_y(wf - 1.0)).0,
+            );
+            (a.min(b), a.max(b))
+        };
+        let clay_edge = look.edge_roughness_px.map(|rms| {
+            let scale = look.edge_scale_px.unwrap_or(4.0);
+            EdgeProfile::new(rng, s_lo, s_hi, rms, scale, visible, true)
         });
-    let visible = {
-        let (a, b) = (
-            g.to_local_px(0.0, line_y(0.0)).0,
-            g.to_local_px(wf - 1.0, line_y(wf - 1.0)).0,
-        );
-        (a.min(b), a.max(b))
-    };
-    let clay_edge = look.edge_roughness_px.map(|rms| {
-        let scale = look.edge_scale_px.unwrap_or(4.0);
-        EdgeProfile::new(&mut rng, s_lo, s_hi, rms, scale, visible, true)
-    });
-    let tape_span = if look.surface == SurfaceLook::TapeOnClay {
-        (d.tape_s.0.max(visible.0), d.tape_s.1.min(visible.1))
-    } else {
-        visible
-    };
-    let tape_edge = look.tape_edge_roughness_px.map(|rms| {
-        let span = if tape_span.0 < tape_span.1 { tape_span } else { visible };
-        EdgeProfile::new(&mut rng, s_lo, s_hi, rms, d.tape_edge_scale_px, span, false)
-    });
-    let clay = look.grain_px.map(|grain| Clay {
-        seed: rng.next_u64(),
-        grain,
-        fore: d.foreshortening,
-        mottle: ValueNoise::new(&mut rng, 32),
-    });
-    let tape = look.weave_period_px.map(|period| Tape {
-        seed: rng.next_u64(),
-        herringbone: look.weave == Some("herringbone"),
-        period,
-        fore: d.foreshortening,
-        zig: d.zig_periods,
-        dirt: ValueNoise::new(&mut rng, 32),
-    });
-    let thick = look.tape_thickness_px.unwrap_or(0.0);
-    let band_depth = hf - g.ty;
-    let tape_depth = if look.surface == SurfaceLook::TapeOnClay {
-        d.tape_depth_frac * band_depth
-    } else {
-        f64::INFINITY
-    };
-    let (ts0, ts1) = if look.surface == SurfaceLook::TapeOnClay {
-        d.tape_s
-    } else {
-        (f64::NEG_INFINITY, f64::INFINITY)
-    };
-    // Per pixel: coverage, local depth below the layer's own edge and raw texture, for clay and tape.
-    let (mut cov_c, mut dep_c, mut tex_c) = (vec![0f32; n], vec![0f32; n], vec![0f32; n]);
-    let (mut cov_t, mut dep_t, mut tex_t) = (vec![0f32; n], vec![0f32; n], vec![0f32; n]);
-    let (mut top_c, mut top_t) = (Vec::new(), Vec::new());
-    for y in 0..h {
-        for x in 0..w {
-            let i = y * w + x;
-            let (s, up) = g.to_local_px(x as f64, y as f64);
-            let depth = -up;
-            if let (Some(cl), Some(e)) = (&clay, &clay_edge) {
-                let dl = depth - thick + e.at(s);
-                let cv = ramp(dl + 0.5);
-                if cv > 0.0 {
-                    cov_c[i] = cv as f32;
-                    dep_c[i] = dl.max(0.0) as f32;
-                    tex_c[i] = cl.raw(s, depth.max(0.0)) as f32;
-                    if cv >= 0.99 && dl < TOP_STRIP_PX && s >= visible.0 && s <= visible.1 {
-                        top_c.push(i);
-                    }
-                }
-            }
-            if let (Some(tp), Some(e)) = (&tape, &tape_edge) {
-                let dl = depth + e.at(s);
-                let side = ramp(s - ts0 + 0.5) * ramp(ts1 - s + 0.5) * ramp(tape_depth - depth + 0.5);
-                let cv = ramp(dl + 0.5) * side;
-                if cv > 0.0 {
-                    cov_t[i] = cv as f32;
-                    dep_t[i] = dl.max(0.0) as f32;
-                    tex_t[i] = tp.raw(s, depth.max(0.0)) as f32;
-                    if cv >= 0.99 && dl < TOP_STRIP_PX {
-                        top_t.push(i);
-                    }
-                }
-            }
+        let tape_on_clay = look.surface == SurfaceLook::TapeOnClay;
+        let tape_span = if tape_on_clay {
+            (d.tape_s.0.max(visible.0), d.tape_s.1.min(visible.1))
+        } else {
+            visible
+        };
+        let tape_edge = look.tape_edge_roughness_px.map(|rms| {
+            let span = if tape_span.0 < tape_span.1 { tape_span } else { visible };
+            EdgeProfile::new(rng, s_lo, s_hi, rms, d.tape_edge_scale_px, span, false)
+        });
+        let clay = look.grain_px.map(|grain| Clay {
+            seed: rng.next_u64(),
+            grain,
+            fore: d.foreshortening,
+            mottle: ValueNoise::new(rng, 32),
+        });
+        let tape = look.weave_period_px.map(|period| Tape {
+            seed: rng.next_u64(),
+            herringbone: look.weave == Some("herringbone"),
+            period,
+            fore: d.foreshortening,
+            zig: d.zig_periods,
+            dirt: ValueNoise::new(rng, 32),
+        });
+        Band {
+            clay_edge,
+            tape_edge,
+            clay,
+            tape,
+            visible,
+            thick: look.tape_thickness_px.unwrap_or(0.0),
+            tape_depth: if tape_on_clay {
+                d.tape_depth_frac * (hf - g.ty)
+            } else {
+                f64::INFINITY
+            },
+            tape_s: if tape_on_clay {
+                d.tape_s
+            } else {
+                (f64::NEG_INFINITY, f64::INFINITY)
+            },
         }
-    }
-    let (mc, sc) = stats(&tex_c, &top_c);
-    let (mt, st) = stats(&tex_t, &top_t);
-    let clay_level = look.clay_dn.unwrap_or(look.band_dn);
-    let depth_scale = 0.3 * hf;
-    let mut band = vec![0f32; n];
-    let mut front = vec![0f32; n];
-    for y in 0..h {
-        for x in 0..w {
-            let i = y * w + x;
-            let (ct, cc) = (cov_t[i] as f64, cov_c[i] as f64);
-            let f = ct + (1.0 - ct) * cc;
-            if f <= 0.0 {
-                continue;
-            }
-            let depth = -g.to_local_px(x as f64, y as f64).1;
-            let fade = d.fade_dn * (depth.max(0.0) / depth_scale).min(1.0);
-            let lip = |dl: f32| look.lip_dn * ramp(1.0 - dl as f64 / d.lip_px);
-            let vc = clay_level + look.texture_dn * (tex_c[i] as f64 - mc) / sc - fade + lip(dep_c[i]);
-            let vt = look.band_dn + look.texture_dn * (tex_t[i] as f64 - mt) / st - fade + lip(dep_t[i]);
-            front[i] = f as f32;
-            band[i] = ((ct * vt + (1.0 - ct) * cc * vc) / f) as f32;
-        }
-    }
-    for i in 0..n {
-        back[i] *= vig[i];
-        band[i] *= vig[i];
     }
 
-    // The ball's light and shading.
-    let (light, shading) = if look.ball == BallLook::Backlit {
+    /// Where the clay and the tape cover each pixel, how deep below their edges, and their raw textures.
+    fn cover(&self, g: Geometry, w: usize, h: usize) -> Coverage {
+        let n = w * h;
+        let (ts0, ts1) = self.tape_s;
+        let visible = self.visible;
+        let mut c = Coverage {
+            cov_c: vec![0f32; n],
+            dep_c: vec![0f32; n],
+            tex_c: vec![0f32; n],
+            cov_t: vec![0f32; n],
+            dep_t: vec![0f32; n],
+            tex_t: vec![0f32; n],
+            top_c: Vec::new(),
+            top_t: Vec::new(),
+        };
+        for y in 0..h {
+            for x in 0..w {
+                let i = y * w + x;
+                let (s, up) = g.to_local_px(x as f64, y as f64);
+                let depth = -up;
+                if let (Some(cl), Some(e)) = (&self.clay, &self.clay_edge) {
+                    let dl = depth - self.thick + e.at(s);
+                    let cv = ramp(dl + 0.5);
+                    if cv > 0.0 {
+                        c.cov_c[i] = cv as f32;
+                        c.dep_c[i] = dl.max(0.0) as f32;
+                        c.tex_c[i] = cl.raw(s, depth.max(0.0)) as f32;
+                        if cv >= 0.99 && dl < TOP_STRIP_PX && s >= visible.0 && s <= visible.1 {
+                            c.top_c.push(i);
+                        }
+                    }
+                }
+                if let (Some(tp), Some(e)) = (&self.tape, &self.tape_edge) {
+                    let dl = depth + e.at(s);
+                    let side = ramp(s - ts0 + 0.5) * ramp(ts1 - s + 0.5) * ramp(self.tape_depth - depth + 0.5);
+                    let cv = ramp(dl + 0.5) * side;
+                    if cv > 0.0 {
+                        c.cov_t[i] = cv as f32;
+                        c.dep_t[i] = dl.max(0.0) as f32;
+                        c.tex_t[i] = tp.raw(s, depth.max(0.0)) as f32;
+                        if cv >= 0.99 && dl < TOP_STRIP_PX {
+                            c.top_t.push(i);
+                        }
+                    }
+                }
+            }
+        }
+        c
+    }
+
+    /// The band's radiance before lighting (tape over clay, each texture normalised over its top strip to
+    /// the look's level and contrast, fading with depth, with its lip) and its coverage, per pixel.
+    fn shade(&self, look: &Look, g: Geometry, c: &Coverage, w: usize, h: usize) -> (Vec<f32>, Vec<f32>) {
+        let d = &look.draft;
+        let n = w * h;
+        let (mc, sc) = stats(&c.tex_c, &c.top_c);
+        let (mt, st) = stats(&c.tex_t, &c.top_t);
+        let clay_level = look.clay_dn.unwrap_or(look.band_dn);
+        let depth_scale = 0.3 * h as f64;
+        let mut band = vec![0f32; n];
+        let mut front = vec![0f32; n];
+        for y in 0..h {
+            for x in 0..w {
+                let i = y * w + x;
+                let (ct, cc) = (c.cov_t[i] as f64, c.cov_c[i] as f64);
+                let f = ct + (1.0 - ct) * cc;
+                if f <= 0.0 {
+                    continue;
+                }
+                let depth = -g.to_local_px(x as f64, y as f64).1;
+                let fade = d.fade_dn * (depth.max(0.0) / depth_scale).min(1.0);
+                let lip = |dl: f32| look.lip_dn * ramp(1.0 - dl as f64 / d.lip_px);
+                let vc = clay_level + look.texture_dn * (c.tex_c[i] as f64 - mc) / sc - fade + lip(c.dep_c[i]);
+                let vt = look.band_dn + look.texture_dn * (c.tex_t[i] as f64 - mt) / st - fade + lip(c.dep_t[i]);
+                front[i] = f as f32;
+                band[i] = ((ct * vt + (1.0 - ct) * cc * vc) / f) as f32;
+            }
+        }
+        (band, front)
+    }
+}
+
+/// The moving ball's light direction and shading: a backlit ball is a silhouette with a rim, a felt ball is
+/// lit from the look's azimuth and elevation.
+fn ball_light(look: &Look) -> ([f64; 3], Shading) {
+    let d = &look.draft;
+    if look.ball == BallLook::Backlit {
         (
             [0.0, 0.0, 1.0],
             Shading {
@@ -627,47 +788,6 @@ pub(crate) fn build(plan: &ShotPlan, look: &Look) -> Layers {
                 rim: d.rim,
             },
         )
-    };
-
-    // Clutter, then glare on top.
-    let mut canvas = Canvas {
-        w,
-        h,
-        back: &mut back,
-        band: &mut band,
-        vig: &vig,
-    };
-    for it in &look.items {
-        paint_item(&mut canvas, it, g, look, light, shading);
-    }
-    for hs in &look.hot_spots {
-        let reach = 3.0 * hs.sigma_px;
-        let two_s2 = 2.0 * hs.sigma_px * hs.sigma_px;
-        let (x0, x1) = (
-            (hs.x_px - reach).max(0.0) as usize,
-            (hs.x_px + reach).min(wf - 1.0).max(0.0) as usize,
-        );
-        let (y0, y1) = (
-            (hs.y_px - reach).max(0.0) as usize,
-            (hs.y_px + reach).min(hf - 1.0).max(0.0) as usize,
-        );
-        for y in y0..=y1 {
-            for x in x0..=x1 {
-                let i = y * w + x;
-                let r2 = (x as f64 - hs.x_px).powi(2) + (y as f64 - hs.y_px).powi(2);
-                let add = (hs.peak_dn * (-r2 / two_s2).exp() * vig[i] as f64) as f32;
-                back[i] += add;
-                band[i] += add;
-            }
-        }
-    }
-    Layers {
-        back,
-        band,
-        front,
-        vig,
-        light,
-        shading,
     }
 }
 

@@ -27,8 +27,9 @@ pub use look::{BallLook, HotSpot, Item, ItemKind, LOOK_COLUMNS, LOOK_FAMILIES, L
 pub use presets::{EFFECT_MAGNITUDES, EFFECT_PAIRS, preset_names, preset_toml};
 pub use progress::ProgressBarObserver;
 pub use scenario::{BallSpec, Camera, Downslope, Format, RandomPhysics, Scenario, Shot, Surface, Texture};
-pub use scene::{Frame, Pixels, ShotRenderer};
+pub use scene::{Pixels, RenderedFrame, ShotRenderer};
 pub use session::{
-    FRAME_COLUMNS, Observer, RenderOptions, Rendered, SHOTS_COLUMNS, Silent, encode, render, render_with,
+    FRAME_COLUMNS, NoRenderProgress, RenderObserver, RenderOptions, Rendered, SHOTS_COLUMNS, encode, render,
+    render_with,
 };
 pub use shot::{FrameTruth, ShotPlan, ShotTruth, Visibility};

@@ -113,6 +113,15 @@ impl SurfaceLook {
     pub fn has_tape(self) -> bool {
         self != SurfaceLook::ClaySpeckle
     }
+    /// The tape's weave, `plain` or `herringbone` (a tape on clay has either, as drawn), or none for clay.
+    fn weave(self, herringbone_on_clay: bool) -> Option<&'static str> {
+        match self {
+            SurfaceLook::ClaySpeckle => None,
+            SurfaceLook::WovenTape => Some("plain"),
+            SurfaceLook::HerringboneTape => Some("herringbone"),
+            SurfaceLook::TapeOnClay => Some(if herringbone_on_clay { "herringbone" } else { "plain" }),
+        }
+    }
 }
 
 /// How the moving ball looks.
@@ -508,6 +517,39 @@ pub(crate) struct Draft {
     pub tape_s: (f64, f64),
 }
 
+impl Draft {
+    /// Draws the painter's parameters (one draw each, in this order, whatever the look); the clutter to
+    /// place is left empty. `backlit`: the ball is a silhouette (ambient 1, a stronger rim).
+    fn draw(rng: &mut Rng, backlit: bool) -> Draft {
+        Draft {
+            seed: rng.next_u64(),
+            foreshortening: rng.range(1.2, 2.5),
+            fade_dn: rng.range(0.0, 25.0),
+            lip_px: rng.range(1.0, 3.0),
+            backdrop_ramp_dn: rng.range(-25.0, 25.0),
+            blotch_dn: rng.range(1.0, 6.0),
+            backdrop_grain_dn: rng.range(0.0, 2.5),
+            line_frac: rng.range(0.62, 0.85),
+            ambient: if backlit {
+                rng.uniform();
+                1.0
+            } else {
+                rng.range(0.25, 0.45)
+            },
+            rim: if backlit {
+                rng.range(0.2, 1.0)
+            } else {
+                rng.range(0.1, 0.35)
+            },
+            tape_edge_scale_px: rng.range(2.0, 8.0),
+            zig_periods: rng.range(2.5, 4.0),
+            tape_depth_frac: rng.range(0.3, 1.0),
+            tape_margins: (rng.range(0.4, 3.0), rng.range(0.4, 3.0)),
+            ..Draft::default()
+        }
+    }
+}
+
 fn pick<T: Copy>(rng: &mut Rng, v: &[T]) -> T {
     v[((rng.uniform() * v.len() as f64) as usize).min(v.len() - 1)]
 }
@@ -632,11 +674,8 @@ impl LookSpec {
         Ok(())
     }
 
-    /// Draws a shot's look (everything but the placement of clutter, which [`Look::place`] does once the
-    /// path is known) for a surface of texture `texture`.
-    pub(crate) fn draw(&self, rng: &mut Rng, texture: Texture) -> Look {
-        // Every value is drawn whether or not the chosen families use it, so a change of one list does not
-        // shift the others' draws.
+    /// The ball's look and the backdrop level that goes with it (both levels drawn, the ball's kept).
+    fn draw_ball_and_backdrop(&self, rng: &mut Rng) -> (BallLook, f64) {
         let ball = pick(rng, &self.balls);
         let normal_backdrop = self.backdrop_dn.draw(rng);
         let backlit_backdrop = self.backlit_backdrop_dn.draw(rng);
@@ -645,14 +684,25 @@ impl LookSpec {
         } else {
             normal_backdrop
         };
-        let surface = pick(
-            rng,
-            if texture == Texture::Clay {
-                &self.clay_looks
-            } else {
-                &self.tape_looks
-            },
-        );
+        (ball, backdrop_dn)
+    }
+
+    /// The looks a surface of texture `texture` may take.
+    fn surface_looks(&self, texture: Texture) -> &[SurfaceLook] {
+        if texture == Texture::Clay {
+            &self.clay_looks
+        } else {
+            &self.tape_looks
+        }
+    }
+
+    /// Draws a shot's look (everything but the placement of clutter, which [`Look::place`] does once the
+    /// path is known) for a surface of texture `texture`.
+    pub(crate) fn draw(&self, rng: &mut Rng, texture: Texture) -> Look {
+        // Every value is drawn whether or not the chosen families use it, so a change of one list does not
+        // shift the others' draws.
+        let (ball, backdrop_dn) = self.draw_ball_and_backdrop(rng);
+        let surface = pick(rng, self.surface_looks(texture));
         let band_offset = draw_offset(rng, self.band_offset_dn, backdrop_dn);
         let clay_offset = draw_offset(rng, self.band_offset_dn, backdrop_dn);
         let texture_dn = self.texture_dn.draw(rng);
@@ -687,29 +737,6 @@ impl LookSpec {
         let width_px = self.width_px.draw_whole(rng);
         let height_px = self.height_px.draw_whole(rng);
         let draft = Draft {
-            seed: rng.next_u64(),
-            foreshortening: rng.range(1.2, 2.5),
-            fade_dn: rng.range(0.0, 25.0),
-            lip_px: rng.range(1.0, 3.0),
-            backdrop_ramp_dn: rng.range(-25.0, 25.0),
-            blotch_dn: rng.range(1.0, 6.0),
-            backdrop_grain_dn: rng.range(0.0, 2.5),
-            line_frac: rng.range(0.62, 0.85),
-            ambient: if ball == BallLook::Backlit {
-                rng.uniform();
-                1.0
-            } else {
-                rng.range(0.25, 0.45)
-            },
-            rim: if ball == BallLook::Backlit {
-                rng.range(0.2, 1.0)
-            } else {
-                rng.range(0.1, 0.35)
-            },
-            tape_edge_scale_px: rng.range(2.0, 8.0),
-            zig_periods: rng.range(2.5, 4.0),
-            tape_depth_frac: rng.range(0.3, 1.0),
-            tape_margins: (rng.range(0.4, 3.0), rng.range(0.4, 3.0)),
             hot_spots,
             ruler,
             fixtures,
@@ -717,7 +744,7 @@ impl LookSpec {
             screw_radius: self.screw_radius_px,
             second_circle,
             hand,
-            tape_s: (0.0, 0.0),
+            ..Draft::draw(rng, ball == BallLook::Backlit)
         };
         let clay = surface.has_clay();
         let tape = surface.has_tape();
@@ -733,12 +760,7 @@ impl LookSpec {
             grain_px: clay.then_some(grain),
             tape_edge_roughness_px: tape.then_some(tape_edge),
             weave_period_px: tape.then_some(weave),
-            weave: match surface {
-                SurfaceLook::ClaySpeckle => None,
-                SurfaceLook::WovenTape => Some("plain"),
-                SurfaceLook::HerringboneTape => Some("herringbone"),
-                SurfaceLook::TapeOnClay => Some(if herringbone_on_clay { "herringbone" } else { "plain" }),
-            },
+            weave: surface.weave(herringbone_on_clay),
             tape_thickness_px: (surface == SurfaceLook::TapeOnClay).then_some(thickness),
             tape_span_px: None,
             gradient,
@@ -757,13 +779,7 @@ impl LookSpec {
             read_noise_dn,
             bit_depth,
             format,
-            naming: format!(
-                "{stem}{}",
-                match format {
-                    Format::Png => ".png",
-                    Format::Tiff => ".tif",
-                }
-            ),
+            naming: format!("{stem}{}", format.extension()),
             downslope,
             roll_deg,
             ball_radius_px,
@@ -869,207 +885,248 @@ impl Look {
     /// Places the hot spots, the tape strip (tape on clay) and the clutter once the camera is placed; what
     /// finds no room is left out, so `items` lists what the frames show.
     pub(crate) fn place(&mut self, rng: &mut Rng, p: &Placement) {
-        let (w, h) = (p.width, p.height);
-        let r = p.r_px;
         let d = self.draft.clone();
         for _ in 0..d.hot_spots {
             self.hot_spots.push(HotSpot {
-                x_px: rng.range(0.0, w),
-                y_px: rng.range(0.0, h),
+                x_px: rng.range(0.0, p.width),
+                y_px: rng.range(0.0, p.height),
                 sigma_px: rng.range(3.0, 25.0),
                 peak_dn: rng.range(30.0, 120.0),
             });
         }
         if self.surface == SurfaceLook::TapeOnClay {
-            let s: Vec<f64> = p.contact.iter().map(|&(x, y)| p.geom.to_local_px(x, y).0).collect();
-            let (smin, smax) = s
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
-            let (s0, s1) = (smin - d.tape_margins.0 * r, smax + d.tape_margins.1 * r);
-            self.draft.tape_s = (s0, s1);
-            let (x0, _) = p.geom.local_px_to_image(s0, 0.0);
-            let (x1, _) = p.geom.local_px_to_image(s1, 0.0);
-            self.tape_span_px = Some((x0.min(x1), x0.max(x1)));
+            self.place_tape(p, d.tape_margins);
         }
         let mut items: Vec<Item> = Vec::new();
-        let free = |items: &[Item], x: f64, y: f64, rr: f64| {
-            items
-                .iter()
-                .filter(|i| i.kind != ItemKind::Ruler)
-                .all(|i| (i.x_px - x).hypot(i.y_px - y) > i.r_px + rr + 3.0)
-        };
         if d.ruler {
-            let width = (0.4 * r).clamp(8.0, 40.0);
-            let horizontal = rng.uniform() < 0.6;
-            let tilt = rng.range(-2.0, 2.0).to_radians();
-            let bright = rng.uniform() < 0.7;
-            let tick = rng.range(3.0, 10.0);
-            let (x, y, half, angle) = if horizontal {
-                let top = 0.06 * h + width;
-                let bottom = (p.line_y(w / 2.0) - width - 10.0).max(top);
-                (
-                    rng.range(0.3 * w, 0.7 * w),
-                    rng.range(top, bottom),
-                    rng.range(0.4 * w, 0.7 * w),
-                    tilt,
-                )
-            } else {
-                // Standing on the surface near a side edge.
-                let x = if rng.uniform() < 0.5 {
-                    rng.range(0.03, 0.12) * w
-                } else {
-                    rng.range(0.88, 0.97) * w
-                };
-                let bottom = p.line_y(x) + 2.0;
-                let top = rng.range(-0.1, 0.3) * h;
-                (
-                    x,
-                    0.5 * (top + bottom),
-                    0.5 * (bottom - top),
-                    std::f64::consts::FRAC_PI_2 + tilt,
-                )
-            };
-            items.push(Item {
-                kind: ItemKind::Ruler,
-                x_px: x,
-                y_px: y,
-                r_px: half.max(width),
-                bright,
-                angle_rad: angle,
-                width_px: width,
-                spacing_px: tick,
-            });
+            items.push(p.ruler(rng));
         }
         for _ in 0..d.fixtures {
-            let rf = (rng.range(0.4, 1.3) * r).max(8.0);
-            let bevel = rng.range(0.05, 0.12) * rf;
-            let ring_gap = rng.range(0.08, 0.2) * rf;
-            for _ in 0..30 {
-                let (x, y) = if rng.uniform() < 0.5 {
-                    (
-                        rng.range(rf + 2.0, (w - rf - 3.0).max(rf + 2.0)),
-                        rng.range(rf + 2.0, (p.line_y(w / 2.0) - rf).max(rf + 2.0)),
-                    )
-                } else {
-                    // Centred just outside an edge or a corner, partly in view.
-                    let out = rng.range(0.2, 0.6) * rf;
-                    match (rng.uniform() * 4.0) as u32 {
-                        0 => (-out, rng.range(0.0, p.line_y(0.0))),
-                        1 => (w - 1.0 + out, rng.range(0.0, p.line_y(w - 1.0))),
-                        2 => (rng.range(0.0, w), -out),
-                        _ => (if rng.uniform() < 0.5 { -out } else { w - 1.0 + out }, -out),
-                    }
-                };
-                if p.clear_of_path(x, y, rf) && free(&items, x, y, rf) {
-                    items.push(Item {
-                        kind: ItemKind::Fixture,
-                        x_px: x,
-                        y_px: y,
-                        r_px: rf,
-                        bright: false,
-                        angle_rad: 0.0,
-                        width_px: bevel,
-                        spacing_px: ring_gap,
-                    });
-                    break;
-                }
-            }
+            items.extend(p.fixture(rng, &items));
         }
         for _ in 0..d.screws {
-            let rs = d.screw_radius.draw(rng);
-            let bright = rng.uniform() < 0.6;
-            let slot = rng.range(0.0, std::f64::consts::PI);
-            for _ in 0..30 {
-                let x = rng.range(rs + 2.0, (w - rs - 3.0).max(rs + 2.0));
-                let ly = p.line_y(x);
-                let mode = rng.uniform();
-                let y = if mode < 0.5 {
-                    ly - 0.35 * rs
-                } else if mode < 0.8 {
-                    rng.range(rs + 2.0, (ly - rs - 2.0).max(rs + 2.0))
-                } else {
-                    rng.range(ly + rs + 3.0, (h - rs - 3.0).max(ly + rs + 3.0))
-                };
-                if p.inside(x, y, rs) && p.clear_of_path(x, y, rs) && free(&items, x, y, rs) {
-                    items.push(Item {
-                        kind: ItemKind::Screw,
-                        x_px: x,
-                        y_px: y,
-                        r_px: rs,
-                        bright,
-                        angle_rad: slot,
-                        width_px: 0.0,
-                        spacing_px: 0.0,
-                    });
-                    break;
-                }
-            }
+            items.extend(p.screw(rng, &items, d.screw_radius));
         }
         if d.second_circle {
-            let first = (rng.uniform() * 3.0) as u32;
-            'kinds: for k in 0..3 {
-                let kind = [ItemKind::RestingBall, ItemKind::Ring, ItemKind::Lamp][((first + k) % 3) as usize];
-                let rr = r * rng.range(0.85, 1.15);
-                let thick = rng.range(3.0, 8.0).min(0.4 * rr);
-                let bright = rng.uniform() < 0.6;
-                for _ in 0..40 {
-                    let x = rng.range(rr + 2.0, (w - rr - 3.0).max(rr + 2.0));
-                    let ly = p.line_y(x);
-                    let y = if kind == ItemKind::RestingBall {
-                        ly - rr
-                    } else {
-                        rng.range(rr + 2.0, (ly - rr - 3.0).max(rr + 2.0))
-                    };
-                    if p.inside(x, y, rr) && p.clear_of_path(x, y, rr) && free(&items, x, y, rr) {
-                        items.push(Item {
-                            kind,
-                            x_px: x,
-                            y_px: y,
-                            r_px: rr,
-                            bright,
-                            angle_rad: rng.range(0.0, std::f64::consts::TAU),
-                            width_px: thick,
-                            spacing_px: 0.0,
-                        });
-                        break 'kinds;
-                    }
-                }
-            }
+            items.extend(p.second_circle(rng, &items));
         }
         if d.hand {
-            let size = (1.2 * r).clamp(30.0, 0.35 * w.min(h));
-            for _ in 0..12 {
-                let side = (rng.uniform() * 3.0) as u32;
-                let (x, y, angle) = match side {
-                    0 => (-0.25 * size, rng.range(0.15 * h, 0.85 * h), 0.0),
-                    1 => (
-                        w - 1.0 + 0.25 * size,
-                        rng.range(0.15 * h, 0.85 * h),
-                        std::f64::consts::PI,
-                    ),
-                    _ => (
-                        rng.range(0.15 * w, 0.85 * w),
-                        -0.25 * size,
-                        -std::f64::consts::FRAC_PI_2,
-                    ),
+            items.extend(p.hand(rng, &items));
+        }
+        self.items = items;
+    }
+
+    /// The tape strip on the clay: from `margins` ball radii (left, right) beyond the contact.
+    fn place_tape(&mut self, p: &Placement, margins: (f64, f64)) {
+        let r = p.r_px;
+        let s: Vec<f64> = p.contact.iter().map(|&(x, y)| p.geom.to_local_px(x, y).0).collect();
+        let (smin, smax) = s
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+        let (s0, s1) = (smin - margins.0 * r, smax + margins.1 * r);
+        self.draft.tape_s = (s0, s1);
+        let (x0, _) = p.geom.local_px_to_image(s0, 0.0);
+        let (x1, _) = p.geom.local_px_to_image(s1, 0.0);
+        self.tape_span_px = Some((x0.min(x1), x0.max(x1)));
+    }
+}
+
+/// True if a disc of radius `rr` at (x, y) keeps 3 px clear of every placed item but rulers (which hang
+/// behind).
+fn free(items: &[Item], x: f64, y: f64, rr: f64) -> bool {
+    items
+        .iter()
+        .filter(|i| i.kind != ItemKind::Ruler)
+        .all(|i| (i.x_px - x).hypot(i.y_px - y) > i.r_px + rr + 3.0)
+}
+
+impl Placement<'_> {
+    /// A ruler: horizontal above the surface (60 %) or standing on it near a side edge.
+    fn ruler(&self, rng: &mut Rng) -> Item {
+        let (w, h) = (self.width, self.height);
+        let width = (0.4 * self.r_px).clamp(8.0, 40.0);
+        let horizontal = rng.uniform() < 0.6;
+        let tilt = rng.range(-2.0, 2.0).to_radians();
+        let bright = rng.uniform() < 0.7;
+        let tick = rng.range(3.0, 10.0);
+        let (x, y, half, angle) = if horizontal {
+            let top = 0.06 * h + width;
+            let bottom = (self.line_y(w / 2.0) - width - 10.0).max(top);
+            (
+                rng.range(0.3 * w, 0.7 * w),
+                rng.range(top, bottom),
+                rng.range(0.4 * w, 0.7 * w),
+                tilt,
+            )
+        } else {
+            // Standing on the surface near a side edge.
+            let x = if rng.uniform() < 0.5 {
+                rng.range(0.03, 0.12) * w
+            } else {
+                rng.range(0.88, 0.97) * w
+            };
+            let bottom = self.line_y(x) + 2.0;
+            let top = rng.range(-0.1, 0.3) * h;
+            (
+                x,
+                0.5 * (top + bottom),
+                0.5 * (bottom - top),
+                std::f64::consts::FRAC_PI_2 + tilt,
+            )
+        };
+        Item {
+            kind: ItemKind::Ruler,
+            x_px: x,
+            y_px: y,
+            r_px: half.max(width),
+            bright,
+            angle_rad: angle,
+            width_px: width,
+            spacing_px: tick,
+        }
+    }
+
+    /// A round fixture above the surface or centred just outside an edge or corner (30 tries).
+    fn fixture(&self, rng: &mut Rng, items: &[Item]) -> Option<Item> {
+        let (w, r) = (self.width, self.r_px);
+        let rf = (rng.range(0.4, 1.3) * r).max(8.0);
+        let bevel = rng.range(0.05, 0.12) * rf;
+        let ring_gap = rng.range(0.08, 0.2) * rf;
+        for _ in 0..30 {
+            let (x, y) = if rng.uniform() < 0.5 {
+                (
+                    rng.range(rf + 2.0, (w - rf - 3.0).max(rf + 2.0)),
+                    rng.range(rf + 2.0, (self.line_y(w / 2.0) - rf).max(rf + 2.0)),
+                )
+            } else {
+                // Centred just outside an edge or a corner, partly in view.
+                let out = rng.range(0.2, 0.6) * rf;
+                match (rng.uniform() * 4.0) as u32 {
+                    0 => (-out, rng.range(0.0, self.line_y(0.0))),
+                    1 => (w - 1.0 + out, rng.range(0.0, self.line_y(w - 1.0))),
+                    2 => (rng.range(0.0, w), -out),
+                    _ => (if rng.uniform() < 0.5 { -out } else { w - 1.0 + out }, -out),
+                }
+            };
+            if self.clear_of_path(x, y, rf) && free(items, x, y, rf) {
+                return Some(Item {
+                    kind: ItemKind::Fixture,
+                    x_px: x,
+                    y_px: y,
+                    r_px: rf,
+                    bright: false,
+                    angle_rad: 0.0,
+                    width_px: bevel,
+                    spacing_px: ring_gap,
+                });
+            }
+        }
+        None
+    }
+
+    /// A screw head of a radius drawn from `radius`: on the line (half the tries), above it or in the band
+    /// (30 tries).
+    fn screw(&self, rng: &mut Rng, items: &[Item], radius: Range) -> Option<Item> {
+        let (w, h) = (self.width, self.height);
+        let rs = radius.draw(rng);
+        let bright = rng.uniform() < 0.6;
+        let slot = rng.range(0.0, std::f64::consts::PI);
+        for _ in 0..30 {
+            let x = rng.range(rs + 2.0, (w - rs - 3.0).max(rs + 2.0));
+            let ly = self.line_y(x);
+            let mode = rng.uniform();
+            let y = if mode < 0.5 {
+                ly - 0.35 * rs
+            } else if mode < 0.8 {
+                rng.range(rs + 2.0, (ly - rs - 2.0).max(rs + 2.0))
+            } else {
+                rng.range(ly + rs + 3.0, (h - rs - 3.0).max(ly + rs + 3.0))
+            };
+            if self.inside(x, y, rs) && self.clear_of_path(x, y, rs) && free(items, x, y, rs) {
+                return Some(Item {
+                    kind: ItemKind::Screw,
+                    x_px: x,
+                    y_px: y,
+                    r_px: rs,
+                    bright,
+                    angle_rad: slot,
+                    width_px: 0.0,
+                    spacing_px: 0.0,
+                });
+            }
+        }
+        None
+    }
+
+    /// A second ball-sized circle: a resting ball on the line, a ring or a lamp above it, the kinds tried in
+    /// turn from a random one (40 tries each).
+    fn second_circle(&self, rng: &mut Rng, items: &[Item]) -> Option<Item> {
+        let (w, r) = (self.width, self.r_px);
+        let first = (rng.uniform() * 3.0) as u32;
+        for k in 0..3 {
+            let kind = [ItemKind::RestingBall, ItemKind::Ring, ItemKind::Lamp][((first + k) % 3) as usize];
+            let rr = r * rng.range(0.85, 1.15);
+            let thick = rng.range(3.0, 8.0).min(0.4 * rr);
+            let bright = rng.uniform() < 0.6;
+            for _ in 0..40 {
+                let x = rng.range(rr + 2.0, (w - rr - 3.0).max(rr + 2.0));
+                let ly = self.line_y(x);
+                let y = if kind == ItemKind::RestingBall {
+                    ly - rr
+                } else {
+                    rng.range(rr + 2.0, (ly - rr - 3.0).max(rr + 2.0))
                 };
-                let angle = angle + rng.range(-0.4, 0.4);
-                if p.clear_of_path(x, y, 1.3 * size) && free(&items, x, y, 1.3 * size) {
-                    items.push(Item {
-                        kind: ItemKind::Hand,
+                if self.inside(x, y, rr) && self.clear_of_path(x, y, rr) && free(items, x, y, rr) {
+                    return Some(Item {
+                        kind,
                         x_px: x,
                         y_px: y,
-                        r_px: 1.3 * size,
-                        bright: false,
-                        angle_rad: angle,
-                        width_px: rng.range(0.14, 0.2) * size,
+                        r_px: rr,
+                        bright,
+                        angle_rad: rng.range(0.0, std::f64::consts::TAU),
+                        width_px: thick,
                         spacing_px: 0.0,
                     });
-                    break;
                 }
             }
         }
-        self.items = items;
+        None
+    }
+
+    /// A hand reaching in from the left, right or top edge (12 tries).
+    fn hand(&self, rng: &mut Rng, items: &[Item]) -> Option<Item> {
+        let (w, h) = (self.width, self.height);
+        let size = (1.2 * self.r_px).clamp(30.0, 0.35 * w.min(h));
+        for _ in 0..12 {
+            let side = (rng.uniform() * 3.0) as u32;
+            let (x, y, angle) = match side {
+                0 => (-0.25 * size, rng.range(0.15 * h, 0.85 * h), 0.0),
+                1 => (
+                    w - 1.0 + 0.25 * size,
+                    rng.range(0.15 * h, 0.85 * h),
+                    std::f64::consts::PI,
+                ),
+                _ => (
+                    rng.range(0.15 * w, 0.85 * w),
+                    -0.25 * size,
+                    -std::f64::consts::FRAC_PI_2,
+                ),
+            };
+            let angle = angle + rng.range(-0.4, 0.4);
+            if self.clear_of_path(x, y, 1.3 * size) && free(items, x, y, 1.3 * size) {
+                return Some(Item {
+                    kind: ItemKind::Hand,
+                    x_px: x,
+                    y_px: y,
+                    r_px: 1.3 * size,
+                    bright: false,
+                    angle_rad: angle,
+                    width_px: rng.range(0.14, 0.2) * size,
+                    spacing_px: 0.0,
+                });
+            }
+        }
+        None
     }
 }
 

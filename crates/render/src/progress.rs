@@ -1,6 +1,6 @@
-//! A terminal progress bar (indicatif) as an [`Observer`], hidden when stderr is not a terminal.
+//! A terminal progress bar (indicatif) as a [`RenderObserver`], hidden when stderr is not a terminal.
 
-use crate::Observer;
+use crate::RenderObserver;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 
@@ -41,7 +41,7 @@ impl Default for ProgressBarObserver {
     }
 }
 
-impl Observer for ProgressBarObserver {
+impl RenderObserver for ProgressBarObserver {
     fn planned(&self, _shots: usize, frames: usize) {
         self.bar.set_length(frames as u64);
     }

@@ -42,6 +42,16 @@ pub enum Format {
     Tiff,
 }
 
+impl Format {
+    /// The extension of its frame files, with the dot (`.png`, `.tif`).
+    pub(crate) fn extension(self) -> &'static str {
+        match self {
+            Format::Png => ".png",
+            Format::Tiff => ".tif",
+        }
+    }
+}
+
 /// Which image direction is down the slope (`docs/session.md`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
 pub enum Downslope {
@@ -398,273 +408,17 @@ impl Scenario {
 
     /// Parses scenario text; `origin` names it in errors.
     pub fn parse(text: &str, origin: &str) -> Result<Scenario, RenderError> {
-        let syntax = |message: String| RenderError::Syntax {
-            origin: origin.to_string(),
-            message,
-        };
-        let raw: Raw = toml::from_str(text).map_err(|e| syntax(e.to_string().trim_end().replace('\n', " ")))?;
-        let invalid = |field: &str, value: String, reason: &str| RenderError::InvalidValue {
-            origin: origin.to_string(),
-            field: field.to_string(),
-            value,
-            reason: reason.to_string(),
-        };
-        let c = &raw.camera;
-        let check = |field: &str, v: f64, ok: bool, reason: &str| {
-            if ok && v.is_finite() {
-                Ok(())
-            } else {
-                Err(invalid(field, v.to_string(), reason))
-            }
-        };
-        if !(16..=8192).contains(&c.width) {
-            return Err(invalid(
-                "camera.width",
-                c.width.to_string(),
-                "must be 16 to 8192 pixels",
-            ));
-        }
-        if !(16..=8192).contains(&c.height) {
-            return Err(invalid(
-                "camera.height",
-                c.height.to_string(),
-                "must be 16 to 8192 pixels",
-            ));
-        }
-        check(
-            "camera.scale_m_per_px",
-            c.scale_m_per_px,
-            c.scale_m_per_px > 0.0,
-            "must be > 0",
-        )?;
-        check(
-            "camera.fps",
-            c.fps,
-            c.fps > 0.0 && c.fps <= 1e7,
-            "must be > 0 (and ≤ 1e7)",
-        )?;
-        check(
-            "camera.exposure_s",
-            c.exposure_s,
-            c.exposure_s > 0.0 && c.exposure_s <= 1.0 / c.fps,
-            "must be > 0 and at most one frame period (1/fps)",
-        )?;
-        check("camera.read_noise", c.read_noise, c.read_noise >= 0.0, "must be ≥ 0 DN")?;
-        check(
-            "camera.shot_noise_gain",
-            c.shot_noise_gain,
-            c.shot_noise_gain >= 0.0,
-            "must be ≥ 0 DN per electron",
-        )?;
-        check(
-            "camera.flicker_amplitude",
-            c.flicker_amplitude,
-            (0.0..0.5).contains(&c.flicker_amplitude),
-            "must be in [0, 0.5)",
-        )?;
-        check("camera.flicker_hz", c.flicker_hz, c.flicker_hz >= 0.0, "must be ≥ 0 Hz")?;
-        check(
-            "camera.roll_deg",
-            c.roll_deg,
-            c.roll_deg.abs() <= 45.0,
-            "must be within ±45°",
-        )?;
-        check(
-            "camera.vignetting",
-            c.vignetting,
-            (0.0..=0.9).contains(&c.vignetting),
-            "must be in [0, 0.9]",
-        )?;
-        check(
-            "camera.fixed_pattern_noise",
-            c.fixed_pattern_noise,
-            (0.0..=20.0).contains(&c.fixed_pattern_noise),
-            "must be 0 to 20 DN",
-        )?;
-        check(
-            "camera.hot_pixel_fraction",
-            c.hot_pixel_fraction,
-            (0.0..=0.01).contains(&c.hot_pixel_fraction),
-            "must be 0 to 0.01",
-        )?;
-        if ![8, 12, 16].contains(&c.bit_depth) {
-            return Err(invalid(
-                "camera.bit_depth",
-                c.bit_depth.to_string(),
-                "must be 8, 12 (12-bit data in 16-bit files) or 16",
-            ));
-        }
-        if !(1..=64).contains(&c.blur_samples) {
-            return Err(invalid(
-                "camera.blur_samples",
-                c.blur_samples.to_string(),
-                "must be 1 to 64",
-            ));
-        }
-        let pattern = c.naming_pattern();
-        let (_, _, suffix) =
-            parse_naming(&pattern).map_err(|r| invalid("camera.naming", format!("{pattern:?}"), &r))?;
-        let lower = suffix.to_ascii_lowercase();
-        let ext_ok = match c.format {
-            Format::Png => lower.ends_with(".png"),
-            Format::Tiff => lower.ends_with(".tif") || lower.ends_with(".tiff"),
-        };
-        if !ext_ok {
-            return Err(invalid(
-                "camera.naming",
-                format!("{pattern:?}"),
-                "its extension must match camera.format (.png, or .tif/.tiff)",
-            ));
-        }
-        let b = &raw.ball;
-        check(
-            "ball.diameter_m",
-            b.diameter_m,
-            b.diameter_m > 0.0 && b.diameter_m < 10.0,
-            "must be > 0 m",
-        )?;
-        check("ball.mass_kg", b.mass_kg, b.mass_kg > 0.0, "must be > 0 kg")?;
-        check(
-            "ball.inertia_factor",
-            b.inertia_factor,
-            b.inertia_factor > 0.0,
-            "must be > 0",
-        )?;
-        check(
-            "pre_contact_ms",
-            raw.pre_contact_ms,
-            (0.0..=2000.0).contains(&raw.pre_contact_ms),
-            "must be 0 to 2000 ms",
-        )?;
-        check(
-            "post_separation_ms",
-            raw.post_separation_ms,
-            (0.0..=2000.0).contains(&raw.post_separation_ms),
-            "must be 0 to 2000 ms",
-        )?;
-
-        // Surfaces: a texture plus per-surface model values.
-        let mut surfaces = Vec::new();
-        for (name, body) in &raw.surfaces {
-            let field = format!("surfaces.{name}");
-            let t = body
-                .as_table()
-                .ok_or_else(|| syntax(format!("{field} must be a table")))?;
-            let tex = t
-                .get("texture")
-                .ok_or_else(|| syntax(format!("{field}: missing `texture` (clay, white_tape or green_tape)")))?;
-            let texture: Texture = tex.clone().try_into().map_err(|_| {
-                invalid(
-                    &format!("{field}.texture"),
-                    tex.to_string(),
-                    "expected \"clay\", \"white_tape\" or \"green_tape\"",
-                )
-            })?;
-            let mut model_values = t.clone();
-            model_values.remove("texture");
-            if name.is_empty() || name.contains([',', '"', '/', '\\', '\n']) {
-                return Err(invalid(
-                    &field,
-                    format!("{name:?}"),
-                    "a surface name must be non-empty, without , \" / \\",
-                ));
-            }
-            surfaces.push(Surface {
-                name: name.clone(),
-                texture,
-                model_values,
-            });
-        }
-        if surfaces.is_empty() {
-            return Err(syntax(
-                "no surfaces: add at least one [surfaces.NAME] with a texture".into(),
-            ));
-        }
-        let surface_names = || surfaces.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", ");
-
-        // Shots: the list, then the grid.
+        let at = Origin(origin);
+        let raw: Raw = toml::from_str(text).map_err(|e| at.syntax(e.to_string().trim_end().replace('\n', " ")))?;
+        check_camera(&raw.camera, &at)?;
+        check_ball_and_timing(&raw, &at)?;
+        let surfaces = read_surfaces(&raw.surfaces, &at)?;
         let mut shots = raw.shots;
         if let Some(g) = &raw.grid {
-            for s in &g.surfaces {
-                if !surfaces.iter().any(|x| &x.name == s) {
-                    return Err(RenderError::UnknownSurface {
-                        origin: origin.to_string(),
-                        field: "grid.surfaces".into(),
-                        surface: s.clone(),
-                        known: surface_names(),
-                    });
-                }
-            }
-            if g.repeats == 0 {
-                return Err(invalid("grid.repeats", "0".into(), "must be ≥ 1"));
-            }
-            for s in &g.surfaces {
-                for &a in &g.angles_deg {
-                    for &h in &g.drop_heights_m {
-                        for r in 1..=g.repeats {
-                            shots.push(Shot {
-                                surface: s.clone(),
-                                angle_deg: a,
-                                drop_height_m: h,
-                                repeat: r,
-                                effects: g.effects.clone(),
-                            });
-                        }
-                    }
-                }
-            }
+            expand_grid(g, &surfaces, &mut shots, &at)?;
         }
-        if shots.is_empty() {
-            return Err(syntax("no shots: add [[shots]] or a [grid]".into()));
-        }
-        for (i, s) in shots.iter().enumerate() {
-            let f = |k: &str| format!("shots[{i}].{k}");
-            if !surfaces.iter().any(|x| x.name == s.surface) {
-                return Err(RenderError::UnknownSurface {
-                    origin: origin.to_string(),
-                    field: f("surface"),
-                    surface: s.surface.clone(),
-                    known: surface_names(),
-                });
-            }
-            check(
-                &f("angle_deg"),
-                s.angle_deg,
-                s.angle_deg.abs() <= 60.0,
-                "must be within ±60°",
-            )?;
-            check(
-                &f("drop_height_m"),
-                s.drop_height_m,
-                s.drop_height_m > 0.0 && s.drop_height_m <= 10.0,
-                "must be > 0 and ≤ 10 m",
-            )?;
-            if s.repeat == 0 {
-                return Err(invalid(&f("repeat"), "0".into(), "must be ≥ 1"));
-            }
-            for e in &s.effects {
-                if !raw.extra_effects.contains_key(e) {
-                    return Err(RenderError::UnknownEffect {
-                        origin: origin.to_string(),
-                        field: f("effects"),
-                        effect: e.clone(),
-                        known: if raw.extra_effects.is_empty() {
-                            "none".into()
-                        } else {
-                            raw.extra_effects.keys().cloned().collect::<Vec<_>>().join(", ")
-                        },
-                    });
-                }
-            }
-        }
-        let model = raw.model.unwrap_or_else(default_model);
-        for key in ["ball", "surfaces"] {
-            if model.contains_key(key) {
-                return Err(syntax(format!(
-                    "model.{key}: the ball comes from [ball] and per-surface values go under [surfaces.NAME]"
-                )));
-            }
-        }
+        check_shots(&shots, &surfaces, &raw.extra_effects, &at)?;
+        let model = model_table(raw.model, &at)?;
         let scenario = Scenario {
             origin: origin.to_string(),
             source: text.to_string(),
@@ -685,39 +439,48 @@ impl Scenario {
         if let Some(l) = &scenario.look {
             l.check(origin)?;
         }
-        // Surface values may only name effects of the model or of [extra_effects].
-        let model_effects = scenario.model.get("effects").and_then(Value::as_table);
-        for s in &scenario.surfaces {
+        scenario.check_surface_values()?;
+        scenario.check_effect_sets()?;
+        if let Some(rp) = scenario.random_physics {
+            scenario.check_random_physics(&rp)?;
+        }
+        Ok(scenario)
+    }
+
+    /// Surface values may only name effects of the model or of `[extra_effects]`.
+    fn check_surface_values(&self) -> Result<(), RenderError> {
+        let model_effects = self.model.get("effects").and_then(Value::as_table);
+        for s in &self.surfaces {
             for key in s.model_values.keys() {
-                let known =
-                    model_effects.is_some_and(|m| m.contains_key(key)) || scenario.extra_effects.contains_key(key);
+                let known = model_effects.is_some_and(|m| m.contains_key(key)) || self.extra_effects.contains_key(key);
                 if !known {
-                    return Err(syntax(format!(
+                    return Err(Origin(&self.origin).syntax(format!(
                         "surfaces.{}.{key}: no effect `{key}` in [model.effects] or [extra_effects] (write e.g. spring.k = 25650)",
                         s.name
                     )));
                 }
             }
         }
-        // Check every effect set the shots use, for every surface they use it on.
+        Ok(())
+    }
+
+    /// Builds the model of every effect set the shots use, for every surface they use it on.
+    fn check_effect_sets(&self) -> Result<(), RenderError> {
         let mut seen: Vec<(Vec<String>, String)> = Vec::new();
-        for s in &scenario.shots {
+        for s in &self.shots {
             let key = (s.effects.clone(), s.surface.clone());
             if seen.contains(&key) {
                 continue;
             }
-            let spec = scenario.model_spec(&s.effects)?;
+            let spec = self.model_spec(&s.effects)?;
             spec.build(Some(&s.surface)).map_err(|source| RenderError::Model {
-                origin: origin.to_string(),
+                origin: self.origin.clone(),
                 context: format!("surface `{}` with effects [{}]", s.surface, s.effects.join(", ")),
                 source: Box::new(source),
             })?;
             seen.push(key);
         }
-        if let Some(rp) = scenario.random_physics {
-            scenario.check_random_physics(&rp)?;
-        }
-        Ok(scenario)
+        Ok(())
     }
 
     /// Checks `[random_physics]`: finite ranges, inclines and heights in range, and every drawn model value
@@ -950,6 +713,310 @@ fn default_model() -> Table {
     let text =
         "gravity_m_s2 = 9.81\n[effects.spring]\nk = 25650\n[effects.damping]\nb = 14\n[effects.coulomb]\nmu = 0.5\n";
     text.parse().expect("built-in model parses")
+}
+
+/// The scenario a check is about: builds its errors, each naming it.
+struct Origin<'a>(&'a str);
+
+impl Origin<'_> {
+    /// The file does not say what a scenario needs (`message` says what).
+    fn syntax(&self, message: String) -> RenderError {
+        RenderError::Syntax {
+            origin: self.0.to_string(),
+            message,
+        }
+    }
+
+    /// `field` holds `value`, which breaks `reason`.
+    fn invalid(&self, field: &str, value: String, reason: &str) -> RenderError {
+        RenderError::InvalidValue {
+            origin: self.0.to_string(),
+            field: field.to_string(),
+            value,
+            reason: reason.to_string(),
+        }
+    }
+
+    /// Each (field, value, within its range, reason) in turn: the first value out of its range (or not
+    /// finite) is the error.
+    fn check_all<'f>(
+        &self,
+        checks: impl IntoIterator<Item = (&'f str, f64, bool, &'f str)>,
+    ) -> Result<(), RenderError> {
+        for (field, v, ok, reason) in checks {
+            if !(ok && v.is_finite()) {
+                return Err(self.invalid(field, v.to_string(), reason));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Checks `[camera]`: frame size, optics, noise, bits, blur samples and the naming pattern.
+fn check_camera(c: &Camera, at: &Origin) -> Result<(), RenderError> {
+    for (field, px) in [("camera.width", c.width), ("camera.height", c.height)] {
+        if !(16..=8192).contains(&px) {
+            return Err(at.invalid(field, px.to_string(), "must be 16 to 8192 pixels"));
+        }
+    }
+    at.check_all([
+        (
+            "camera.scale_m_per_px",
+            c.scale_m_per_px,
+            c.scale_m_per_px > 0.0,
+            "must be > 0",
+        ),
+        (
+            "camera.fps",
+            c.fps,
+            c.fps > 0.0 && c.fps <= 1e7,
+            "must be > 0 (and ≤ 1e7)",
+        ),
+        (
+            "camera.exposure_s",
+            c.exposure_s,
+            c.exposure_s > 0.0 && c.exposure_s <= 1.0 / c.fps,
+            "must be > 0 and at most one frame period (1/fps)",
+        ),
+        ("camera.read_noise", c.read_noise, c.read_noise >= 0.0, "must be ≥ 0 DN"),
+        (
+            "camera.shot_noise_gain",
+            c.shot_noise_gain,
+            c.shot_noise_gain >= 0.0,
+            "must be ≥ 0 DN per electron",
+        ),
+        (
+            "camera.flicker_amplitude",
+            c.flicker_amplitude,
+            (0.0..0.5).contains(&c.flicker_amplitude),
+            "must be in [0, 0.5)",
+        ),
+        ("camera.flicker_hz", c.flicker_hz, c.flicker_hz >= 0.0, "must be ≥ 0 Hz"),
+        (
+            "camera.roll_deg",
+            c.roll_deg,
+            c.roll_deg.abs() <= 45.0,
+            "must be within ±45°",
+        ),
+        (
+            "camera.vignetting",
+            c.vignetting,
+            (0.0..=0.9).contains(&c.vignetting),
+            "must be in [0, 0.9]",
+        ),
+        (
+            "camera.fixed_pattern_noise",
+            c.fixed_pattern_noise,
+            (0.0..=20.0).contains(&c.fixed_pattern_noise),
+            "must be 0 to 20 DN",
+        ),
+        (
+            "camera.hot_pixel_fraction",
+            c.hot_pixel_fraction,
+            (0.0..=0.01).contains(&c.hot_pixel_fraction),
+            "must be 0 to 0.01",
+        ),
+    ])?;
+    if ![8, 12, 16].contains(&c.bit_depth) {
+        return Err(at.invalid(
+            "camera.bit_depth",
+            c.bit_depth.to_string(),
+            "must be 8, 12 (12-bit data in 16-bit files) or 16",
+        ));
+    }
+    if !(1..=64).contains(&c.blur_samples) {
+        return Err(at.invalid("camera.blur_samples", c.blur_samples.to_string(), "must be 1 to 64"));
+    }
+    check_naming(c, at)
+}
+
+/// Checks the frame file naming pattern and that its extension matches the format.
+fn check_naming(c: &Camera, at: &Origin) -> Result<(), RenderError> {
+    let pattern = c.naming_pattern();
+    let (_, _, suffix) = parse_naming(&pattern).map_err(|r| at.invalid("camera.naming", format!("{pattern:?}"), &r))?;
+    let lower = suffix.to_ascii_lowercase();
+    let ext_ok = match c.format {
+        Format::Png => lower.ends_with(".png"),
+        Format::Tiff => lower.ends_with(".tif") || lower.ends_with(".tiff"),
+    };
+    if !ext_ok {
+        return Err(at.invalid(
+            "camera.naming",
+            format!("{pattern:?}"),
+            "its extension must match camera.format (.png, or .tif/.tiff)",
+        ));
+    }
+    Ok(())
+}
+
+/// Checks `[ball]` and the flight filmed either side of the contact.
+fn check_ball_and_timing(raw: &Raw, at: &Origin) -> Result<(), RenderError> {
+    let b = &raw.ball;
+    at.check_all([
+        (
+            "ball.diameter_m",
+            b.diameter_m,
+            b.diameter_m > 0.0 && b.diameter_m < 10.0,
+            "must be > 0 m",
+        ),
+        ("ball.mass_kg", b.mass_kg, b.mass_kg > 0.0, "must be > 0 kg"),
+        (
+            "ball.inertia_factor",
+            b.inertia_factor,
+            b.inertia_factor > 0.0,
+            "must be > 0",
+        ),
+        (
+            "pre_contact_ms",
+            raw.pre_contact_ms,
+            (0.0..=2000.0).contains(&raw.pre_contact_ms),
+            "must be 0 to 2000 ms",
+        ),
+        (
+            "post_separation_ms",
+            raw.post_separation_ms,
+            (0.0..=2000.0).contains(&raw.post_separation_ms),
+            "must be 0 to 2000 ms",
+        ),
+    ])
+}
+
+/// The `[surfaces.NAME]` tables, in file order: each a texture plus per-surface model values.
+fn read_surfaces(tables: &Table, at: &Origin) -> Result<Vec<Surface>, RenderError> {
+    let mut surfaces = Vec::new();
+    for (name, body) in tables {
+        let field = format!("surfaces.{name}");
+        let t = body
+            .as_table()
+            .ok_or_else(|| at.syntax(format!("{field} must be a table")))?;
+        let tex = t
+            .get("texture")
+            .ok_or_else(|| at.syntax(format!("{field}: missing `texture` (clay, white_tape or green_tape)")))?;
+        let texture: Texture = tex.clone().try_into().map_err(|_| {
+            at.invalid(
+                &format!("{field}.texture"),
+                tex.to_string(),
+                "expected \"clay\", \"white_tape\" or \"green_tape\"",
+            )
+        })?;
+        let mut model_values = t.clone();
+        model_values.remove("texture");
+        if name.is_empty() || name.contains([',', '"', '/', '\\', '\n']) {
+            return Err(at.invalid(
+                &field,
+                format!("{name:?}"),
+                "a surface name must be non-empty, without , \" / \\",
+            ));
+        }
+        surfaces.push(Surface {
+            name: name.clone(),
+            texture,
+            model_values,
+        });
+    }
+    if surfaces.is_empty() {
+        return Err(at.syntax("no surfaces: add at least one [surfaces.NAME] with a texture".into()));
+    }
+    Ok(surfaces)
+}
+
+/// The surfaces' names, for messages.
+fn surface_list(surfaces: &[Surface]) -> String {
+    surfaces.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", ")
+}
+
+/// Appends the `[grid]`'s shots (surface × angle × height × repeat) once its surfaces and repeats are checked.
+fn expand_grid(g: &Grid, surfaces: &[Surface], shots: &mut Vec<Shot>, at: &Origin) -> Result<(), RenderError> {
+    for s in &g.surfaces {
+        if !surfaces.iter().any(|x| &x.name == s) {
+            return Err(RenderError::UnknownSurface {
+                origin: at.0.to_string(),
+                field: "grid.surfaces".into(),
+                surface: s.clone(),
+                known: surface_list(surfaces),
+            });
+        }
+    }
+    if g.repeats == 0 {
+        return Err(at.invalid("grid.repeats", "0".into(), "must be ≥ 1"));
+    }
+    for s in &g.surfaces {
+        for &a in &g.angles_deg {
+            for &h in &g.drop_heights_m {
+                for r in 1..=g.repeats {
+                    shots.push(Shot {
+                        surface: s.clone(),
+                        angle_deg: a,
+                        drop_height_m: h,
+                        repeat: r,
+                        effects: g.effects.clone(),
+                    });
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Checks every shot: a known surface, incline and height in range, a repeat from 1, known extra effects.
+fn check_shots(shots: &[Shot], surfaces: &[Surface], extra_effects: &Table, at: &Origin) -> Result<(), RenderError> {
+    if shots.is_empty() {
+        return Err(at.syntax("no shots: add [[shots]] or a [grid]".into()));
+    }
+    for (i, s) in shots.iter().enumerate() {
+        let f = |k: &str| format!("shots[{i}].{k}");
+        if !surfaces.iter().any(|x| x.name == s.surface) {
+            return Err(RenderError::UnknownSurface {
+                origin: at.0.to_string(),
+                field: f("surface"),
+                surface: s.surface.clone(),
+                known: surface_list(surfaces),
+            });
+        }
+        at.check_all([
+            (
+                f("angle_deg").as_str(),
+                s.angle_deg,
+                s.angle_deg.abs() <= 60.0,
+                "must be within ±60°",
+            ),
+            (
+                f("drop_height_m").as_str(),
+                s.drop_height_m,
+                s.drop_height_m > 0.0 && s.drop_height_m <= 10.0,
+                "must be > 0 and ≤ 10 m",
+            ),
+        ])?;
+        if s.repeat == 0 {
+            return Err(at.invalid(&f("repeat"), "0".into(), "must be ≥ 1"));
+        }
+        if let Some(e) = s.effects.iter().find(|e| !extra_effects.contains_key(*e)) {
+            return Err(RenderError::UnknownEffect {
+                origin: at.0.to_string(),
+                field: f("effects"),
+                effect: e.clone(),
+                known: if extra_effects.is_empty() {
+                    "none".into()
+                } else {
+                    extra_effects.keys().cloned().collect::<Vec<_>>().join(", ")
+                },
+            });
+        }
+    }
+    Ok(())
+}
+
+/// `[model]` (the paper's base model when absent), which must hold neither the ball nor per-surface values.
+fn model_table(model: Option<Table>, at: &Origin) -> Result<Table, RenderError> {
+    let model = model.unwrap_or_else(default_model);
+    for key in ["ball", "surfaces"] {
+        if model.contains_key(key) {
+            return Err(at.syntax(format!(
+                "model.{key}: the ball comes from [ball] and per-surface values go under [surfaces.NAME]"
+            )));
+        }
+    }
+    Ok(model)
 }
 
 #[cfg(test)]

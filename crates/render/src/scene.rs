@@ -8,7 +8,7 @@ use std::f64::consts::TAU;
 
 /// A rendered frame.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Frame {
+pub struct RenderedFrame {
     /// Width, pixels.
     pub width: u32,
     /// Height, pixels.
@@ -26,7 +26,7 @@ pub enum Pixels {
     Gray16(Vec<u16>),
 }
 
-impl Frame {
+impl RenderedFrame {
     /// The gray level at (x, y) on the 8-bit scale (16-bit frames divided by 257; 12-bit data in 16-bit
     /// frames comes out within 0.4 % of it).
     pub fn get(&self, x: u32, y: u32) -> f64 {
@@ -87,6 +87,17 @@ pub(crate) struct Layers {
     pub vig: Vec<f32>,
     pub light: [f64; 3],
     pub shading: Shading,
+}
+
+/// The pixels a frame's ball can touch: the radii (squared, px²) within which it covers a pixel wholly and
+/// beyond which not at all, and the bounding box [x0, x1) × [y0, y1) of its blurred disc, pixels.
+struct BallWindow {
+    r_in2: f64,
+    r_out2: f64,
+    x0: usize,
+    x1: usize,
+    y0: usize,
+    y1: usize,
 }
 
 /// Makes the frames of one shot.
@@ -565,22 +576,10 @@ impl<'a> ShotRenderer<'a> {
         self.albedo_at(bx + self.acen, by + self.acen) * s
     }
 
-    /// Renders frame `i` (0-based).
-    ///
-    /// # Panics
-    /// If `i` is not a frame of the shot.
-    #[allow(clippy::needless_range_loop)] // x indexes four parallel arrays
-    pub fn frame(&self, i: usize) -> Frame {
-        let plan = self.plan;
-        let cam = &plan.camera;
+    /// The pixels the ball of a frame can touch: centre (cx, cy) and radius `r` px, blurred over the
+    /// sub-exposure centres `subs`.
+    fn ball_window(&self, cx: f64, cy: f64, r: f64, subs: &[(f64, f64)]) -> BallWindow {
         let (w, h) = (self.w, self.h);
-        let ft = &plan.frames[i];
-        let k = cam.blur_samples as usize;
-        let subs = &plan.subs[i * k..(i + 1) * k];
-        let r = ft.r_px;
-        let (cx, cy) = (ft.x_px, ft.y_px);
-        let (sa, ca) = plan.alpha[i].sin_cos();
-        let gain = 1.0 + cam.flicker_amplitude * (TAU * cam.flicker_hz * ft.t_s + plan.flicker_phase).sin();
         let blur = subs.iter().fold(0.0f64, |a, s| a.max((s.0 - cx).hypot(s.1 - cy)));
         let r_in = r - self.fuzz_max - blur - EDGE_W;
         let r_out = r + self.fuzz_max + blur + EDGE_W;
@@ -592,10 +591,56 @@ impl<'a> ShotRenderer<'a> {
             sy0 = sy0.min(s.1);
             sy1 = sy1.max(s.1);
         }
-        let bx0 = (sx0 - r_out).floor().max(0.0) as usize;
-        let bx1 = ((sx1 + r_out).ceil() + 1.0).clamp(0.0, w as f64) as usize;
-        let by0 = (sy0 - r_out).floor().max(0.0) as usize;
-        let by1 = ((sy1 + r_out).ceil() + 1.0).clamp(0.0, h as f64) as usize;
+        BallWindow {
+            r_in2,
+            r_out2,
+            x0: (sx0 - r_out).floor().max(0.0) as usize,
+            x1: ((sx1 + r_out).ceil() + 1.0).clamp(0.0, w as f64) as usize,
+            y0: (sy0 - r_out).floor().max(0.0) as usize,
+            y1: ((sy1 + r_out).ceil() + 1.0).clamp(0.0, h as f64) as usize,
+        }
+    }
+
+    /// The ball's coverage of pixel (x, y) on its fuzzy edge, summed over the sub-exposure centres `subs`
+    /// (divide by their number): (dx, dy) is the pixel's offset from the mid-exposure centre, `alpha` the
+    /// pattern's turn, rad.
+    #[inline]
+    fn edge_coverage(&self, (x, y): (f64, f64), (dx, dy): (f64, f64), r: f64, alpha: f64, subs: &[(f64, f64)]) -> f64 {
+        let ang = (-dy).atan2(dx) - alpha;
+        let e = ((ang / TAU).rem_euclid(1.0) * FUZZ_N as f64) as usize % FUZZ_N;
+        let re = r + self.fuzz[e] as f64;
+        let mut acc = 0.0;
+        for s in subs {
+            let d = (x - s.0).hypot(y - s.1);
+            acc += ramp((re - d) / EDGE_W + 0.5);
+        }
+        acc
+    }
+
+    /// Renders frame `i` (0-based).
+    ///
+    /// # Panics
+    /// If `i` is not a frame of the shot.
+    #[allow(clippy::needless_range_loop)] // x indexes four parallel arrays
+    pub fn frame(&self, i: usize) -> RenderedFrame {
+        let plan = self.plan;
+        let cam = &plan.camera;
+        let (w, h) = (self.w, self.h);
+        let ft = &plan.frames[i];
+        let k = cam.blur_samples as usize;
+        let subs = &plan.subs[i * k..(i + 1) * k];
+        let r = ft.r_px;
+        let (cx, cy) = (ft.x_px, ft.y_px);
+        let (sa, ca) = plan.alpha[i].sin_cos();
+        let gain = 1.0 + cam.flicker_amplitude * (TAU * cam.flicker_hz * ft.t_s + plan.flicker_phase).sin();
+        let BallWindow {
+            r_in2,
+            r_out2,
+            x0: bx0,
+            x1: bx1,
+            y0: by0,
+            y1: by1,
+        } = self.ball_window(cx, cy, r, subs);
         let gauss = gauss_table();
         let mut rng = Rng::new(plan.frame_seed(i));
         let sixteen = cam.bit_depth != 8;
@@ -623,15 +668,7 @@ impl<'a> ShotRenderer<'a> {
                     let cov = if d2 <= r_in2 {
                         1.0
                     } else {
-                        let ang = (-dy).atan2(dx) - plan.alpha[i];
-                        let e = ((ang / TAU).rem_euclid(1.0) * FUZZ_N as f64) as usize % FUZZ_N;
-                        let re = r + self.fuzz[e] as f64;
-                        let mut acc = 0.0;
-                        for s in subs {
-                            let d = (xf - s.0).hypot(yf - s.1);
-                            acc += ramp((re - d) / EDGE_W + 0.5);
-                        }
-                        acc * inv_k
+                        self.edge_coverage((xf, yf), (dx, dy), r, plan.alpha[i], subs) * inv_k
                     };
                     if cov <= 0.0 {
                         continue;
@@ -662,7 +699,7 @@ impl<'a> ShotRenderer<'a> {
                 }
             }
         }
-        Frame {
+        RenderedFrame {
             width: w as u32,
             height: h as u32,
             pixels: if sixteen {

@@ -1,6 +1,6 @@
 //! Writing a session (`docs/session.md`) and its truth beside it.
 
-use crate::scene::{Frame, Pixels};
+use crate::scene::{Pixels, RenderedFrame};
 use crate::shot::{ShotPlan, ShotTruth};
 use crate::{Format, RenderError, Scenario};
 use image::ExtendedColorType;
@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 /// Receives progress while a session renders (a progress bar, a log, a test). Methods are called from
 /// worker threads.
-pub trait Observer: Sync {
+pub trait RenderObserver: Sync {
     /// Every shot is planned: `shots` clips with `frames` frames in total will be written.
     fn planned(&self, _shots: usize, _frames: usize) {}
     /// One more frame is written.
@@ -22,8 +22,8 @@ pub trait Observer: Sync {
 
 /// An observer that does nothing.
 #[derive(Debug, Clone, Copy, Default)]
-pub struct Silent;
-impl Observer for Silent {}
+pub struct NoRenderProgress;
+impl RenderObserver for NoRenderProgress {}
 
 /// How to render.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -59,7 +59,7 @@ pub struct Rendered {
 /// Renders `scenario` into `out_dir/session` (the session) and `out_dir/truth` (its ground truth), in
 /// parallel, refusing to overwrite.
 pub fn render(scenario: &Scenario, out_dir: &Path) -> Result<Rendered, RenderError> {
-    render_with(scenario, out_dir, &RenderOptions::default(), &Silent)
+    render_with(scenario, out_dir, &RenderOptions::default(), &NoRenderProgress)
 }
 
 fn non_empty(p: &Path) -> bool {
@@ -71,7 +71,7 @@ pub fn render_with(
     scenario: &Scenario,
     out_dir: &Path,
     opts: &RenderOptions,
-    observer: &dyn Observer,
+    observer: &dyn RenderObserver,
 ) -> Result<Rendered, RenderError> {
     let session_dir = out_dir.join("session");
     let truth_dir = out_dir.join("truth");
@@ -133,7 +133,7 @@ pub fn render_with(
 }
 
 /// Encodes a frame as PNG (fast compression) or uncompressed TIFF.
-pub fn encode(frame: &Frame, format: Format) -> Result<Vec<u8>, image::ImageError> {
+pub fn encode(frame: &RenderedFrame, format: Format) -> Result<Vec<u8>, image::ImageError> {
     let (w, h) = (frame.width, frame.height);
     let (bytes, color): (std::borrow::Cow<[u8]>, _) = match &frame.pixels {
         Pixels::Gray8(v) => (v.as_slice().into(), ExtendedColorType::L8),

@@ -2,7 +2,7 @@
 
 #![allow(dead_code)]
 
-use bouncelab_render::{Frame, RenderOptions, Rendered, Scenario, Silent, render_with};
+use bouncelab_render::{NoRenderProgress, RenderOptions, Rendered, RenderedFrame, Scenario, render_with};
 use std::path::{Path, PathBuf};
 
 /// A tiny two-shot scenario: 160×160 frames, ball ≈ 42 px across, 2 ms before touch and after separation.
@@ -78,7 +78,7 @@ pub fn col<'a>(header: &[String], row: &'a [String], col: &str) -> &'a str {
 }
 
 /// Bilinear sample of the frame.
-pub fn sample(f: &Frame, x: f64, y: f64) -> f64 {
+pub fn sample(f: &RenderedFrame, x: f64, y: f64) -> f64 {
     let (x0, y0) = (x.floor(), y.floor());
     let (fx, fy) = (x - x0, y - y0);
     let (i, j) = (x0 as u32, y0 as u32);
@@ -90,7 +90,7 @@ pub fn sample(f: &Frame, x: f64, y: f64) -> f64 {
 /// lightly smoothed profile) near the start radius, refined by a parabola; then an algebraic least-squares
 /// circle fit with one round of outlier rejection.
 #[allow(clippy::needless_range_loop)] // a small dense Gauss–Jordan solve
-pub fn fit_circle(f: &Frame, cx: f64, cy: f64, r: f64) -> (f64, f64, f64) {
+pub fn fit_circle(f: &RenderedFrame, cx: f64, cy: f64, r: f64) -> (f64, f64, f64) {
     let mut pts = Vec::new();
     for a in 0..360 {
         let t = (a as f64).to_radians();
@@ -225,7 +225,7 @@ pub fn render_to(s: &Scenario, dir: &Path, parallel: bool) -> Rendered {
         parallel,
         overwrite: false,
     };
-    render_with(s, dir, &opts, &Silent).unwrap()
+    render_with(s, dir, &opts, &NoRenderProgress).unwrap()
 }
 
 /// Renders `s` twice sequentially and once in parallel and asserts the three folders are byte-identical;

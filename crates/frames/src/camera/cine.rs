@@ -103,111 +103,174 @@ impl Frames {
     }
 }
 
-pub(crate) fn open(path: &Path, max_pixels: u64) -> Result<CameraFile> {
-    let map = map(path)?;
-    let b: &[u8] = &map;
-    let bad = |field: &str, problem: String| header_error(path, field, problem);
-    let short = |field: &str| header_error(path, field, "the file ends before this field (truncated header)");
-    if b.get(0..2) != Some(b"CI".as_slice()) {
-        return Err(bad(
-            "CINEFILEHEADER.Type",
-            "not \"CI\": not a Phantom .cine file".into(),
-        ));
-    }
-    let compression = u16_at(b, 4).ok_or_else(|| short("CINEFILEHEADER.Compression"))?;
-    if compression != 0 {
-        return Err(bad(
-            "CINEFILEHEADER.Compression",
-            format!(
-                "{compression} ({}): only uncompressed (0) images are read; save the cine uncompressed",
-                if compression == 1 {
-                    "JPEG"
-                } else {
-                    "uninterpolated colour raw"
-                }
-            ),
-        ));
-    }
-    let first_image_no = i32_at(b, 16).ok_or_else(|| short("CINEFILEHEADER.FirstImageNo"))?;
-    let image_count = u32_at(b, 20).ok_or_else(|| short("CINEFILEHEADER.ImageCount"))?;
-    let off_bitmap = u32_at(b, 24).ok_or_else(|| short("CINEFILEHEADER.OffImageHeader"))? as usize;
-    let off_setup = u32_at(b, 28).ok_or_else(|| short("CINEFILEHEADER.OffSetup"))? as usize;
-    let table = u32_at(b, 32).ok_or_else(|| short("CINEFILEHEADER.OffImageOffsets"))? as usize;
-    if image_count == 0 {
-        return Err(bad("CINEFILEHEADER.ImageCount", "0 images".into()));
-    }
+/// The fields of `CINEFILEHEADER` the reader uses.
+struct FileHeader {
+    first_image_no: i32,
+    image_count: u32,
+    /// Byte offset of `BITMAPINFOHEADER`.
+    off_bitmap: usize,
+    /// Byte offset of `SETUP`.
+    off_setup: usize,
+    /// Byte offset of the image offset table.
+    table: usize,
+}
 
-    let bi = |at: usize, field: &str| -> Result<u32> {
-        u32_at(b, off_bitmap + at).ok_or_else(|| {
-            bad(
-                field,
+impl FileHeader {
+    /// Reads and checks `CINEFILEHEADER`: the "CI" mark, uncompressed images, at least one image.
+    fn read(path: &Path, b: &[u8]) -> Result<FileHeader> {
+        let short = |field: &str| header_error(path, field, "the file ends before this field (truncated header)");
+        if b.get(0..2) != Some(b"CI".as_slice()) {
+            return Err(header_error(
+                path,
+                "CINEFILEHEADER.Type",
+                "not \"CI\": not a Phantom .cine file",
+            ));
+        }
+        let compression = u16_at(b, 4).ok_or_else(|| short("CINEFILEHEADER.Compression"))?;
+        if compression != 0 {
+            return Err(header_error(
+                path,
+                "CINEFILEHEADER.Compression",
                 format!(
-                    "BITMAPINFOHEADER at byte {off_bitmap} (OffImageHeader) runs past the end of the file ({} bytes)",
-                    b.len()
+                    "{compression} ({}): only uncompressed (0) images are read; save the cine uncompressed",
+                    if compression == 1 {
+                        "JPEG"
+                    } else {
+                        "uninterpolated colour raw"
+                    }
                 ),
-            )
+            ));
+        }
+        let header = FileHeader {
+            first_image_no: i32_at(b, 16).ok_or_else(|| short("CINEFILEHEADER.FirstImageNo"))?,
+            image_count: u32_at(b, 20).ok_or_else(|| short("CINEFILEHEADER.ImageCount"))?,
+            off_bitmap: u32_at(b, 24).ok_or_else(|| short("CINEFILEHEADER.OffImageHeader"))? as usize,
+            off_setup: u32_at(b, 28).ok_or_else(|| short("CINEFILEHEADER.OffSetup"))? as usize,
+            table: u32_at(b, 32).ok_or_else(|| short("CINEFILEHEADER.OffImageOffsets"))? as usize,
+        };
+        if header.image_count == 0 {
+            return Err(header_error(path, "CINEFILEHEADER.ImageCount", "0 images"));
+        }
+        Ok(header)
+    }
+}
+
+/// The fields of `BITMAPINFOHEADER` the reader uses.
+struct Bitmap {
+    width: i32,
+    /// Positive: rows stored bottom-up.
+    height: i32,
+    bit_count: u16,
+    compression: u32,
+}
+
+impl Bitmap {
+    fn read(path: &Path, b: &[u8], off_bitmap: usize) -> Result<Bitmap> {
+        let bi = |at: usize, field: &str| -> Result<u32> {
+            u32_at(b, off_bitmap + at).ok_or_else(|| {
+                header_error(
+                    path,
+                    field,
+                    format!(
+                        "BITMAPINFOHEADER at byte {off_bitmap} (OffImageHeader) runs past the end of the file ({} bytes)",
+                        b.len()
+                    ),
+                )
+            })
+        };
+        Ok(Bitmap {
+            width: bi(4, "BITMAPINFOHEADER.biWidth")? as i32,
+            height: bi(8, "BITMAPINFOHEADER.biHeight")? as i32,
+            bit_count: (bi(12, "BITMAPINFOHEADER.biBitCount")? >> 16) as u16,
+            compression: bi(16, "BITMAPINFOHEADER.biCompression")?,
         })
-    };
-    let width = bi(4, "BITMAPINFOHEADER.biWidth")? as i32;
-    let height = bi(8, "BITMAPINFOHEADER.biHeight")? as i32;
-    let bit_count = (bi(12, "BITMAPINFOHEADER.biBitCount")? >> 16) as u16;
-    let bi_compression = bi(16, "BITMAPINFOHEADER.biCompression")?;
-    if width <= 0 {
-        return Err(bad("BITMAPINFOHEADER.biWidth", format!("{width} px")));
     }
-    let size = check_size(path, width as u64, u64::from(height.unsigned_abs()), max_pixels)?;
 
-    // SETUP fields are read only when the SETUP block (by its own Length) and the file both hold them.
-    let setup_len = usize::from(u16_at(b, off_setup + 142).unwrap_or(0));
-    let setup_u32 = |at: usize| (at + 4 <= setup_len).then(|| u32_at(b, off_setup + at)).flatten();
-    let setup_u16 = |at: usize| (at + 2 <= setup_len).then(|| u16_at(b, off_setup + at)).flatten();
-    if let Some(cfa) = setup_u32(808).filter(|c| *c != 0) {
-        return Err(bad(
-            "SETUP.CFA",
-            format!("{cfa}: a colour sensor's cine is not supported; record or save monochrome"),
-        ));
+    /// How the images are packed, and the bits per pixel as stored, from the compression and bit count
+    /// (`real_bpp`: the bits a 16-bit sample holds, from `SETUP`).
+    fn packing(&self, path: &Path, real_bpp: Option<u32>) -> Result<(Packing, u32)> {
+        Ok(match (self.compression, self.bit_count) {
+            (0, 8) => (Packing::U8, 8),
+            (0, 16) => (Packing::U16Le(real_bpp.map_or(0, |r| 16 - r)), 16),
+            (256, _) => (Packing::P10, 10),
+            (1024, _) => (Packing::P12, 12),
+            (0, other) => {
+                return Err(header_error(
+                    path,
+                    "BITMAPINFOHEADER.biBitCount",
+                    format!(
+                        "unknown bit depth {other} (this reader knows 8 and 16 bits, 10 and 12 bits packed; colour is not supported)"
+                    ),
+                ));
+            }
+            (other, _) => {
+                return Err(header_error(
+                    path,
+                    "BITMAPINFOHEADER.biCompression",
+                    format!(
+                        "unknown image packing {other} (this reader knows 0 = plain, 256 = 10-bit, 1024 = 12-bit packed)"
+                    ),
+                ));
+            }
+        })
     }
-    let real_bpp = setup_u32(896).filter(|b| (1..=16).contains(b));
-    let (packing, field_bits) = match (bi_compression, bit_count) {
-        (0, 8) => (Packing::U8, 8),
-        (0, 16) => (Packing::U16Le(real_bpp.map_or(0, |r| 16 - r)), 16),
-        (256, _) => (Packing::P10, 10),
-        (1024, _) => (Packing::P12, 12),
-        (0, other) => {
-            return Err(bad(
-                "BITMAPINFOHEADER.biBitCount",
-                format!(
-                    "unknown bit depth {other} (this reader knows 8 and 16 bits, 10 and 12 bits packed; colour is not supported)"
-                ),
-            ));
-        }
-        (other, _) => {
-            return Err(bad(
-                "BITMAPINFOHEADER.biCompression",
-                format!(
-                    "unknown image packing {other} (this reader knows 0 = plain, 256 = 10-bit, 1024 = 12-bit packed)"
-                ),
-            ));
-        }
-    };
-    let pixels = u64::from(size.0) * u64::from(size.1);
-    let frame_bytes = packing.frame_bytes(pixels).ok_or_else(|| {
-        bad(
-            "BITMAPINFOHEADER.biCompression",
-            format!(
-                "{}×{} px cannot be stored whole at {field_bits} bits packed",
-                size.0, size.1
-            ),
-        )
-    })?;
+}
 
-    // The offset table must lie in the file, and every offset must point into it.
+/// The `SETUP` block: a field is read only when the block (by its own `Length`) and the file both hold it.
+struct Setup<'a> {
+    b: &'a [u8],
+    at: usize,
+    len: usize,
+}
+
+impl<'a> Setup<'a> {
+    fn new(b: &'a [u8], off_setup: usize) -> Setup<'a> {
+        Setup {
+            b,
+            at: off_setup,
+            len: usize::from(u16_at(b, off_setup + 142).unwrap_or(0)),
+        }
+    }
+
+    fn u32(&self, at: usize) -> Option<u32> {
+        (at + 4 <= self.len).then(|| u32_at(self.b, self.at + at)).flatten()
+    }
+
+    fn u16(&self, at: usize) -> Option<u16> {
+        (at + 2 <= self.len).then(|| u16_at(self.b, self.at + at)).flatten()
+    }
+
+    /// Frame rate, frames/s: `FrameRate`, else the older `FrameRate16`.
+    fn fps(&self) -> Option<f64> {
+        match self.u32(768).filter(|f| *f > 0) {
+            Some(f) => Some(f64::from(f)),
+            None => self.u16(0).filter(|f| *f > 0).map(f64::from),
+        }
+    }
+
+    /// Exposure, s: `ShutterNs`, else `Shutter` or the older `Shutter16` (µs).
+    fn exposure_s(&self) -> Option<f64> {
+        match self.u32(1568).filter(|s| *s > 0) {
+            Some(ns) => Some(f64::from(ns) * 1e-9),
+            None => self
+                .u32(772)
+                .filter(|s| *s > 0)
+                .or_else(|| self.u16(2).filter(|s| *s > 0).map(u32::from))
+                .map(|us| f64::from(us) * 1e-6),
+        }
+    }
+}
+
+/// Checks that the image offset table lies in the file and that every offset leaves room for an image of
+/// `frame_bytes` bytes.
+fn check_offsets(path: &Path, b: &[u8], table: usize, image_count: u32, frame_bytes: u64) -> Result<()> {
     let table_end = (image_count as usize)
         .checked_mul(8)
         .and_then(|n| n.checked_add(table))
         .filter(|end| *end <= b.len())
         .ok_or_else(|| {
-            bad(
+            header_error(
+                path,
                 "CINEFILEHEADER.OffImageOffsets",
                 format!(
                     "a table of {image_count} image offsets at byte {table} runs past the end of the file ({} bytes)",
@@ -221,7 +284,8 @@ pub(crate) fn open(path: &Path, max_pixels: u64) -> Result<CameraFile> {
             .checked_add(frame_bytes + 8)
             .is_none_or(|end| end > b.len() as u64)
         {
-            return Err(bad(
+            return Err(header_error(
+                path,
                 &format!("pImage[{k}]"),
                 format!(
                     "image offset {offset} leaves no room for a {frame_bytes}-byte image in the file ({} bytes)",
@@ -230,18 +294,49 @@ pub(crate) fn open(path: &Path, max_pixels: u64) -> Result<CameraFile> {
             ));
         }
     }
+    Ok(())
+}
 
-    let fps = match setup_u32(768).filter(|f| *f > 0) {
-        Some(f) => Some(f64::from(f)),
-        None => setup_u16(0).filter(|f| *f > 0).map(f64::from),
-    };
-    let exposure_s = match setup_u32(1568).filter(|s| *s > 0) {
-        Some(ns) => Some(f64::from(ns) * 1e-9),
-        None => setup_u32(772)
-            .filter(|s| *s > 0)
-            .or_else(|| setup_u16(2).filter(|s| *s > 0).map(u32::from))
-            .map(|us| f64::from(us) * 1e-6),
-    };
+pub(crate) fn open(path: &Path, max_pixels: u64) -> Result<CameraFile> {
+    let map = map(path)?;
+    let b: &[u8] = &map;
+    let header = FileHeader::read(path, b)?;
+    let bitmap = Bitmap::read(path, b, header.off_bitmap)?;
+    if bitmap.width <= 0 {
+        return Err(header_error(
+            path,
+            "BITMAPINFOHEADER.biWidth",
+            format!("{} px", bitmap.width),
+        ));
+    }
+    let size = check_size(
+        path,
+        bitmap.width as u64,
+        u64::from(bitmap.height.unsigned_abs()),
+        max_pixels,
+    )?;
+    let setup = Setup::new(b, header.off_setup);
+    if let Some(cfa) = setup.u32(808).filter(|c| *c != 0) {
+        return Err(header_error(
+            path,
+            "SETUP.CFA",
+            format!("{cfa}: a colour sensor's cine is not supported; record or save monochrome"),
+        ));
+    }
+    let real_bpp = setup.u32(896).filter(|b| (1..=16).contains(b));
+    let (packing, field_bits) = bitmap.packing(path, real_bpp)?;
+    let pixels = u64::from(size.0) * u64::from(size.1);
+    let frame_bytes = packing.frame_bytes(pixels).ok_or_else(|| {
+        header_error(
+            path,
+            "BITMAPINFOHEADER.biCompression",
+            format!(
+                "{}×{} px cannot be stored whole at {field_bits} bits packed",
+                size.0, size.1
+            ),
+        )
+    })?;
+    check_offsets(path, b, header.table, header.image_count, frame_bytes)?;
     let mut warnings = Vec::new();
     if packing == Packing::P10 {
         warnings.push(Warning::NonLinearPixels {
@@ -253,31 +348,31 @@ pub(crate) fn open(path: &Path, max_pixels: u64) -> Result<CameraFile> {
     }
     let info = CameraInfo {
         format: SourceFormat::PhantomCine,
-        fps,
-        exposure_s,
+        fps: setup.fps(),
+        exposure_s: setup.exposure_s(),
         bit_depth: Some(packing.bits()),
         effective_bit_depth: real_bpp.map(|r| r as u8),
         effective_bit_side: None,
-        camera_model: setup_u32(792).filter(|v| *v > 0).map(|v| format!("Phantom v{v}")),
-        camera_serial: setup_u32(743).filter(|v| *v > 0).map(|v| v.to_string()),
-        start_frame: Some(i64::from(first_image_no)),
-        trigger_frame: Some(-i64::from(first_image_no)),
+        camera_model: setup.u32(792).filter(|v| *v > 0).map(|v| format!("Phantom v{v}")),
+        camera_serial: setup.u32(743).filter(|v| *v > 0).map(|v| v.to_string()),
+        start_frame: Some(i64::from(header.first_image_no)),
+        trigger_frame: Some(-i64::from(header.first_image_no)),
     };
     Ok(CameraFile {
         sources: vec![path.into()],
         path: path.into(),
         data_path: path.into(),
         layout: Layout::Cine(Frames {
-            table,
+            table: header.table,
             packing,
-            bottom_up: height > 0 && matches!(packing, Packing::U8 | Packing::U16Le(_)),
+            bottom_up: bitmap.height > 0 && matches!(packing, Packing::U8 | Packing::U16Le(_)),
             frame_bytes: frame_bytes as usize,
         }),
         map,
         pool: Pool::default(),
         info,
         size,
-        count: image_count as usize,
+        count: header.image_count as usize,
         warnings,
     })
 }

@@ -222,103 +222,156 @@ pub(crate) fn parse_cihx(path: &Path, bytes: &[u8]) -> Result<Header> {
     })
 }
 
-/// Opens a Photron clip from its header or its `.mraw`.
-pub(crate) fn open(path: &Path, max_pixels: u64) -> Result<CameraFile> {
-    let (header_path, data_path) = pair(path)?;
-    let h = read_header(&header_path)?;
-    let xml = header_path.extension().is_some_and(|e| e.eq_ignore_ascii_case("cihx"));
-    let name = |xml_name: &str, text_name: &str| {
-        if xml {
+/// A header's field names as the user's file spells them: XML paths in a `.cihx`, keys in a `.cih`.
+struct FieldNames {
+    xml: bool,
+}
+
+impl FieldNames {
+    fn name(&self, xml_name: &str, text_name: &str) -> String {
+        if self.xml {
             xml_name.to_string()
         } else {
             text_name.to_string()
         }
-    };
-    let missing = |f: String| header_error(&header_path, &f, "missing from the header");
-    if let Some(ff) = &h.file_format
-        && !ff.eq_ignore_ascii_case("mraw")
-    {
-        return Err(header_error(
-            &header_path,
-            &name("<imageFileInfo><fileFormat>", "File Format"),
-            format!("`{ff}`: this header describes {ff} files, not a .mraw"),
-        ));
     }
-    if let Some(c) = &h.colour
-        && (c.to_ascii_lowercase().contains("color") || c.to_ascii_lowercase().contains("colour"))
-    {
-        return Err(header_error(
-            &header_path,
-            &name("<imageDataInfo><colorInfo><type>", "Color Type"),
-            format!("`{c}`: colour MRAW (a Bayer mosaic) is not supported; record or save monochrome"),
-        ));
-    }
-    let width = h
-        .width
-        .ok_or_else(|| missing(name("<imageDataInfo><resolution><width>", "Image Width")))?;
-    let height = h
-        .height
-        .ok_or_else(|| missing(name("<imageDataInfo><resolution><height>", "Image Height")))?;
-    let frames = h
-        .frames
-        .ok_or_else(|| missing(name("<frameInfo><totalFrame>", "Total Frame")))?;
-    let bits_field = name("<imageDataInfo><colorInfo><bit>", "Color Bit");
-    let bits = h.bits.ok_or_else(|| missing(bits_field.clone()))?;
-    let size = check_size(&header_path, width, height, max_pixels)?;
-    let packing = match bits {
-        8 => Packing::U8,
-        12 => Packing::P12,
-        16 => Packing::U16Le(match (h.effective_depth, h.side) {
-            (Some(d @ 1..=15), Some(BitSide::Lower) | None) => u32::from(16 - d),
-            _ => 0,
-        }),
-        other => {
+}
+
+/// The frame geometry a header must give: width and height (px), frame count and bits per pixel.
+#[derive(Clone, Copy)]
+struct FrameGeometry {
+    width: u64,
+    height: u64,
+    frames: u64,
+    bits: u64,
+}
+
+impl Header {
+    /// Refuses headers of other file formats and of colour recordings.
+    fn check_mono_mraw(&self, header_path: &Path, names: &FieldNames) -> Result<()> {
+        if let Some(ff) = &self.file_format
+            && !ff.eq_ignore_ascii_case("mraw")
+        {
             return Err(header_error(
-                &header_path,
-                &bits_field,
-                format!("unknown bit depth {other} (this reader knows 8, 12 packed and 16)"),
+                header_path,
+                &names.name("<imageFileInfo><fileFormat>", "File Format"),
+                format!("`{ff}`: this header describes {ff} files, not a .mraw"),
             ));
         }
-    };
-    if frames == 0 {
-        return Err(header_error(
-            &header_path,
-            &name("<frameInfo><totalFrame>", "Total Frame"),
-            "0 frames",
-        ));
+        if let Some(c) = &self.colour
+            && (c.to_ascii_lowercase().contains("color") || c.to_ascii_lowercase().contains("colour"))
+        {
+            return Err(header_error(
+                header_path,
+                &names.name("<imageDataInfo><colorInfo><type>", "Color Type"),
+                format!("`{c}`: colour MRAW (a Bayer mosaic) is not supported; record or save monochrome"),
+            ));
+        }
+        Ok(())
     }
-    let pixels = width * height;
-    let frame_bytes = packing.frame_bytes(pixels).ok_or_else(|| {
+
+    /// Width, height, frame count and bits, each required.
+    fn geometry(&self, header_path: &Path, names: &FieldNames) -> Result<FrameGeometry> {
+        let missing = |f: String| header_error(header_path, &f, "missing from the header");
+        Ok(FrameGeometry {
+            width: self
+                .width
+                .ok_or_else(|| missing(names.name("<imageDataInfo><resolution><width>", "Image Width")))?,
+            height: self
+                .height
+                .ok_or_else(|| missing(names.name("<imageDataInfo><resolution><height>", "Image Height")))?,
+            frames: self
+                .frames
+                .ok_or_else(|| missing(names.name("<frameInfo><totalFrame>", "Total Frame")))?,
+            bits: self
+                .bits
+                .ok_or_else(|| missing(names.name("<imageDataInfo><colorInfo><bit>", "Color Bit")))?,
+        })
+    }
+
+    /// How the frames are packed: 8 bits, 12 bits packed, or 16-bit words shifted to full scale when the
+    /// effective depth sits on the lower side.
+    fn packing(&self, bits: u64, header_path: &Path, bits_field: &str) -> Result<Packing> {
+        Ok(match bits {
+            8 => Packing::U8,
+            12 => Packing::P12,
+            16 => Packing::U16Le(match (self.effective_depth, self.side) {
+                (Some(d @ 1..=15), Some(BitSide::Lower) | None) => u32::from(16 - d),
+                _ => 0,
+            }),
+            other => {
+                return Err(header_error(
+                    header_path,
+                    bits_field,
+                    format!("unknown bit depth {other} (this reader knows 8, 12 packed and 16)"),
+                ));
+            }
+        })
+    }
+}
+
+/// The `.mraw` must hold exactly the header's frames: a shorter file is truncated, a longer one disagrees.
+fn check_data_size(data_path: &Path, g: &FrameGeometry, frame_bytes: u64, data_len: u64, field: String) -> Result<()> {
+    let FrameGeometry {
+        width,
+        height,
+        frames,
+        bits,
+    } = *g;
+    let expected = frame_bytes.checked_mul(frames);
+    if expected == Some(data_len) {
+        return Ok(());
+    }
+    let problem = match expected {
+        Some(e) if e > data_len => format!(
+            "the header says {frames} frames of {width}×{height} px at {bits} bits = {e} bytes, but the .mraw has \
+             {} bytes (truncated: {} whole frames)",
+            data_len,
+            data_len / frame_bytes
+        ),
+        Some(e) => format!(
+            "the header says {frames} frames of {width}×{height} px at {bits} bits = {e} bytes, but the .mraw has \
+             {} bytes (the header's size or frame count disagrees with the data)",
+            data_len
+        ),
+        None => format!("{frames} frames of {frame_bytes} bytes overflow"),
+    };
+    Err(FramesError::CameraHeader {
+        path: data_path.into(),
+        field,
+        problem,
+    })
+}
+
+/// Opens a Photron clip from its header or its `.mraw`.
+pub(crate) fn open(path: &Path, max_pixels: u64) -> Result<CameraFile> {
+    let (header_path, data_path) = pair(path)?;
+    let h = read_header(&header_path)?;
+    let names = FieldNames {
+        xml: header_path.extension().is_some_and(|e| e.eq_ignore_ascii_case("cihx")),
+    };
+    h.check_mono_mraw(&header_path, &names)?;
+    let g = h.geometry(&header_path, &names)?;
+    let bits_field = names.name("<imageDataInfo><colorInfo><bit>", "Color Bit");
+    let size = check_size(&header_path, g.width, g.height, max_pixels)?;
+    let packing = h.packing(g.bits, &header_path, &bits_field)?;
+    let frames_field = names.name("<frameInfo><totalFrame>", "Total Frame");
+    if g.frames == 0 {
+        return Err(header_error(&header_path, &frames_field, "0 frames"));
+    }
+    let frame_bytes = packing.frame_bytes(g.width * g.height).ok_or_else(|| {
         header_error(
             &header_path,
             &bits_field,
-            format!("{width}×{height} px cannot be stored whole at {bits} bits packed"),
+            format!(
+                "{}×{} px cannot be stored whole at {} bits packed",
+                g.width, g.height, g.bits
+            ),
         )
     })?;
     let map = map(&data_path)?;
-    let expected = frame_bytes.checked_mul(frames);
-    if expected != Some(map.len() as u64) {
-        let problem = match expected {
-            Some(e) if e > map.len() as u64 => format!(
-                "the header says {frames} frames of {width}×{height} px at {bits} bits = {e} bytes, but the .mraw has \
-                 {} bytes (truncated: {} whole frames)",
-                map.len(),
-                map.len() as u64 / frame_bytes
-            ),
-            Some(e) => format!(
-                "the header says {frames} frames of {width}×{height} px at {bits} bits = {e} bytes, but the .mraw has \
-                 {} bytes (the header's size or frame count disagrees with the data)",
-                map.len()
-            ),
-            None => format!("{frames} frames of {frame_bytes} bytes overflow"),
-        };
-        return Err(FramesError::CameraHeader {
-            path: data_path,
-            field: name("<frameInfo><totalFrame>", "Total Frame"),
-            problem,
-        });
-    }
-    let count = usize::try_from(frames).map_err(|_| header_error(&header_path, "Total Frame", "too many frames"))?;
+    check_data_size(&data_path, &g, frame_bytes, map.len() as u64, frames_field)?;
+    let count = usize::try_from(g.frames).map_err(|_| header_error(&header_path, "Total Frame", "too many frames"))?;
     let info = CameraInfo {
         format: SourceFormat::PhotronMraw,
         fps: h.fps.filter(|f| f.is_finite() && *f > 0.0),
