@@ -10,25 +10,8 @@ use std::path::{Path, PathBuf};
 use image::codecs::png::{CompressionType, FilterType, PngEncoder};
 use image::{ColorType, DynamicImage, ImageBuffer};
 
-/// SplitMix64: a tiny deterministic pseudo-random source.
-#[derive(Clone, Debug)]
-pub struct Noise(u64);
-
-impl Noise {
-    /// A source seeded with `seed`.
-    pub fn new(seed: u64) -> Self {
-        Self(seed)
-    }
-
-    /// The next 64 random bits.
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-}
+/// The workspace's one seeded generator (SplitMix64), by the name these helpers use for it.
+pub type Noise = bouncelab_testkit::Rng;
 
 /// A `w`×`h` diagonal gradient with ±25 % full-scale noise, in colour type `colour` (L8, L16, La8, La16,
 /// Rgb8, Rgb16, Rgba8, Rgba16). Channels get different noise, so colour frames are really colour.
