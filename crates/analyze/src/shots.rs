@@ -234,6 +234,14 @@ mod tests {
         }
     }
 
+    /// The store cannot see the tracker's column list, so its `trajectory` table is checked against it here.
+    #[test]
+    fn the_store_trajectory_table_has_the_trajectory_columns() {
+        let columns = bouncelab_store::Table::Trajectory.columns();
+        assert_eq!(columns[0], "shot_id");
+        assert_eq!(&columns[1..], &bouncelab_track::TRAJECTORY_COLUMNS[..]);
+    }
+
     #[test]
     fn an_unknown_stored_status_names_the_shot_and_frame() {
         let mut record = trajectory_record(&TrajectoryRow {
