@@ -3,8 +3,8 @@
 
 use anyhow::Context;
 use bouncelab_overlay::{
-    BallMark, ContactRule, Crop, Levels, OverlayError, Phase, PngSpeed, SheetLayout, Status, StripFrame, Style,
-    SurfaceLine, annotate_frame, choose_key_frames, encode_png, encode_png_with, key_frame_strip,
+    BallMark, ContactRule, Crop, Levels, Phase, PngSpeed, SheetLayout, StripFrame, Style, SurfaceLine, annotate_frame,
+    choose_key_frames, encode_png, encode_png_with, key_frame_strip,
 };
 use bouncelab_track::Track;
 use std::collections::HashMap;
@@ -47,28 +47,25 @@ enum LevelsArg {
 }
 
 /// The ball of every tracked frame, by frame index, and the surface line, as the overlay's plain data.
-fn marks_of(track: &Track) -> anyhow::Result<(Vec<BallMark>, Option<SurfaceLine>)> {
-    let mut marks = Vec::with_capacity(track.fixes.len());
-    for f in &track.fixes {
-        let status = Status::from_name(f.status.name()).ok_or_else(|| OverlayError::UnknownStatus {
-            frame: f.frame as u64,
-            name: f.status.name().to_string(),
-        })?;
-        marks.push(BallMark {
+fn marks_of(track: &Track) -> (Vec<BallMark>, Option<SurfaceLine>) {
+    let marks = track
+        .fixes
+        .iter()
+        .map(|f| BallMark {
             frame: f.frame as u64,
             x_px: f.x_px,
             y_px: f.y_px,
             r_px: f.r_px,
-            status,
+            status: f.status,
             phase: Phase::Unknown,
-        });
-    }
+        })
+        .collect();
     let line = track.surface.map(|l| SurfaceLine {
         x0: l.x0,
         y0: l.y0,
         slope: l.slope,
     });
-    Ok((marks, line))
+    (marks, line)
 }
 
 /// The default step: every frame up to `DEFAULT_MAX_PICTURES`, else the smallest step giving at most that many.
@@ -95,7 +92,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         .unwrap_or_else(|| Path::new("bouncelab-results").join("overlay").join(&name));
     std::fs::create_dir_all(&out).with_context(|| format!("creating the output folder {}", out.display()))?;
     let (clip, track) = super::track::track_clip_dir(&a.clip_dir, &a.tracking)?;
-    let (mut marks, line) = marks_of(&track)?;
+    let (mut marks, line) = marks_of(&track);
     let rule = ContactRule {
         radius_px: track.scale.map(|s| s.radius_px),
         ..ContactRule::default()

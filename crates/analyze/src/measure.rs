@@ -9,8 +9,8 @@ use crate::{AnalyzeError, Progress, Stage};
 use bouncelab_estimate::{Conditions, Estimate, estimate_with_frames, saturation_flag};
 use bouncelab_frames::{ClipEntry, Downslope, ReadOptions, Session};
 use bouncelab_store::{
-    ClipFingerprint, EstimateRecord, Fingerprint, SessionRecord, ShotRecord, Store, TrackRecord, TrajectoryRecord,
-    ValueSe, fingerprint_clip_dir,
+    ClipFingerprint, EstimateRecord, Fingerprint, SessionRecord, ShotRecord, Store, TrackRecord, ValueSe,
+    fingerprint_clip_dir,
 };
 use bouncelab_track::{ClipTracking, Track, track_clip};
 use rayon::prelude::*;
@@ -114,7 +114,43 @@ pub fn measure_session(
             holder.map_or_else(|| "process unknown".to_string(), |p| format!("process {p}"))
         ))
     })?;
-    // A row whose clip cannot be opened fails as a shot, with its reason, and the session goes on.
+    record_unusable(session, store, session_id, progress, &mut summary)?;
+    let jobs = shots_to_measure(session, store, session_id, gravity, fingerprint, &mut summary)?;
+    progress.start(Stage::Track, jobs.len() as u64);
+    measure_and_store(&jobs, store, gravity, progress, &mut summary)?;
+    // Shots reused from the store may have failed before: list them too (those still listed).
+    let listed = session.listed();
+    for row in store.shots(session_id)? {
+        if row.status == bouncelab_store::ShotStatus::Failed
+            && listed.contains(&row.record.clip.as_str())
+            && !summary.failed.iter().any(|(c, _)| *c == row.record.clip)
+        {
+            summary
+                .failed
+                .push((row.record.clip.clone(), row.error.clone().unwrap_or_default()));
+        }
+    }
+    progress.finish(
+        Stage::Track,
+        &format!(
+            "{} shot(s) tracked, {} reused, {} failed",
+            summary.measured.len(),
+            summary.reused.len(),
+            summary.failed.len()
+        ),
+    );
+    Ok(summary)
+}
+
+/// Records each row of `clips.csv` whose clip cannot be opened as a failed shot, with its reason: the
+/// session goes on without it.
+fn record_unusable(
+    session: &Session,
+    store: &mut Store,
+    session_id: i64,
+    progress: &dyn Progress,
+    summary: &mut MeasureSummary,
+) -> Result<(), AnalyzeError> {
     for u in &session.unusable {
         let record = ShotRecord {
             clip: u.name.clone(),
@@ -132,6 +168,19 @@ pub fn measure_session(
         progress.note(&format!("{}: {}", u.name, u.reason));
         summary.failed.push((u.name.clone(), u.reason.clone()));
     }
+    Ok(())
+}
+
+/// Stores every clip's shot with its fingerprint and returns those that must be tracked; the others are
+/// listed as reused.
+fn shots_to_measure<'a>(
+    session: &'a Session,
+    store: &mut Store,
+    session_id: i64,
+    gravity: f64,
+    fingerprint: ClipFingerprint,
+    summary: &mut MeasureSummary,
+) -> Result<Vec<Job<'a>>, AnalyzeError> {
     let mut jobs = Vec::new();
     for entry in &session.clips {
         let hash = fingerprint_clip_dir(&entry.dir, &settings_text(entry, gravity), fingerprint)?;
@@ -151,11 +200,22 @@ pub fn measure_session(
             summary.reused.push(entry.name.clone());
         }
     }
-    progress.start(Stage::Track, jobs.len() as u64);
+    Ok(jobs)
+}
+
+/// Measures the `jobs` on rayon's threads while this thread writes each result in one transaction (track,
+/// trajectory and estimate together), as it arrives. After a store error the remaining shots stay pending
+/// and the error is returned.
+fn measure_and_store(
+    jobs: &[Job<'_>],
+    store: &mut Store,
+    gravity: f64,
+    progress: &dyn Progress,
+    summary: &mut MeasureSummary,
+) -> Result<(), AnalyzeError> {
     let (tx, rx) = mpsc::channel();
     let mut store_error = None;
     std::thread::scope(|scope| {
-        let jobs = &jobs;
         scope.spawn(move || {
             jobs.par_iter().for_each_with(tx, |tx, job| {
                 let result = measure_clip(job.entry, gravity);
@@ -189,31 +249,10 @@ pub fn measure_session(
             progress.advance(Stage::Track, 1);
         }
     });
-    if let Some(e) = store_error {
-        return Err(e.into());
+    match store_error {
+        Some(e) => Err(e.into()),
+        None => Ok(()),
     }
-    // Shots reused from the store may have failed before: list them too (those still listed).
-    let listed = session.listed();
-    for row in store.shots(session_id)? {
-        if row.status == bouncelab_store::ShotStatus::Failed
-            && listed.contains(&row.record.clip.as_str())
-            && !summary.failed.iter().any(|(c, _)| *c == row.record.clip)
-        {
-            summary
-                .failed
-                .push((row.record.clip.clone(), row.error.clone().unwrap_or_default()));
-        }
-    }
-    progress.finish(
-        Stage::Track,
-        &format!(
-            "{} shot(s) tracked, {} reused, {} failed",
-            summary.measured.len(),
-            summary.reused.len(),
-            summary.failed.len()
-        ),
-    );
-    Ok(summary)
 }
 
 type Measured = Result<(TrackRecord, Result<EstimateRecord, String>), String>;
@@ -284,38 +323,29 @@ fn track_record(
         warnings: track.warnings.clone(),
         seconds,
         camera: None,
-        rows: rows
-            .into_iter()
-            .map(|r| TrajectoryRecord {
-                frame: r.frame as u64,
-                t_s: r.t_s,
-                x_px: r.x_px,
-                y_px: r.y_px,
-                r_px: r.r_px,
-                sigma_px: r.sigma_px,
-                quality: r.quality,
-                status: r.status.to_string(),
-                x_m: r.x_m,
-                y_m: r.y_m,
-            })
-            .collect(),
+        rows: rows.iter().map(crate::shots::trajectory_record).collect(),
     }
 }
 
+/// An estimate's measured quantities in the order of [`bouncelab_store::ESTIMATE_QUANTITIES`], in the units
+/// their column names give: what the store's `estimates` table and `estimates.csv` both hold.
+pub(crate) fn estimate_quantities(e: &Estimate) -> [Option<ValueSe>; 10] {
+    let v = |m: bouncelab_estimate::Measured| Some(ValueSe::new(m.value, m.se));
+    [
+        v(e.v_in[0]),
+        v(e.v_in[1]),
+        v(e.v_out[0]),
+        v(e.v_out[1]),
+        v(e.cor),
+        // + 0.0: a friction of zero is written 0, not −0.
+        Some(ValueSe::new(e.mu.value + 0.0, e.mu.se)),
+        v(e.contact_ms),
+        Some(ValueSe::new(e.delta_max_m.value * 1e3, e.delta_max_m.se * 1e3)),
+        e.spin_in.and_then(v),
+        e.spin_out.and_then(v),
+    ]
+}
+
 fn estimate_record(e: &Estimate) -> EstimateRecord {
-    let v = |m: bouncelab_estimate::Measured| ValueSe::new(m.value, m.se);
-    EstimateRecord {
-        v_in_t: v(e.v_in[0]),
-        v_in_n: v(e.v_in[1]),
-        v_out_t: v(e.v_out[0]),
-        v_out_n: v(e.v_out[1]),
-        cor: v(e.cor),
-        mu: v(e.mu),
-        contact_ms: v(e.contact_ms),
-        spin_in: e.spin_in.map(v),
-        spin_out: e.spin_out.map(v),
-        delta_max_m: v(e.delta_max_m),
-        notes: e.notes.clone(),
-        detail: serde_json::to_string(e).ok(),
-    }
+    EstimateRecord::from_quantities(estimate_quantities(e), e.notes.clone(), serde_json::to_string(e).ok())
 }

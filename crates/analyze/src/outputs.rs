@@ -4,41 +4,45 @@
 use crate::{AnalyzeError, ShotData};
 use bouncelab_fit::FitResult;
 use bouncelab_report as r;
+use bouncelab_store::ESTIMATE_QUANTITIES as Q;
+use bouncelab_track::{TRAJECTORY_COLUMNS, TrajectoryRow};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// The columns of `estimates.csv`, in order. Every name ends in its unit (`_m_s`, `_ms`, `_mm`, `_deg`,
 /// `_rad_s`, `_m_s2`, `_s`, `_m`); `cor`, `mu_eff`, their `_se` and `chi2_red_flight` are dimensionless. A
-/// standard error is `<quantity>_se_<unit>` (see `docs/outputs.md`).
+/// standard error is `<quantity>_se_<unit>` (see `docs/outputs.md`). The measured quantities' columns are the
+/// store's `estimates` columns ([`Q`], `bouncelab_store::ESTIMATE_QUANTITIES`), so the file and the table name
+/// them alike.
 pub const ESTIMATE_COLUMNS: [&str; 43] = [
     "clip",
     "surface",
     "angle_deg",
     "drop_height_m",
-    "v_in_t_m_s",
-    "v_in_t_se_m_s",
-    "v_in_n_m_s",
-    "v_in_n_se_m_s",
-    "v_out_t_m_s",
-    "v_out_t_se_m_s",
-    "v_out_n_m_s",
-    "v_out_n_se_m_s",
+    Q[0][0],
+    Q[0][1],
+    Q[1][0],
+    Q[1][1],
+    Q[2][0],
+    Q[2][1],
+    Q[3][0],
+    Q[3][1],
     "impact_speed_m_s",
     "impact_speed_se_m_s",
     "impact_angle_deg",
     "impact_angle_se_deg",
-    "cor",
-    "cor_se",
-    "mu_eff",
-    "mu_eff_se",
-    "contact_ms",
-    "contact_se_ms",
-    "delta_max_mm",
-    "delta_max_se_mm",
-    "spin_in_rad_s",
-    "spin_in_se_rad_s",
-    "spin_out_rad_s",
-    "spin_out_se_rad_s",
+    Q[4][0],
+    Q[4][1],
+    Q[5][0],
+    Q[5][1],
+    Q[6][0],
+    Q[6][1],
+    Q[7][0],
+    Q[7][1],
+    Q[8][0],
+    Q[8][1],
+    Q[9][0],
+    Q[9][1],
     "peak_decel_track_m_s2",
     "peak_decel_track_se_m_s2",
     "peak_force_track_n",
@@ -163,78 +167,63 @@ pub fn write_estimates_csv(
     let mut w = csv::Writer::from_writer(out);
     w.write_record(ESTIMATE_COLUMNS)?;
     for s in shots {
-        let e = &s.estimate;
-        let m = crate::report::measurement(s, None, ball_mass_kg, gravity);
-        let opt = |m: Option<bouncelab_estimate::Measured>| {
-            m.map_or((String::new(), String::new()), |m| (num(m.value), num(m.se)))
-        };
-        let (si, si_se) = opt(e.spin_in);
-        let (so, so_se) = opt(e.spin_out);
-        let (tilt, tilt_se) = opt(e.surface_tilt_deg);
-        let pair = |v: Option<r::Measured>| {
-            v.map_or((String::new(), String::new()), |a| {
-                (num(a.value), a.se.map_or(String::new(), num))
-            })
-        };
-        let (pd, pd_se) = pair(m.peak_deceleration_track_m_s2);
-        let (pf, pf_se) = pair(m.peak_force_track_n);
-        let (speed, angle) = (m.impact_speed(), m.impact_angle());
-        let worst_chi2 = e.chi2_red.iter().cloned().fold(f64::NAN, f64::max);
-        w.write_record([
-            s.clip.clone(),
-            s.surface.clone(),
-            num(s.angle_deg),
-            num(s.drop_height_m),
-            num(e.v_in[0].value),
-            num(e.v_in[0].se),
-            num(e.v_in[1].value),
-            num(e.v_in[1].se),
-            num(e.v_out[0].value),
-            num(e.v_out[0].se),
-            num(e.v_out[1].value),
-            num(e.v_out[1].se),
-            num(speed.value),
-            speed.se.map_or(String::new(), num),
-            num(angle.value),
-            angle.se.map_or(String::new(), num),
-            num(e.cor.value),
-            num(e.cor.se),
-            num(e.mu.value + 0.0),
-            num(e.mu.se),
-            num(e.contact_ms.value),
-            num(e.contact_ms.se),
-            num(e.delta_max_m.value * 1e3),
-            num(e.delta_max_m.se * 1e3),
-            si,
-            si_se,
-            so,
-            so_se,
-            pd,
-            pd_se,
-            pf,
-            pf_se,
-            num(e.t_touch.value),
-            num(e.t_touch.se),
-            num(e.t_sep.value),
-            num(e.t_sep.se),
-            num(worst_chi2),
-            e.contact_line.map_or(String::new(), |l| l.cue.name().to_string()),
-            tilt,
-            tilt_se,
-            e.flags.join("; "),
-            e.notes.join("; "),
-            files
-                .get(&s.clip)
-                .map_or_else(String::new, |f| format!("trajectories/{f}")),
-        ])?;
+        w.write_record(estimate_cells(s, ball_mass_kg, gravity, files))?;
     }
     w.flush()?;
     Ok(())
 }
 
+/// A value and its standard error as two cells; two empty cells when not measured.
+fn value_se_cells(v: Option<(f64, Option<f64>)>) -> [String; 2] {
+    v.map_or([String::new(), String::new()], |(value, se)| {
+        [num(value), se.map_or(String::new(), num)]
+    })
+}
+
+/// One shot's `estimates.csv` row, in the order of [`ESTIMATE_COLUMNS`]: its conditions, the measured
+/// quantities as the store holds them ([`crate::measure::estimate_quantities`]) with the impact's speed and
+/// angle after the velocities, then what is derived from the track and the estimate's own account.
+fn estimate_cells(s: &ShotData, ball_mass_kg: f64, gravity: f64, files: &TrajectoryFiles) -> Vec<String> {
+    let e = &s.estimate;
+    let m = crate::report::measurement(s, None, ball_mass_kg, gravity);
+    let stored = crate::measure::estimate_quantities(e).map(|q| value_se_cells(q.map(|v| (v.value, Some(v.se)))));
+    let pair = |v: Option<r::Measured>| value_se_cells(v.map(|a| (a.value, a.se)));
+    let (speed, angle) = (m.impact_speed(), m.impact_angle());
+    let worst_chi2 = e.chi2_red.iter().cloned().fold(f64::NAN, f64::max);
+    let mut cells = vec![
+        s.clip.clone(),
+        s.surface.clone(),
+        num(s.angle_deg),
+        num(s.drop_height_m),
+    ];
+    cells.extend(stored[..4].iter().flatten().cloned());
+    cells.extend(pair(Some(speed)));
+    cells.extend(pair(Some(angle)));
+    cells.extend(stored[4..].iter().flatten().cloned());
+    cells.extend(pair(m.peak_deceleration_track_m_s2));
+    cells.extend(pair(m.peak_force_track_n));
+    cells.extend([
+        num(e.t_touch.value),
+        num(e.t_touch.se),
+        num(e.t_sep.value),
+        num(e.t_sep.se),
+    ]);
+    cells.push(num(worst_chi2));
+    cells.push(e.contact_line.map_or(String::new(), |l| l.cue.name().to_string()));
+    cells.extend(value_se_cells(e.surface_tilt_deg.map(|t| (t.value, Some(t.se)))));
+    cells.push(e.flags.join("; "));
+    cells.push(e.notes.join("; "));
+    cells.push(
+        files
+            .get(&s.clip)
+            .map_or_else(String::new, |f| format!("trajectories/{f}")),
+    );
+    cells
+}
+
 /// `trajectories/<clip>.csv`: the `docs/outputs.md` columns of every frame.
 fn write_trajectory(out: &mut dyn Write, s: &ShotData) -> Result<(), csv::Error> {
-    write_track_rows(out, &s.track)
+    write_track_rows(out, &s.rows)
 }
 
 /// Writes `trajectories/<clip>.csv` for tracks whose shots could not be estimated (what was measured of them
@@ -251,8 +240,9 @@ pub(crate) fn write_failed_trajectories(
     })?;
     let mut written = Vec::new();
     for (clip, track) in tracks {
+        let rows = crate::shots::trajectory_rows(clip, &track.rows)?;
         let path = traj.join(file_for(files, clip));
-        write_atomic(&path, |w| write_track_rows(w, track).map_err(csv_io))?;
+        write_atomic(&path, |w| write_track_rows(w, &rows).map_err(csv_io))?;
         written.push(path);
     }
     Ok(written)
@@ -273,12 +263,11 @@ pub(crate) fn write_estimates_only(
     Ok(path)
 }
 
-fn write_track_rows(out: &mut dyn Write, track: &bouncelab_store::TrackRecord) -> Result<(), csv::Error> {
+/// A trajectory's rows under [`TRAJECTORY_COLUMNS`]; a NaN (not measured) is an empty cell.
+fn write_track_rows(out: &mut dyn Write, rows: &[TrajectoryRow]) -> Result<(), csv::Error> {
     let mut w = csv::Writer::from_writer(out);
-    w.write_record([
-        "frame", "t_s", "x_px", "y_px", "r_px", "sigma_px", "quality", "status", "x_m", "y_m",
-    ])?;
-    for r in &track.rows {
+    w.write_record(TRAJECTORY_COLUMNS)?;
+    for r in rows {
         w.write_record([
             r.frame.to_string(),
             num(r.t_s),
@@ -287,7 +276,7 @@ fn write_track_rows(out: &mut dyn Write, track: &bouncelab_store::TrackRecord) -
             num(r.r_px),
             num(r.sigma_px),
             num(r.quality),
-            r.status.clone(),
+            r.status.name().to_string(),
             num(r.x_m),
             num(r.y_m),
         ])?;
@@ -508,121 +497,126 @@ const SURFACE_QUANTITIES: [SurfaceQuantity; 16] = [
 /// `contact_force.csv` (when the report has a contact) and `surfaces.csv`; returns their paths.
 pub(crate) fn write_figure_data(dir: &Path, report: &r::Report) -> Result<Vec<PathBuf>, AnalyzeError> {
     let mut written = Vec::new();
-    let path = dir.join("model_predictions.csv");
-    write_atomic(&path, |out| {
-        let mut w = csv::Writer::from_writer(out);
-        w.write_record(PREDICTION_COLUMNS).map_err(csv_io)?;
-        for sh in &report.shots {
-            let p = report
-                .measurements
-                .iter()
-                .find(|m| m.clip == sh.clip)
-                .and_then(|m| m.model);
-            let f =
-                |g: fn(&r::ShotPrediction) -> f64, scale: f64| p.as_ref().map_or(String::new(), |p| num(g(p) * scale));
-            w.write_record([
-                sh.clip.clone(),
-                sh.surface.clone(),
-                num(sh.angle_deg),
-                f(|p| p.cor, 1.0),
-                f(|p| p.mu_eff, 1.0),
-                f(|p| p.contact_time_s, 1e3),
-                f(|p| p.delta_max_m, 1e3),
-                f(|p| p.spin_out_rad_s, 1.0),
-                f(|p| p.peak_force_n, 1.0),
-                f(|p| p.peak_deceleration_m_s2, 1.0),
-                sh.measured.len().to_string(),
-                sh.rms_m.map_or(String::new(), |v| num(v * 1e6)),
-                sh.chi2_red.map_or(String::new(), num),
-                sh.notes.join("; "),
-            ])
-            .map_err(csv_io)?;
-        }
-        w.flush()
-    })?;
-    written.push(path);
-    let path = dir.join("model_curves.csv");
-    write_atomic(&path, |out| {
-        let mut w = csv::Writer::from_writer(out);
-        w.write_record(CURVE_COLUMNS).map_err(csv_io)?;
-        for c in &report.model_curves {
-            for p in &c.points {
-                let q = &p.prediction;
-                w.write_record([
-                    c.surface.clone(),
-                    num(c.angle_deg),
-                    num(p.v_in_n_m_s),
-                    num(q.cor),
-                    num(q.mu_eff),
-                    num(q.contact_time_s * 1e3),
-                    num(q.delta_max_m * 1e3),
-                    num(q.spin_out_rad_s),
-                    num(q.peak_force_n),
-                    num(q.peak_deceleration_m_s2),
-                ])
-                .map_err(csv_io)?;
-            }
-        }
-        w.flush()
-    })?;
-    written.push(path);
-    if let Some(f) = report.contact_force.get() {
-        let path = dir.join("contact_force.csv");
+    let mut write = |name: &str, rows: &dyn Fn(&mut csv::Writer<&mut dyn Write>) -> csv::Result<()>| {
+        let path = dir.join(name);
         write_atomic(&path, |out| {
             let mut w = csv::Writer::from_writer(out);
-            w.write_record(FORCE_COLUMNS).map_err(csv_io)?;
-            for s in &f.samples {
-                w.write_record([
-                    f.clip.clone(),
-                    f.surface.clone(),
-                    num(s.t_s * 1e3),
-                    num(s.delta_m * 1e3),
-                    num(s.force_n),
-                ])
-                .map_err(csv_io)?;
-            }
+            rows(&mut w).map_err(csv_io)?;
             w.flush()
         })?;
         written.push(path);
+        Ok::<(), AnalyzeError>(())
+    };
+    write("model_predictions.csv", &|w| write_predictions(w, report))?;
+    write("model_curves.csv", &|w| write_curves(w, report))?;
+    if let Some(f) = report.contact_force.get() {
+        write("contact_force.csv", &|w| write_contact_force(w, f))?;
     }
-    let path = dir.join("surfaces.csv");
-    write_atomic(&path, |out| {
-        let mut w = csv::Writer::from_writer(out);
-        w.write_record(SURFACE_COLUMNS).map_err(csv_io)?;
-        let mut surfaces: Vec<&str> = Vec::new();
-        for m in &report.measurements {
-            if !surfaces.contains(&m.surface.as_str()) {
-                surfaces.push(&m.surface);
-            }
-        }
-        for s in surfaces {
-            for (name, unit, scale, get) in SURFACE_QUANTITIES {
-                let v: Vec<f64> = report
-                    .measurements
-                    .iter()
-                    .filter(|m| m.surface == s)
-                    .filter_map(get)
-                    .map(|v| v * scale)
-                    .filter(|v| v.is_finite())
-                    .collect();
-                if v.is_empty() {
-                    continue;
-                }
-                let n = v.len() as f64;
-                let mean = v.iter().sum::<f64>() / n;
-                let sd = if v.len() > 1 {
-                    (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
-                } else {
-                    f64::NAN
-                };
-                w.write_record([s, name, unit, &v.len().to_string(), &num(mean), &num(sd)])
-                    .map_err(csv_io)?;
-            }
-        }
-        w.flush()
-    })?;
-    written.push(path);
+    write("surfaces.csv", &|w| write_surfaces(w, report))?;
     Ok(written)
+}
+
+/// `model_predictions.csv`: per shot, the fitted model at its measured incoming velocity and the fit's error.
+fn write_predictions(w: &mut csv::Writer<&mut dyn Write>, report: &r::Report) -> csv::Result<()> {
+    w.write_record(PREDICTION_COLUMNS)?;
+    for sh in &report.shots {
+        let p = report
+            .measurements
+            .iter()
+            .find(|m| m.clip == sh.clip)
+            .and_then(|m| m.model);
+        let f = |g: fn(&r::ShotPrediction) -> f64, scale: f64| p.as_ref().map_or(String::new(), |p| num(g(p) * scale));
+        w.write_record([
+            sh.clip.clone(),
+            sh.surface.clone(),
+            num(sh.angle_deg),
+            f(|p| p.cor, 1.0),
+            f(|p| p.mu_eff, 1.0),
+            f(|p| p.contact_time_s, 1e3),
+            f(|p| p.delta_max_m, 1e3),
+            f(|p| p.spin_out_rad_s, 1.0),
+            f(|p| p.peak_force_n, 1.0),
+            f(|p| p.peak_deceleration_m_s2, 1.0),
+            sh.measured.len().to_string(),
+            sh.rms_m.map_or(String::new(), |v| num(v * 1e6)),
+            sh.chi2_red.map_or(String::new(), num),
+            sh.notes.join("; "),
+        ])?;
+    }
+    Ok(())
+}
+
+/// `model_curves.csv`: the fitted model against the incoming normal speed, per surface and incline.
+fn write_curves(w: &mut csv::Writer<&mut dyn Write>, report: &r::Report) -> csv::Result<()> {
+    w.write_record(CURVE_COLUMNS)?;
+    for c in &report.model_curves {
+        for p in &c.points {
+            let q = &p.prediction;
+            w.write_record([
+                c.surface.clone(),
+                num(c.angle_deg),
+                num(p.v_in_n_m_s),
+                num(q.cor),
+                num(q.mu_eff),
+                num(q.contact_time_s * 1e3),
+                num(q.delta_max_m * 1e3),
+                num(q.spin_out_rad_s),
+                num(q.peak_force_n),
+                num(q.peak_deceleration_m_s2),
+            ])?;
+        }
+    }
+    Ok(())
+}
+
+/// `contact_force.csv`: one contact's force against time and penetration.
+fn write_contact_force(w: &mut csv::Writer<&mut dyn Write>, f: &r::ContactForce) -> csv::Result<()> {
+    w.write_record(FORCE_COLUMNS)?;
+    for s in &f.samples {
+        w.write_record([
+            f.clip.clone(),
+            f.surface.clone(),
+            num(s.t_s * 1e3),
+            num(s.delta_m * 1e3),
+            num(s.force_n),
+        ])?;
+    }
+    Ok(())
+}
+
+/// `surfaces.csv`: per surface (in the order first measured) and quantity, mean, sample SD and count.
+fn write_surfaces(w: &mut csv::Writer<&mut dyn Write>, report: &r::Report) -> csv::Result<()> {
+    w.write_record(SURFACE_COLUMNS)?;
+    let mut surfaces: Vec<&str> = Vec::new();
+    for m in &report.measurements {
+        if !surfaces.contains(&m.surface.as_str()) {
+            surfaces.push(&m.surface);
+        }
+    }
+    for s in surfaces {
+        for (name, unit, scale, get) in SURFACE_QUANTITIES {
+            let v: Vec<f64> = report
+                .measurements
+                .iter()
+                .filter(|m| m.surface == s)
+                .filter_map(get)
+                .map(|v| v * scale)
+                .filter(|v| v.is_finite())
+                .collect();
+            if v.is_empty() {
+                continue;
+            }
+            let n = v.len() as f64;
+            let mean = v.iter().sum::<f64>() / n;
+            let sd = if v.len() > 1 {
+                (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
+            } else {
+                f64::NAN
+            };
+            w.write_record([s, name, unit, &v.len().to_string(), &num(mean), &num(sd)])?;
+        }
+    }
+    Ok(())
 }
 
 /// Where the diagnosis of model version `version` is kept in an output folder.
@@ -683,6 +677,41 @@ mod tests {
         assert!(
             expected == actual,
             "CSV headers changed (refresh with BOUNCELAB_BLESS=1)\n--- expected\n{expected}\n--- actual\n{actual}"
+        );
+    }
+
+    /// `docs/outputs.md` names every column of `estimates.csv` (a standard error either by name or as the
+    /// `(+ `_se_`)` of its quantity's line) and the trajectory columns in order.
+    #[test]
+    fn the_outputs_doc_names_every_estimate_and_trajectory_column() {
+        let doc = include_str!("../../../docs/outputs.md");
+        let section = |title: &str| {
+            let start = doc
+                .find(title)
+                .unwrap_or_else(|| panic!("{title} not in docs/outputs.md"));
+            let rest = &doc[start + title.len()..];
+            &rest[..rest.find("\n## ").unwrap_or(rest.len())]
+        };
+        let estimates = section("## `estimates.csv`");
+        for c in ESTIMATE_COLUMNS {
+            let named = estimates.contains(&format!("`{c}`"));
+            let by_quantity = c.contains("_se_") && {
+                let value = format!("`{}`", c.replacen("_se_", "_", 1));
+                estimates
+                    .lines()
+                    .any(|l| l.contains(&value) && l.contains("(+ `_se_`)"))
+            };
+            assert!(
+                named || by_quantity,
+                "estimates.csv column {c} is not in docs/outputs.md"
+            );
+        }
+        let words: Vec<&str> = section("## The rest").split_whitespace().collect();
+        assert!(
+            words
+                .join(" ")
+                .contains(&format!("(`{}`)", TRAJECTORY_COLUMNS.join(", "))),
+            "docs/outputs.md does not list the trajectory columns {TRAJECTORY_COLUMNS:?}"
         );
     }
 

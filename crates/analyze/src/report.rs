@@ -1060,23 +1060,18 @@ fn draw_key_frames(report: &mut r::Report, shots: &[ShotData], clips: &[bouncela
 fn key_frame_strip(entry: &bouncelab_frames::ClipEntry, shot: &ShotData) -> Result<r::FrameImage, String> {
     use bouncelab_overlay as o;
     let clip = entry.open().map_err(|e| e.to_string())?;
-    let marks = shot
-        .track
+    let marks: Vec<o::BallMark> = shot
         .rows
         .iter()
-        .map(|row| {
-            let status = o::Status::from_name(&row.status)
-                .ok_or_else(|| format!("frame {}: unknown status `{}`", row.frame, row.status))?;
-            Ok(o::BallMark {
-                frame: row.frame,
-                x_px: row.x_px,
-                y_px: row.y_px,
-                r_px: row.r_px,
-                status,
-                phase: o::Phase::Unknown,
-            })
+        .map(|row| o::BallMark {
+            frame: row.frame as u64,
+            x_px: row.x_px,
+            y_px: row.y_px,
+            r_px: row.r_px,
+            status: row.status,
+            phase: o::Phase::Unknown,
         })
-        .collect::<Result<Vec<_>, String>>()?;
+        .collect();
     let line = shot.estimate.contact_line.map(|l| o::SurfaceLine {
         x0: l.x0,
         y0: l.y0,

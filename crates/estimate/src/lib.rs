@@ -10,17 +10,19 @@
 
 mod ballistic;
 mod contact;
+mod phase;
 mod roll;
 mod shot;
 mod spin;
+mod with_frames;
 
 pub use ballistic::{BallisticFit, fit_ballistic, fit_free_acceleration};
 pub use contact::{HeightPoint, TrajectoryContact, find_impact, trajectory_contact};
+pub use phase::{Phase, PhaseFrames};
 pub use roll::session_tilt_deg;
 pub use shot::{
-    Conditions, Estimate, EstimateError, GravityCheck, MIN_FLIGHT_FRAMES, MIN_SIGMA_PX, Measured, PhaseFrames,
-    estimate, saturation_flag,
+    Conditions, Estimate, EstimateError, GravityCheck, MIN_FLIGHT_FRAMES, MIN_SIGMA_PX, Measured, estimate,
+    saturation_flag,
 };
-pub use spin::{
-    Rotation, Spin, SpinFrame, SpinOptions, estimate_with_frames, measure_spin, rotation_between, spin_from_frames,
-};
+pub use spin::{Rotation, Spin, SpinImage, SpinOptions, measure_spin, rotation_between, spin_from_frames};
+pub use with_frames::estimate_with_frames;

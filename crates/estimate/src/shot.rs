@@ -2,7 +2,8 @@
 
 use crate::ballistic::{BallisticFit, fit_ballistic, fit_free_acceleration};
 use crate::contact::{HeightPoint, TrajectoryContact, find_impact, trajectory_contact};
-use bouncelab_track::{LineCue, Status, SurfaceFrame, SurfaceLine, Track};
+use crate::phase::PhaseFrames;
+use bouncelab_track::{LineCue, SurfaceFrame, SurfaceLine, Track};
 use serde::{Deserialize, Serialize};
 
 /// The conditions of a shot that the video does not show.
@@ -65,19 +66,6 @@ impl Measured {
     fn new(value: f64, se: f64) -> Self {
         Measured { value, se }
     }
-}
-
-/// Frame indices (first, last) of each phase, and the frames each flight fit used.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct PhaseFrames {
-    /// Incoming flight: first and last frame fitted.
-    pub flight_in: (usize, usize),
-    /// Frames with the ball on (or within a pixel of) the surface.
-    pub contact: (usize, usize),
-    /// Outgoing flight: first and last frame fitted.
-    pub flight_out: (usize, usize),
-    /// Frames in each fit (in, out).
-    pub fitted: (usize, usize),
 }
 
 /// The per-shot results (local frame of `docs/outputs.md`: t along the surface down-slope, n along the normal).
@@ -248,75 +236,13 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
     c.check()?;
     let scale = track.scale.ok_or(EstimateError::NoScale)?;
     let s = scale.m_per_px;
-    let measured: Vec<&bouncelab_track::BallFix> = track
-        .fixes
-        .iter()
-        .filter(|f| matches!(f.status, Status::Ok | Status::Occluded) && f.x_px.is_finite() && f.y_px.is_finite())
-        .collect();
-    if measured.len() < 2 * MIN_FLIGHT_FRAMES {
-        return Err(EstimateError::FlightTooShort {
-            phase: "incoming",
-            frames: measured.len(),
-            needed: 2 * MIN_FLIGHT_FRAMES,
-            which: "holds too few measured frames",
-        });
-    }
+    let measured = fitted_fixes(track)?;
     let beta = c.incline_deg.to_radians();
     let choice = contact_line(track, &measured, scale.radius_px, -c.gravity * beta.cos() / s)?;
     let line = choice.line;
-    // The frame's origin: on the line, below the lowest centre.
-    let lowest = measured
-        .iter()
-        .min_by(|a, b| {
-            line.height_of(a.x_px, a.y_px)
-                .total_cmp(&line.height_of(b.x_px, b.y_px))
-        })
-        .expect("measured frames");
-    let frame = SurfaceFrame::on_line(&line, lowest.x_px, lowest.y_px, track.downslope_negative_x, s);
-    let points: Vec<Point> = measured
-        .iter()
-        .map(|f| {
-            let (x, y) = frame.to_local(f.x_px, f.y_px);
-            Point {
-                frame: f.frame,
-                t: f.t_s,
-                x,
-                y,
-                sigma: f.sigma_px.max(MIN_SIGMA_PX) * s,
-                clearance_px: y / s - scale.radius_px,
-            }
-        })
-        .collect();
-    let low = (0..points.len())
-        .min_by(|&a, &b| points[a].clearance_px.total_cmp(&points[b].clearance_px))
-        .expect("measured frames");
-    if points[low].clearance_px > CLEARANCE_MARGIN_PX {
-        // The trajectory's own account (a fall with its speed) says more than the clearance.
-        return Err(choice.no_impact.unwrap_or(EstimateError::NoContact {
-            clearance_px: points[low].clearance_px,
-        }));
-    }
-    // The contact: the run of frames around the lowest one within the margin of the surface.
-    let near = |p: &Point| p.clearance_px <= CLEARANCE_MARGIN_PX;
-    let (mut first, mut last) = (low, low);
-    while first > 0 && near(&points[first - 1]) {
-        first -= 1;
-    }
-    while last + 1 < points.len() && near(&points[last + 1]) {
-        last += 1;
-    }
-    let incoming: Vec<&Point> = points[..first].iter().filter(|p| !near(p)).collect();
-    let outgoing: Vec<&Point> = points[last + 1..].iter().filter(|p| !near(p)).collect();
-    for (phase, set, which) in [("incoming", &incoming, "starts"), ("outgoing", &outgoing, "ends")] {
-        if set.len() < MIN_FLIGHT_FRAMES {
-            return Err(EstimateError::FlightTooShort {
-                phase,
-                frames: set.len(),
-                needed: MIN_FLIGHT_FRAMES,
-                which,
-            });
-        }
-    }
+    let (frame, points) = local_points(track, &measured, &line, &scale);
+    let (first, last) = contact_run(&points, choice.no_impact)?;
+    let (incoming, outgoing) = flights(&points, first, last)?;
     let beta = c.incline_deg.to_radians();
     let a = [c.gravity * beta.sin(), -c.gravity * beta.cos()];
     let fit = |set: &[&Point], phase| {
@@ -326,116 +252,41 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
     let fin = fit(&incoming, "incoming")?;
     let fout = fit(&outgoing, "outgoing")?;
     let radius = c.ball_diameter_m / 2.0;
-    // Uncertainty of "one radius above the surface line" in the local frame, m: all of it for this shot's
-    // errors (the line's scatter and its edge's definition as a uniform Type-B term, the scale's at one
-    // radius), and for a fit's per-shot level only the shot-to-shot part, without the Type-B terms that a
-    // surface's clips share (see `Estimate::surface_sigma_m`).
-    // A level taken from the trajectory is where the centre was at the touch, one radius above a line put
-    // one radius below it: the scale's error in that radius cancels.
-    let radius_scale = if line.cue == LineCue::Trajectory {
-        0.0
-    } else {
-        radius / s
-    };
-    let sigma_level = ((line.sigma_y0.powi(2) + line.edge_definition_px.powi(2) / 3.0) * s * s
-        + (radius_scale * scale.sigma_m_per_px).powi(2))
-    .sqrt();
-    let scatter_scale = (scale.sigma_m_per_px.powi(2) - scale.sigma_shape_m_per_px.powi(2))
-        .max(0.0)
-        .sqrt();
-    let sigma_level_scatter = ((line.sigma_y0 * s).powi(2) + (radius_scale * scatter_scale).powi(2)).sqrt();
-    // The frame's axes follow the line's tilt, measured to σθ: a turn of the axes by dθ moves v_n by v_t·dθ
-    // and v_t by v_n·dθ, in both flights alike.
-    let sigma_theta = line.sigma_tilt_deg.to_radians();
+    let level = LevelErrors::of(&line, &scale, radius);
     // The level's error is common to both crossings, so it is carried as a derivative and propagated
     // coherently into the contact time, COR and μ, not added to each crossing separately.
     let touch = crossing(&fin, radius, points[first].t);
     let sep = crossing(&fout, radius, points[last].t);
-    let with_level = |c: &Crossing| Measured::new(c.t.value, c.t.se.hypot(c.dt_dlevel * sigma_level));
+    let with_level = |c: &Crossing| Measured::new(c.t.value, c.t.se.hypot(c.dt_dlevel * level.sigma));
     let (t_touch, t_sep) = (with_level(&touch), with_level(&sep));
-    let rel_scale = scale.sigma_m_per_px / s;
-    // Per velocity component at a crossing: the value, the fit's error (for ratios, where the scale and the
-    // level's common part are propagated separately), its derivative with the level, and the total error.
-    let velocity = |f: &BallisticFit, c: &Crossing| {
-        let v = f.velocity(c.t.value);
-        [0, 1].map(|k| {
-            let (_, sv, _) = f.errors_at(k, c.t.value);
-            let stat = (sv * sv + (f.a[k] * c.t.se).powi(2)).sqrt();
-            let dv_dlevel = f.a[k] * c.dt_dlevel;
-            let tilt = v[1 - k] * sigma_theta;
-            let total =
-                (stat * stat + (dv_dlevel * sigma_level).powi(2) + (v[k] * rel_scale).powi(2) + tilt * tilt).sqrt();
-            VelocityPart {
-                value: v[k],
-                stat,
-                dv_dlevel,
-                total,
-            }
-        })
-    };
-    let vin = velocity(&fin, &touch);
-    let vout = velocity(&fout, &sep);
-    let cor = (vout[1].value / vin[1].value).abs();
-    let cor_level = cor * (vout[1].dv_dlevel / vout[1].value - vin[1].dv_dlevel / vin[1].value) * sigma_level;
-    let cor_tilt = cor * (vout[0].value / vout[1].value - vin[0].value / vin[1].value) * sigma_theta;
-    let cor_se = (cor * cor * ((vin[1].stat / vin[1].value).powi(2) + (vout[1].stat / vout[1].value).powi(2))
-        + cor_level * cor_level
-        + cor_tilt * cor_tilt)
-        .sqrt();
-    let (dvt, dvn) = (vout[0].value - vin[0].value, vout[1].value - vin[1].value);
-    let mu = -dvt / dvn;
-    let (ddvt, ddvn) = (
-        vout[0].dv_dlevel - vin[0].dv_dlevel,
-        vout[1].dv_dlevel - vin[1].dv_dlevel,
-    );
-    let mu_level = (-ddvt / dvn + dvt * ddvn / (dvn * dvn)) * sigma_level;
-    let mu_tilt = (1.0 + mu * mu) * sigma_theta;
-    let mu_se = ((vin[0].stat.powi(2) + vout[0].stat.powi(2)) / (dvn * dvn)
-        + (dvt / (dvn * dvn)).powi(2) * (vin[1].stat.powi(2) + vout[1].stat.powi(2))
-        + mu_level * mu_level
-        + mu_tilt * mu_tilt)
-        .sqrt();
+    let vin = velocity_parts(&fin, &touch, &level);
+    let vout = velocity_parts(&fout, &sep, &level);
+    let cor = restitution(&vin, &vout, &level);
+    let mu = friction(&vin, &vout, &level);
     let contact_se =
-        (touch.t.se.powi(2) + sep.t.se.powi(2) + ((sep.dt_dlevel - touch.dt_dlevel) * sigma_level).powi(2)).sqrt();
+        (touch.t.se.powi(2) + sep.t.se.powi(2) + ((sep.dt_dlevel - touch.dt_dlevel) * level.sigma).powi(2)).sqrt();
     let contact = &points[first..=last];
-    let (t_max, delta_max) = deepest(contact, radius, sigma_level, rel_scale);
+    let (t_max, delta_max) = deepest(contact, radius, level.sigma, level.rel_scale);
     let mut notes = choice.notes;
-    let mut flags = impossible(vin[1].value, vout[1].value, cor, mu, t_touch.value, t_sep.value);
+    let mut flags = impossible(
+        vin[1].value,
+        vout[1].value,
+        cor.value,
+        mu.value,
+        t_touch.value,
+        t_sep.value,
+    );
     flags.extend(saturation_flag(track));
     let gravity = gravity_check(&incoming, &outgoing, a, c.gravity);
     if let Some(g) = &gravity {
-        if !g.consistent {
-            flags.push(format!(
-                "the ball's flight accelerates at ({:.2} ± {:.2}, {:.2} ± {:.2}) m/s² along and across the surface, not gravity's ({:.2}, {:.2}) on a {}° incline: a wrong frame rate, scale or incline, repeated frames, or not the ball",
-                g.measured[0].value,
-                g.measured[0].se,
-                g.measured[1].value,
-                g.measured[1].se,
-                g.expected[0],
-                g.expected[1],
-                c.incline_deg
-            ));
-        } else if g.inconclusive {
-            notes.push(format!(
-                "the flights are too short to check that the ball falls like a ball (acceleration {:.1} ± {:.1} m/s² across the surface)",
-                g.measured[1].value, g.measured[1].se
-            ));
-        }
+        note_gravity(g, c.incline_deg, &mut flags, &mut notes);
     }
-    for (name, f) in [("incoming", &fin), ("outgoing", &fout)] {
-        let worst = f.chi2_red[0].max(f.chi2_red[1]);
-        if worst > 4.0 {
-            notes.push(format!(
-                "{name} flight scatters {:.1}× more than the tracker's σ (reduced χ² {worst:.1}): errors inflated accordingly",
-                worst.sqrt()
-            ));
-        }
-    }
+    note_scatter(&fin, &fout, &mut notes);
     Ok(Estimate {
         v_in: vin.map(|v| Measured::new(v.value, v.total)),
         v_out: vout.map(|v| Measured::new(v.value, v.total)),
-        cor: Measured::new(cor, cor_se),
-        mu: Measured::new(mu, mu_se),
+        cor,
+        mu,
         contact_ms: Measured::new((t_sep.value - t_touch.value) * 1e3, contact_se * 1e3),
         t_touch,
         t_max,
@@ -452,7 +303,7 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
         chi2_red: [fin.chi2_red[0], fin.chi2_red[1], fout.chi2_red[0], fout.chi2_red[1]],
         flight_in: fin,
         flight_out: fout,
-        surface_sigma_m: sigma_level_scatter,
+        surface_sigma_m: level.sigma_scatter,
         contact_line: Some(line),
         frame: Some(frame),
         surface_tilt_deg: track
@@ -466,9 +317,233 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
     })
 }
 
-/// What no bounce of a ball can give, each as a sentence: the ball must come in towards the surface and leave
-/// it, with COR in [0, 1.05] (a little over 1 for the measurement's error), a contact of 0.1–50 ms that
-/// starts before it ends, and |μ_eff| ≤ 1.5.
+/// The fixes a fit weighs ([`bouncelab_track::Status::fitted`] with a finite centre); an error when they
+/// cannot hold two flights.
+fn fitted_fixes(track: &Track) -> Result<Vec<&bouncelab_track::BallFix>, EstimateError> {
+    let measured: Vec<&bouncelab_track::BallFix> = track
+        .fixes
+        .iter()
+        .filter(|f| f.status.fitted() && f.x_px.is_finite() && f.y_px.is_finite())
+        .collect();
+    if measured.len() < 2 * MIN_FLIGHT_FRAMES {
+        return Err(EstimateError::FlightTooShort {
+            phase: "incoming",
+            frames: measured.len(),
+            needed: 2 * MIN_FLIGHT_FRAMES,
+            which: "holds too few measured frames",
+        });
+    }
+    Ok(measured)
+}
+
+/// The local frame on `line` (origin on it, below the lowest centre) and the fixes in it, m, with their
+/// clearance above the line, px.
+fn local_points(
+    track: &Track,
+    measured: &[&bouncelab_track::BallFix],
+    line: &SurfaceLine,
+    scale: &bouncelab_track::Scale,
+) -> (SurfaceFrame, Vec<Point>) {
+    let s = scale.m_per_px;
+    let lowest = measured
+        .iter()
+        .min_by(|a, b| {
+            line.height_of(a.x_px, a.y_px)
+                .total_cmp(&line.height_of(b.x_px, b.y_px))
+        })
+        .expect("measured frames");
+    let frame = SurfaceFrame::on_line(line, lowest.x_px, lowest.y_px, track.downslope_negative_x, s);
+    let points: Vec<Point> = measured
+        .iter()
+        .map(|f| {
+            let (x, y) = frame.to_local(f.x_px, f.y_px);
+            Point {
+                frame: f.frame,
+                t: f.t_s,
+                x,
+                y,
+                sigma: f.sigma_px.max(MIN_SIGMA_PX) * s,
+                clearance_px: y / s - scale.radius_px,
+            }
+        })
+        .collect();
+    (frame, points)
+}
+
+/// The contact: the run of points (first, last) around the lowest one within [`CLEARANCE_MARGIN_PX`] of the
+/// surface; an error when even the lowest is above it (the trajectory's own `no_impact`, a fall with its
+/// speed, says more than the clearance).
+fn contact_run(points: &[Point], no_impact: Option<EstimateError>) -> Result<(usize, usize), EstimateError> {
+    let low = (0..points.len())
+        .min_by(|&a, &b| points[a].clearance_px.total_cmp(&points[b].clearance_px))
+        .expect("measured frames");
+    if points[low].clearance_px > CLEARANCE_MARGIN_PX {
+        return Err(no_impact.unwrap_or(EstimateError::NoContact {
+            clearance_px: points[low].clearance_px,
+        }));
+    }
+    let near = |p: &Point| p.clearance_px <= CLEARANCE_MARGIN_PX;
+    let (mut first, mut last) = (low, low);
+    while first > 0 && near(&points[first - 1]) {
+        first -= 1;
+    }
+    while last + 1 < points.len() && near(&points[last + 1]) {
+        last += 1;
+    }
+    Ok((first, last))
+}
+
+/// The flight points before and after the contact run (first, last), clear of the surface; an error when
+/// either is too short to fit.
+fn flights(points: &[Point], first: usize, last: usize) -> Result<(Vec<&Point>, Vec<&Point>), EstimateError> {
+    let near = |p: &Point| p.clearance_px <= CLEARANCE_MARGIN_PX;
+    let incoming: Vec<&Point> = points[..first].iter().filter(|p| !near(p)).collect();
+    let outgoing: Vec<&Point> = points[last + 1..].iter().filter(|p| !near(p)).collect();
+    for (phase, set, which) in [("incoming", &incoming, "starts"), ("outgoing", &outgoing, "ends")] {
+        if set.len() < MIN_FLIGHT_FRAMES {
+            return Err(EstimateError::FlightTooShort {
+                phase,
+                frames: set.len(),
+                needed: MIN_FLIGHT_FRAMES,
+                which,
+            });
+        }
+    }
+    Ok((incoming, outgoing))
+}
+
+/// The errors of the contact level and the frame's axes that every crossing shares.
+struct LevelErrors {
+    /// Uncertainty of "one radius above the surface line" in the local frame, m: all of it for this shot's
+    /// errors (the line's scatter and its edge's definition as a uniform Type-B term, the scale's at one
+    /// radius).
+    sigma: f64,
+    /// Its shot-to-shot part, m, for a fit's per-shot level: without the Type-B terms that a surface's clips
+    /// share (see `Estimate::surface_sigma_m`).
+    sigma_scatter: f64,
+    /// The tilt's standard error, rad: a turn of the axes by dθ moves v_n by v_t·dθ and v_t by v_n·dθ, in
+    /// both flights alike.
+    sigma_theta: f64,
+    /// The scale's relative standard error.
+    rel_scale: f64,
+}
+
+impl LevelErrors {
+    /// The errors for a contact `line`, at the clip's `scale`, for a ball of `radius` m.
+    fn of(line: &SurfaceLine, scale: &bouncelab_track::Scale, radius: f64) -> Self {
+        let s = scale.m_per_px;
+        // A level taken from the trajectory is where the centre was at the touch, one radius above a line put
+        // one radius below it: the scale's error in that radius cancels.
+        let radius_scale = if line.cue == LineCue::Trajectory {
+            0.0
+        } else {
+            radius / s
+        };
+        let sigma = ((line.sigma_y0.powi(2) + line.edge_definition_px.powi(2) / 3.0) * s * s
+            + (radius_scale * scale.sigma_m_per_px).powi(2))
+        .sqrt();
+        let scatter_scale = (scale.sigma_m_per_px.powi(2) - scale.sigma_shape_m_per_px.powi(2))
+            .max(0.0)
+            .sqrt();
+        let sigma_scatter = ((line.sigma_y0 * s).powi(2) + (radius_scale * scatter_scale).powi(2)).sqrt();
+        LevelErrors {
+            sigma,
+            sigma_scatter,
+            sigma_theta: line.sigma_tilt_deg.to_radians(),
+            rel_scale: scale.sigma_m_per_px / s,
+        }
+    }
+}
+
+/// Per velocity component at a crossing: the value, the fit's error (for ratios, where the scale and the
+/// level's common part are propagated separately), its derivative with the level, and the total error.
+fn velocity_parts(f: &BallisticFit, c: &Crossing, level: &LevelErrors) -> [VelocityPart; 2] {
+    let v = f.velocity(c.t.value);
+    [0, 1].map(|k| {
+        let (_, sv, _) = f.errors_at(k, c.t.value);
+        let stat = (sv * sv + (f.a[k] * c.t.se).powi(2)).sqrt();
+        let dv_dlevel = f.a[k] * c.dt_dlevel;
+        let tilt = v[1 - k] * level.sigma_theta;
+        let total =
+            (stat * stat + (dv_dlevel * level.sigma).powi(2) + (v[k] * level.rel_scale).powi(2) + tilt * tilt).sqrt();
+        VelocityPart {
+            value: v[k],
+            stat,
+            dv_dlevel,
+            total,
+        }
+    })
+}
+
+/// The coefficient of restitution |v_n,out / v_n,in| with its error: the fits', and the level's and the
+/// tilt's, each common to both velocities.
+fn restitution(vin: &[VelocityPart; 2], vout: &[VelocityPart; 2], level: &LevelErrors) -> Measured {
+    let (sigma_level, sigma_theta) = (level.sigma, level.sigma_theta);
+    let cor = (vout[1].value / vin[1].value).abs();
+    let cor_level = cor * (vout[1].dv_dlevel / vout[1].value - vin[1].dv_dlevel / vin[1].value) * sigma_level;
+    let cor_tilt = cor * (vout[0].value / vout[1].value - vin[0].value / vin[1].value) * sigma_theta;
+    let cor_se = (cor * cor * ((vin[1].stat / vin[1].value).powi(2) + (vout[1].stat / vout[1].value).powi(2))
+        + cor_level * cor_level
+        + cor_tilt * cor_tilt)
+        .sqrt();
+    Measured::new(cor, cor_se)
+}
+
+/// The effective friction −Δv_t / Δv_n with its error, propagated as for [`restitution`].
+fn friction(vin: &[VelocityPart; 2], vout: &[VelocityPart; 2], level: &LevelErrors) -> Measured {
+    let (sigma_level, sigma_theta) = (level.sigma, level.sigma_theta);
+    let (dvt, dvn) = (vout[0].value - vin[0].value, vout[1].value - vin[1].value);
+    let mu = -dvt / dvn;
+    let (ddvt, ddvn) = (
+        vout[0].dv_dlevel - vin[0].dv_dlevel,
+        vout[1].dv_dlevel - vin[1].dv_dlevel,
+    );
+    let mu_level = (-ddvt / dvn + dvt * ddvn / (dvn * dvn)) * sigma_level;
+    let mu_tilt = (1.0 + mu * mu) * sigma_theta;
+    let mu_se = ((vin[0].stat.powi(2) + vout[0].stat.powi(2)) / (dvn * dvn)
+        + (dvt / (dvn * dvn)).powi(2) * (vin[1].stat.powi(2) + vout[1].stat.powi(2))
+        + mu_level * mu_level
+        + mu_tilt * mu_tilt)
+        .sqrt();
+    Measured::new(mu, mu_se)
+}
+
+/// A flag when the flights do not fall at gravity's rate on the `incline_deg` incline, a note when they are
+/// too short to tell.
+fn note_gravity(g: &GravityCheck, incline_deg: f64, flags: &mut Vec<String>, notes: &mut Vec<String>) {
+    if !g.consistent {
+        flags.push(format!(
+            "the ball's flight accelerates at ({:.2} ± {:.2}, {:.2} ± {:.2}) m/s² along and across the surface, not gravity's ({:.2}, {:.2}) on a {}° incline: a wrong frame rate, scale or incline, repeated frames, or not the ball",
+            g.measured[0].value,
+            g.measured[0].se,
+            g.measured[1].value,
+            g.measured[1].se,
+            g.expected[0],
+            g.expected[1],
+            incline_deg
+        ));
+    } else if g.inconclusive {
+        notes.push(format!(
+            "the flights are too short to check that the ball falls like a ball (acceleration {:.1} ± {:.1} m/s² across the surface)",
+            g.measured[1].value, g.measured[1].se
+        ));
+    }
+}
+
+/// A note for each flight scattering well beyond the tracker's σ (reduced χ² above 4), whose errors the fit
+/// inflated.
+fn note_scatter(fin: &BallisticFit, fout: &BallisticFit, notes: &mut Vec<String>) {
+    for (name, f) in [("incoming", fin), ("outgoing", fout)] {
+        let worst = f.chi2_red[0].max(f.chi2_red[1]);
+        if worst > 4.0 {
+            notes.push(format!(
+                "{name} flight scatters {:.1}× more than the tracker's σ (reduced χ² {worst:.1}): errors inflated accordingly",
+                worst.sqrt()
+            ));
+        }
+    }
+}
+
 /// Share of a shot's measured frames whose rim may be saturated before the shot is flagged: a few frames
 /// passing a hot spot bias a few centres, which the flight fits' scatter absorbs.
 const SATURATED_FRAMES_SHARE: f64 = 0.05;
@@ -486,6 +561,9 @@ pub fn saturation_flag(track: &Track) -> Option<String> {
     })
 }
 
+/// What no bounce of a ball can give, each as a sentence: the ball must come in towards the surface and leave
+/// it, with COR in [0, 1.05] (a little over 1 for the measurement's error), a contact of 0.1–50 ms that
+/// starts before it ends, and |μ_eff| ≤ 1.5.
 fn impossible(v_in_n: f64, v_out_n: f64, cor: f64, mu: f64, t_touch: f64, t_sep: f64) -> Vec<String> {
     let mut flags = Vec::new();
     if !(v_in_n < 0.0 && v_out_n > 0.0) {
@@ -554,46 +632,8 @@ fn contact_line(
 ) -> Result<ContactChoice, EstimateError> {
     let given = track.surface.filter(|l| l.cue == LineCue::Given);
     let found = track.surface.filter(|l| l.cue != LineCue::Given);
-    // The trajectory in a frame along the best line known (image axes without one).
-    let axis = track
-        .surface
-        .unwrap_or_else(|| SurfaceLine::given((track_width(measured) - 1.0) / 2.0, 0.0, 0.0));
-    let heights: Vec<HeightPoint> = measured
-        .iter()
-        .map(|f| HeightPoint {
-            t: f.t_s,
-            h: axis.height_of(f.x_px, f.y_px),
-            sigma: f.sigma_px.max(MIN_SIGMA_PX),
-        })
-        .collect();
-    let m_per_px = track.scale.map_or(f64::NAN, |s| s.m_per_px);
-    let trajectory: Result<TrajectoryContact, EstimateError> =
-        find_impact(&heights, a_px, m_per_px).and_then(|low| trajectory_contact(&heights, low, a_px, radius_px));
-    // The trajectory's level as a line: one radius below the centre at the touch, parallel to `axis`.
-    let level_line = |tc: &TrajectoryContact| SurfaceLine {
-        y0: axis.y0 + (tc.level_px - radius_px) * -(1.0 + axis.slope * axis.slope).sqrt(),
-        sigma_y0: tc.level_se_px,
-        sigma_tilt_deg: axis.sigma_tilt_deg,
-        columns: 0,
-        edge_definition_px: 0.0,
-        roughness_px: 0.0,
-        cue: LineCue::Trajectory,
-        ..axis
-    };
-    // How far the trajectory's level lies above `line`, px, with its standard error.
-    let relative = |tc: &TrajectoryContact, line: &SurfaceLine| {
-        let l = level_line(tc);
-        let offset = (line.y0 - l.y0) / (1.0 + line.slope * line.slope).sqrt();
-        Measured::new(offset, tc.level_se_px)
-    };
-    // A line agrees with the trajectory when their levels differ by less than 3σ of both plus a pixel (or
-    // 3 % of the radius): gross disagreement means the line is not where the ball lands.
-    let agrees = |m: &Measured, line: &SurfaceLine| {
-        let line_se = (line.sigma_y0.powi(2) + line.edge_definition_px.powi(2) / 3.0).sqrt();
-        m.value.abs() <= 3.0 * m.se.hypot(line_se) + (0.03 * radius_px).max(1.0)
-    };
-    let mut notes = Vec::new();
-    let no_impact = match &trajectory {
+    let view = TrajectoryView::new(track, measured, radius_px, a_px);
+    let no_impact = match &view.trajectory {
         Err(EstimateError::NoImpact {
             frames,
             speed_m_s,
@@ -605,10 +645,11 @@ fn contact_line(
         }),
         _ => None,
     };
+    let mut notes = Vec::new();
     if let Some(line) = given {
-        let trajectory_level_px = trajectory.as_ref().ok().map(|tc| relative(tc, &line));
+        let trajectory_level_px = view.trajectory.as_ref().ok().map(|tc| view.relative(tc, &line));
         if let Some(m) = &trajectory_level_px
-            && !agrees(m, &line)
+            && !view.agrees(m, &line)
         {
             notes.push(format!(
                 "the given contact line is {:.1} ± {:.1} px from where the ball's trajectory puts the contact",
@@ -622,70 +663,8 @@ fn contact_line(
             no_impact,
         });
     }
-    match (found, &trajectory) {
-        (Some(line), Ok(tc)) => {
-            let m = relative(tc, &line);
-            // A trajectory whose touch and separation disagree (an arc it does not follow, such as a
-            // drag-slowed flight) cannot overrule a line that lies between the two.
-            let between = !tc.consistent
-                && tc.separation.is_some_and(|(_, (sep, sep_se))| {
-                    let m_sep = m.value + (sep - tc.touch_level.0);
-                    let tol = 3.0 * m.se.hypot(sep_se) + (0.03 * radius_px).max(1.0);
-                    m.value.min(m_sep) - tol <= 0.0 && 0.0 <= m.value.max(m_sep) + tol
-                });
-            if agrees(&m, &line) || between {
-                if between {
-                    notes.push(format!(
-                        "the ball's touch puts the contact {:.1} ± {:.1} px from the surface line found ({} cue) and its separation on the line's other side: the trajectory contradicts itself, so the line is used",
-                        m.value,
-                        m.se,
-                        line.cue.name()
-                    ));
-                }
-                return Ok(ContactChoice {
-                    line,
-                    trajectory_level_px: Some(m),
-                    notes,
-                    no_impact,
-                });
-            }
-            for alt in track.surface_alternatives.iter().copied() {
-                let ma = relative(tc, &alt);
-                if agrees(&ma, &alt) {
-                    notes.push(format!(
-                        "the first surface line found ({} cue, y = {:.1} px) is {:.1} px from where the ball lands; a lower line ({} cue, y = {:.1} px), which agrees with the ball's trajectory, is used",
-                        line.cue.name(),
-                        line.y0,
-                        m.value,
-                        alt.cue.name(),
-                        alt.y0
-                    ));
-                    return Ok(ContactChoice {
-                        line: alt,
-                        trajectory_level_px: Some(ma),
-                        notes,
-                        no_impact,
-                    });
-                }
-            }
-            notes.push(format!(
-                "the surface line found ({} cue, y = {:.1} px) is {:.1} px from where the ball's trajectory puts the contact: the contact level comes from the trajectory (± {:.2} px)",
-                line.cue.name(),
-                line.y0,
-                m.value,
-                tc.level_se_px
-            ));
-            notes.extend(tc.notes.iter().cloned());
-            Ok(ContactChoice {
-                line: SurfaceLine {
-                    sigma_tilt_deg: line.sigma_tilt_deg,
-                    ..level_line(tc)
-                },
-                trajectory_level_px: Some(Measured::new(0.0, tc.level_se_px)),
-                notes,
-                no_impact,
-            })
-        }
+    match (found, &view.trajectory) {
+        (Some(line), Ok(tc)) => Ok(view.found_or_trajectory(line, tc, &track.surface_alternatives, no_impact)),
         (Some(line), Err(_)) => Ok(ContactChoice {
             line,
             trajectory_level_px: None,
@@ -699,13 +678,150 @@ fn contact_line(
             ));
             notes.extend(tc.notes.iter().cloned());
             Ok(ContactChoice {
-                line: level_line(tc),
+                line: view.level_line(tc),
                 trajectory_level_px: Some(Measured::new(0.0, tc.level_se_px)),
                 notes,
                 no_impact,
             })
         }
         (None, Err(e)) => Err(no_impact.unwrap_or_else(|| EstimateError::NoSurface { why: e.to_string() })),
+    }
+}
+
+/// The ball's trajectory as evidence for the contact level: its heights along the best line known and the
+/// contact they give.
+struct TrajectoryView {
+    /// The line the heights are measured from (image axes without one).
+    axis: SurfaceLine,
+    /// The ball's radius, px.
+    radius_px: f64,
+    /// Where the trajectory puts the contact, or why it cannot.
+    trajectory: Result<TrajectoryContact, EstimateError>,
+}
+
+impl TrajectoryView {
+    fn new(track: &Track, measured: &[&bouncelab_track::BallFix], radius_px: f64, a_px: f64) -> Self {
+        let axis = track
+            .surface
+            .unwrap_or_else(|| SurfaceLine::given((track_width(measured) - 1.0) / 2.0, 0.0, 0.0));
+        let heights: Vec<HeightPoint> = measured
+            .iter()
+            .map(|f| HeightPoint {
+                t: f.t_s,
+                h: axis.height_of(f.x_px, f.y_px),
+                sigma: f.sigma_px.max(MIN_SIGMA_PX),
+            })
+            .collect();
+        let m_per_px = track.scale.map_or(f64::NAN, |s| s.m_per_px);
+        let trajectory =
+            find_impact(&heights, a_px, m_per_px).and_then(|low| trajectory_contact(&heights, low, a_px, radius_px));
+        TrajectoryView {
+            axis,
+            radius_px,
+            trajectory,
+        }
+    }
+
+    /// The trajectory's level as a line: one radius below the centre at the touch, parallel to the axis.
+    fn level_line(&self, tc: &TrajectoryContact) -> SurfaceLine {
+        let axis = self.axis;
+        SurfaceLine {
+            y0: axis.y0 + (tc.level_px - self.radius_px) * -(1.0 + axis.slope * axis.slope).sqrt(),
+            sigma_y0: tc.level_se_px,
+            sigma_tilt_deg: axis.sigma_tilt_deg,
+            columns: 0,
+            edge_definition_px: 0.0,
+            roughness_px: 0.0,
+            cue: LineCue::Trajectory,
+            ..axis
+        }
+    }
+
+    /// How far the trajectory's level lies above `line`, px, with its standard error.
+    fn relative(&self, tc: &TrajectoryContact, line: &SurfaceLine) -> Measured {
+        let l = self.level_line(tc);
+        let offset = (line.y0 - l.y0) / (1.0 + line.slope * line.slope).sqrt();
+        Measured::new(offset, tc.level_se_px)
+    }
+
+    /// A line agrees with the trajectory when their levels differ by less than 3σ of both plus a pixel (or
+    /// 3 % of the radius): gross disagreement means the line is not where the ball lands.
+    fn agrees(&self, m: &Measured, line: &SurfaceLine) -> bool {
+        let line_se = (line.sigma_y0.powi(2) + line.edge_definition_px.powi(2) / 3.0).sqrt();
+        m.value.abs() <= 3.0 * m.se.hypot(line_se) + (0.03 * self.radius_px).max(1.0)
+    }
+
+    /// The line found when the trajectory agrees with it (or contradicts itself across it), else the first
+    /// of the `alternatives` that agrees, else the trajectory's own level.
+    fn found_or_trajectory(
+        &self,
+        line: SurfaceLine,
+        tc: &TrajectoryContact,
+        alternatives: &[SurfaceLine],
+        no_impact: Option<EstimateError>,
+    ) -> ContactChoice {
+        let mut notes = Vec::new();
+        let m = self.relative(tc, &line);
+        // A trajectory whose touch and separation disagree (an arc it does not follow, such as a drag-slowed
+        // flight) cannot overrule a line that lies between the two.
+        let between = !tc.consistent
+            && tc.separation.is_some_and(|(_, (sep, sep_se))| {
+                let m_sep = m.value + (sep - tc.touch_level.0);
+                let tol = 3.0 * m.se.hypot(sep_se) + (0.03 * self.radius_px).max(1.0);
+                m.value.min(m_sep) - tol <= 0.0 && 0.0 <= m.value.max(m_sep) + tol
+            });
+        if self.agrees(&m, &line) || between {
+            if between {
+                notes.push(format!(
+                    "the ball's touch puts the contact {:.1} ± {:.1} px from the surface line found ({} cue) and its separation on the line's other side: the trajectory contradicts itself, so the line is used",
+                    m.value,
+                    m.se,
+                    line.cue.name()
+                ));
+            }
+            return ContactChoice {
+                line,
+                trajectory_level_px: Some(m),
+                notes,
+                no_impact,
+            };
+        }
+        for alt in alternatives.iter().copied() {
+            let ma = self.relative(tc, &alt);
+            if self.agrees(&ma, &alt) {
+                notes.push(format!(
+                    "the first surface line found ({} cue, y = {:.1} px) is {:.1} px from where the ball lands; a lower line ({} cue, y = {:.1} px), which agrees with the ball's trajectory, is used",
+                    line.cue.name(),
+                    line.y0,
+                    m.value,
+                    alt.cue.name(),
+                    alt.y0
+                ));
+                return ContactChoice {
+                    line: alt,
+                    trajectory_level_px: Some(ma),
+                    notes,
+                    no_impact,
+                };
+            }
+        }
+        notes.push(format!(
+            "the surface line found ({} cue, y = {:.1} px) is {:.1} px from where the ball's trajectory puts the contact: the contact level comes from the trajectory (± {:.2} px)",
+            line.cue.name(),
+            line.y0,
+            m.value,
+            tc.level_se_px
+        ));
+        notes.extend(tc.notes.iter().cloned());
+        ContactChoice {
+            line: SurfaceLine {
+                sigma_tilt_deg: line.sigma_tilt_deg,
+                ..self.level_line(tc)
+            },
+            trajectory_level_px: Some(Measured::new(0.0, tc.level_se_px)),
+            notes,
+            no_impact,
+        }
     }
 }
 

@@ -16,7 +16,8 @@
 //! counter-clockwise as seen in the image when down-slope is +x, and clockwise as seen when the image is
 //! mirrored (`downslope = "-x"`), so that the slip v_t + ω·R holds either way.
 
-use crate::shot::{Conditions, Estimate, EstimateError, Measured, PhaseFrames, estimate};
+use crate::phase::PhaseFrames;
+use crate::shot::Measured;
 use bouncelab_frames::{Clip, GrayPixels, PngDecoder};
 use bouncelab_track::{Status, Track};
 use std::collections::HashMap;
@@ -63,7 +64,7 @@ const MIN_WAVELENGTH_PX: f64 = 2.5;
 
 /// One frame of a flight phase: its time, pixels and the ball's circle in it.
 #[derive(Debug, Clone, Copy)]
-pub struct SpinFrame<'a> {
+pub struct SpinImage<'a> {
     /// Time, s.
     pub t_s: f64,
     /// The frame's pixels (8- or 16-bit).
@@ -104,7 +105,7 @@ struct Polar {
 
 /// Samples the ball's interior on the polar grid and keeps the rotating part of each ring's spectrum.
 /// `None` when a sample falls outside the image.
-fn polar(f: &SpinFrame, o: &SpinOptions) -> Option<Polar> {
+fn polar(f: &SpinImage, o: &SpinOptions) -> Option<Polar> {
     let n = o.angles;
     let (w, h) = f.pixels.dimensions();
     let (w, h) = (w as f64, h as f64);
@@ -294,13 +295,13 @@ fn correlate(a: &Polar, b: &Polar, n: usize) -> Option<Rotation> {
 
 /// The rotation of `b`'s texture relative to `a`'s: positive counter-clockwise as seen in the image. `None`
 /// when the polar grid leaves either image or the rings resolve no texture.
-pub fn rotation_between(a: &SpinFrame, b: &SpinFrame, o: &SpinOptions) -> Option<Rotation> {
+pub fn rotation_between(a: &SpinImage, b: &SpinImage, o: &SpinOptions) -> Option<Rotation> {
     correlate(&polar(a, o)?, &polar(b, o)?, o.angles)
 }
 
 /// Spin of one flight phase from its frames (in time order), rad/s, counter-clockwise as seen in the image,
 /// with its standard error from the scatter about the fitted line. An error says why it cannot be measured.
-pub fn spin_from_frames(frames: &[SpinFrame], o: &SpinOptions) -> Result<Measured, String> {
+pub fn spin_from_frames(frames: &[SpinImage], o: &SpinOptions) -> Result<Measured, String> {
     if frames.len() < o.min_frames {
         return Err(format!("{} frame(s), {} needed", frames.len(), o.min_frames));
     }
@@ -395,9 +396,9 @@ pub fn measure_spin(clip: &Clip, track: &Track, phases: &PhaseFrames, o: &SpinOp
         let result = match error {
             Some(e) => Err(format!("a frame could not be read: {e}")),
             None => {
-                let frames: Vec<SpinFrame> = loaded
+                let frames: Vec<SpinImage> = loaded
                     .iter()
-                    .map(|(t_s, pixels, x_px, y_px, r_px)| SpinFrame {
+                    .map(|(t_s, pixels, x_px, y_px, r_px)| SpinImage {
                         t_s: *t_s,
                         pixels,
                         x_px: *x_px,
@@ -425,17 +426,6 @@ pub fn measure_spin(clip: &Clip, track: &Track, phases: &PhaseFrames, o: &SpinOp
         }
     }
     spin
-}
-
-/// [`estimate`] plus the spin before and after the impact, measured from the clip's frames
-/// ([`measure_spin`] with default options); a phase whose spin cannot be measured gets `None` and a note.
-pub fn estimate_with_frames(track: &Track, clip: &Clip, c: &Conditions) -> Result<Estimate, EstimateError> {
-    let mut e = estimate(track, c)?;
-    let spin = measure_spin(clip, track, &e.phases, &SpinOptions::default());
-    e.spin_in = spin.spin_in;
-    e.spin_out = spin.spin_out;
-    e.notes.extend(spin.notes);
-    Ok(e)
 }
 
 #[cfg(test)]
@@ -498,8 +488,8 @@ mod tests {
         }
     }
 
-    fn frame(p: &GrayPixels, cx: f64, cy: f64, r: f64, t: f64) -> SpinFrame<'_> {
-        SpinFrame {
+    fn frame(p: &GrayPixels, cx: f64, cy: f64, r: f64, t: f64) -> SpinImage<'_> {
+        SpinImage {
             t_s: t,
             pixels: p,
             x_px: cx,
@@ -556,7 +546,7 @@ mod tests {
                     (t, cx, disc(cx, 70.0, 40.0, 1.0 + omega * t, false))
                 })
                 .collect();
-            let frames: Vec<SpinFrame> = imgs.iter().map(|(t, cx, p)| frame(p, *cx, 70.0, 40.0, *t)).collect();
+            let frames: Vec<SpinImage> = imgs.iter().map(|(t, cx, p)| frame(p, *cx, 70.0, 40.0, *t)).collect();
             let m = spin_from_frames(&frames, &o).expect("measured");
             assert!(
                 (m.value - omega).abs() < 0.5,
@@ -571,7 +561,7 @@ mod tests {
     fn a_flat_ball_is_not_measured() {
         let flat = GrayPixels::U16(Gray16Image::from_raw(120, 120, vec![150 * 257; 120 * 120]).expect("size"));
         let flat = GrayPixels::U8(flat.to_u8().into_owned());
-        let frames: Vec<SpinFrame> = (0..8)
+        let frames: Vec<SpinImage> = (0..8)
             .map(|i| frame(&flat, 60.0, 60.0, 40.0, i as f64 * 1e-4))
             .collect();
         assert!(spin_from_frames(&frames, &SpinOptions::default()).is_err());

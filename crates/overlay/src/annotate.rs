@@ -3,7 +3,7 @@
 
 use crate::error::OverlayError;
 use crate::font::{draw_label, text_size};
-use crate::marks::{BallMark, Status, SurfaceLine};
+use crate::marks::{BallMark, Status, SurfaceLine, phase_colour, phase_label, status_colour, status_label};
 use crate::paint::{Dash, draw_line_across, draw_ring, draw_segment};
 use crate::view::{Levels, View, render_gray};
 use bouncelab_frames::GrayPixels;
@@ -112,7 +112,7 @@ pub fn draw_annotations(
             style.opacity,
         );
     }
-    let colour = mark.phase.colour();
+    let colour = phase_colour(mark.phase);
     if let Some((x, y, r)) = circle {
         let (u, v) = view.to_canvas(x, y);
         let dash = if mark.status == Status::Ok {
@@ -142,7 +142,7 @@ pub fn draw_annotations(
                 draw_hollow_rect_mut(
                     canvas,
                     Rect::at(k as i32, k as i32).of_size(w - 2 * k, h - 2 * k),
-                    mark.status.colour(),
+                    status_colour(mark.status),
                 );
             }
         }
@@ -159,7 +159,7 @@ pub fn draw_annotations(
             Rgb([255, 255, 255]),
             LABEL_BG,
         );
-        let phase = mark.phase.label();
+        let phase = phase_label(mark.phase);
         if !phase.is_empty() {
             let (pw, _) = text_size(phase, scale);
             let x = w as i32 - (pw + 2 * scale) as i32;
@@ -167,7 +167,15 @@ pub fn draw_annotations(
         }
         let (_, th) = text_size("", scale);
         let y = h as i32 - (th + 2 * scale) as i32;
-        draw_label(canvas, 0, y, mark.status.label(), scale, mark.status.colour(), LABEL_BG);
+        draw_label(
+            canvas,
+            0,
+            y,
+            status_label(mark.status),
+            scale,
+            status_colour(mark.status),
+            LABEL_BG,
+        );
     }
     Ok(())
 }
@@ -326,7 +334,7 @@ mod tests {
             let m = mark(Status::Ok, Phase::FlightIn);
             let img = annotate_frame(&p, &m, None, zoom, &style).unwrap();
             let view = View::full(96, 64, zoom).unwrap();
-            let colour = Phase::FlightIn.colour();
+            let colour = phase_colour(Phase::FlightIn);
             let plain = render_gray(&p, &view, Levels::FULL).unwrap();
             // How much of the ring's colour a canvas pixel took (0 untouched, 1 fully covered).
             let alpha = |u: i64, v: i64| {
@@ -450,8 +458,8 @@ mod tests {
             ..Style::default()
         };
         let img = annotate_frame(&p, &m, None, 1.0, &quiet).unwrap();
-        assert_eq!(*img.get_pixel(50, 2), Status::Absent.colour());
-        let ring = Phase::FlightIn.colour();
+        assert_eq!(*img.get_pixel(50, 2), status_colour(Status::Absent));
+        let ring = phase_colour(Phase::FlightIn);
         assert!(img.pixels().all(|px| *px != ring));
         let e = ball_crop(&p, &m, 20.0, None, &Crop::default(), &Style::default()).unwrap_err();
         assert!(

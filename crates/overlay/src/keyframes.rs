@@ -24,13 +24,7 @@ impl ShotPhases {
     /// The phase of `frame`: before the contact's first frame flight in, through its last contact, after
     /// it flight out.
     pub fn phase_of(&self, frame: u64) -> Phase {
-        if frame < self.contact_first {
-            Phase::FlightIn
-        } else if frame <= self.contact_last {
-            Phase::Contact
-        } else {
-            Phase::FlightOut
-        }
+        Phase::of_frame(frame, self.contact_first, self.contact_last)
     }
 
     /// The key frames these phases define.
@@ -131,7 +125,7 @@ impl Default for ContactRule {
 fn usable(marks: &[BallMark]) -> Vec<&BallMark> {
     marks
         .iter()
-        .filter(|m| matches!(m.status, Status::Ok | Status::Occluded))
+        .filter(|m| m.status.fitted())
         .filter(|m| m.x_px.is_finite() && m.y_px.is_finite() && m.r_px.is_finite())
         .collect()
 }

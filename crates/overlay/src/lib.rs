@@ -3,8 +3,9 @@
 //! the key-frame strip of a shot and contact sheets, as RGB images or PNG bytes (for files, or base64 data
 //! URIs in the report).
 //!
-//! Inputs are plain data ([`BallMark`] per frame, [`SurfaceLine`]), so stored trajectory rows and a fresh
-//! track feed it alike. The main design choice: the circle, line and cross are drawn anti-aliased at their
+//! Inputs are plain data ([`BallMark`] per frame, [`SurfaceLine`]; the tracker's [`Status`] and the
+//! estimate's [`Phase`], re-exported from their crates), so stored trajectory rows and a fresh track feed it
+//! alike. The main design choice: the circle, line and cross are drawn anti-aliased at their
 //! sub-pixel positions, at the canvas's own resolution after the frame has been resampled (bilinear) into
 //! it, because imageproc's integer shapes would move them by up to half a pixel and hide the very error a
 //! person is looking for. Rectangles, borders and the text of a tiny built-in bitmap font (no font file)
@@ -37,7 +38,7 @@ pub use annotate::{Crop, Style, annotate_frame, ball_crop, crop_at, draw_annotat
 pub use error::OverlayError;
 pub use font::{draw_text, text_size};
 pub use keyframes::{ContactRule, KeyFrames, KeyRole, ShotPhases, key_frames_from_trajectory, phases_from_trajectory};
-pub use marks::{BallMark, Phase, Status, SurfaceLine};
+pub use marks::{BallMark, Phase, Status, SurfaceLine, phase_colour, phase_label, status_colour, status_label};
 pub use paint::{Dash, draw_line_across, draw_ring, draw_segment};
 pub use sheet::{SheetLayout, StripFrame, Tile, contact_sheet, key_frame_strip};
 pub use shot::{choose_key_frames, shot_strip};

@@ -1,123 +1,53 @@
-//! The plain data drawn: one ball fix per frame and the surface line, as stored rows give them.
+//! The plain data drawn: one ball fix per frame and the surface line, as stored rows give them; the colours
+//! and words of the tracker's statuses and the impact's phases.
 
 use crate::error::OverlayError;
 use image::Rgb;
 
-/// What the tracker said about a frame (the `status` column of a trajectory).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Status {
-    /// Measured.
-    Ok,
-    /// Measured from less than half of its rim.
-    Occluded,
-    /// Part of the ball outside the frame; measured from the visible arc.
-    CutByBorder,
-    /// Not found.
-    Absent,
-    /// More than one ball-like circle and nothing to tell which is the ball.
-    Ambiguous,
-}
+pub use bouncelab_track::Status;
 
-impl Status {
-    /// Every status, in the order of the legend.
-    pub const ALL: [Status; 5] = [
-        Status::Ok,
-        Status::Occluded,
-        Status::CutByBorder,
-        Status::Absent,
-        Status::Ambiguous,
-    ];
-
-    /// Name as written in trajectory files.
-    pub fn name(self) -> &'static str {
-        match self {
-            Status::Ok => "ok",
-            Status::Occluded => "occluded",
-            Status::CutByBorder => "cut_by_border",
-            Status::Absent => "absent",
-            Status::Ambiguous => "ambiguous",
-        }
-    }
-
-    /// The status with this file name, if any.
-    pub fn from_name(name: &str) -> Option<Status> {
-        Status::ALL.into_iter().find(|s| s.name() == name)
-    }
-
-    /// True if the frame gives a centre and a radius (ok, occluded, cut by the border).
-    pub fn measured(self) -> bool {
-        matches!(self, Status::Ok | Status::Occluded | Status::CutByBorder)
-    }
-
-    /// The word drawn on a frame.
-    pub fn label(self) -> &'static str {
-        match self {
-            Status::Ok => "OK",
-            Status::Occluded => "OCCLUDED",
-            Status::CutByBorder => "CUT",
-            Status::Absent => "ABSENT",
-            Status::Ambiguous => "AMBIGUOUS",
-        }
-    }
-
-    /// Its colour: white when all is well, warmer as the measurement gets weaker, red when there is none.
-    pub fn colour(self) -> Rgb<u8> {
-        match self {
-            Status::Ok => Rgb([255, 255, 255]),
-            Status::Occluded => Rgb([240, 228, 66]),
-            Status::CutByBorder => Rgb([230, 159, 0]),
-            Status::Absent => Rgb([255, 60, 60]),
-            Status::Ambiguous => Rgb([255, 60, 200]),
-        }
+/// The word drawn on a frame for a tracker status.
+pub fn status_label(status: Status) -> &'static str {
+    match status {
+        Status::Ok => "OK",
+        Status::Occluded => "OCCLUDED",
+        Status::CutByBorder => "CUT",
+        Status::Absent => "ABSENT",
+        Status::Ambiguous => "AMBIGUOUS",
     }
 }
 
-/// The phase of the impact a frame belongs to.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Phase {
-    /// Before the touch.
-    FlightIn,
-    /// On (or within the contact margin of) the surface.
-    Contact,
-    /// After the separation.
-    FlightOut,
-    /// Not known (no phases were given or found).
-    Unknown,
+/// A status's colour: white when all is well, warmer as the measurement gets weaker, red when there is none.
+pub fn status_colour(status: Status) -> Rgb<u8> {
+    match status {
+        Status::Ok => Rgb([255, 255, 255]),
+        Status::Occluded => Rgb([240, 228, 66]),
+        Status::CutByBorder => Rgb([230, 159, 0]),
+        Status::Absent => Rgb([255, 60, 60]),
+        Status::Ambiguous => Rgb([255, 60, 200]),
+    }
 }
 
-impl Phase {
-    /// Every phase, in the order of the legend.
-    pub const ALL: [Phase; 4] = [Phase::FlightIn, Phase::Contact, Phase::FlightOut, Phase::Unknown];
+pub use bouncelab_estimate::Phase;
 
-    /// Name as written in files.
-    pub fn name(self) -> &'static str {
-        match self {
-            Phase::FlightIn => "flight_in",
-            Phase::Contact => "contact",
-            Phase::FlightOut => "flight_out",
-            Phase::Unknown => "unknown",
-        }
+/// The word drawn on a frame for a phase.
+pub fn phase_label(phase: Phase) -> &'static str {
+    match phase {
+        Phase::FlightIn => "IN",
+        Phase::Contact => "CONTACT",
+        Phase::FlightOut => "OUT",
+        Phase::Unknown => "",
     }
+}
 
-    /// The word drawn on a frame.
-    pub fn label(self) -> &'static str {
-        match self {
-            Phase::FlightIn => "IN",
-            Phase::Contact => "CONTACT",
-            Phase::FlightOut => "OUT",
-            Phase::Unknown => "",
-        }
-    }
-
-    /// The colour of the circle and centre (Okabe–Ito colours, told apart with colour-blind vision):
-    /// sky blue coming in, vermillion in contact, bluish green going out, white when unknown.
-    pub fn colour(self) -> Rgb<u8> {
-        match self {
-            Phase::FlightIn => Rgb([86, 180, 233]),
-            Phase::Contact => Rgb([213, 94, 0]),
-            Phase::FlightOut => Rgb([0, 158, 115]),
-            Phase::Unknown => Rgb([255, 255, 255]),
-        }
+/// The colour of the circle and centre in a phase (Okabe–Ito colours, told apart with colour-blind vision):
+/// sky blue coming in, vermillion in contact, bluish green going out, white when unknown.
+pub fn phase_colour(phase: Phase) -> Rgb<u8> {
+    match phase {
+        Phase::FlightIn => Rgb([86, 180, 233]),
+        Phase::Contact => Rgb([213, 94, 0]),
+        Phase::FlightOut => Rgb([0, 158, 115]),
+        Phase::Unknown => Rgb([255, 255, 255]),
     }
 }
 
@@ -149,10 +79,7 @@ impl BallMark {
         status: &str,
         phase: Phase,
     ) -> Result<BallMark, OverlayError> {
-        let status = Status::from_name(status).ok_or_else(|| OverlayError::UnknownStatus {
-            frame,
-            name: status.to_string(),
-        })?;
+        let status = Status::from_name(status).map_err(|e| OverlayError::UnknownStatus { frame, name: e.name })?;
         let mark = BallMark {
             frame,
             x_px,
@@ -236,9 +163,9 @@ mod tests {
     #[test]
     fn status_names_round_trip() {
         for s in Status::ALL {
-            assert_eq!(Status::from_name(s.name()), Some(s));
+            assert_eq!(Status::from_name(s.name()), Ok(s));
         }
-        assert_eq!(Status::from_name("OK"), None);
+        assert!(Status::from_name("OK").is_err());
     }
 
     #[test]

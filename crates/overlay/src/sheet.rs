@@ -4,7 +4,7 @@
 use crate::annotate::{Crop, Style, crop_at};
 use crate::error::OverlayError;
 use crate::font::{GLYPH_H, draw_text, text_size};
-use crate::marks::{BallMark, Phase, Status, SurfaceLine};
+use crate::marks::{BallMark, Phase, Status, SurfaceLine, phase_colour, status_colour, status_label};
 use crate::view::MAX_CANVAS_PIXELS;
 use bouncelab_frames::GrayPixels;
 use image::{Rgb, RgbImage};
@@ -57,13 +57,13 @@ type PlacedItem = (i32, i32, Option<Rgb<u8>>, String);
 fn legend_items() -> Vec<LegendItem> {
     let mut items: Vec<LegendItem> = vec![(None, "CIRCLE:".into())];
     for p in [Phase::FlightIn, Phase::Contact, Phase::FlightOut] {
-        items.push((Some(p.colour()), p.name().replace('_', " ")));
+        items.push((Some(phase_colour(p)), p.name().replace('_', " ")));
     }
     items.push((None, "(DASHED: FIT TO PART OF THE RIM)".into()));
     items.push((Some(SurfaceLine::colour()), "SURFACE LINE".into()));
     items.push((None, "STATUS:".into()));
     for s in Status::ALL {
-        items.push((Some(s.colour()), s.label().into()));
+        items.push((Some(status_colour(s)), status_label(s).into()));
     }
     items
 }
@@ -266,7 +266,7 @@ mod tests {
         assert_eq!(wide.height(), plain.height() + GLYPH_H + 3 + 6);
         // Every phase colour appears as a swatch.
         for p in [Phase::FlightIn, Phase::Contact, Phase::FlightOut] {
-            assert!(narrow.pixels().any(|px| *px == p.colour()), "{p:?}");
+            assert!(narrow.pixels().any(|px| *px == phase_colour(p)), "{p:?}");
         }
     }
 
@@ -340,7 +340,7 @@ mod tests {
         // The absent frame's tile is centred where its neighbour saw the ball, and bordered in red.
         let (x, y) = (6 + 2 * 96, 6 + 9);
         assert_eq!(*s.get_pixel(x + 45, y + 45), Rgb([220, 220, 220]));
-        assert_eq!(*s.get_pixel(x + 45, y + 1), Status::Absent.colour());
+        assert_eq!(*s.get_pixel(x + 45, y + 1), status_colour(Status::Absent));
         let none = [StripFrame {
             pixels: &img,
             mark: absent,

@@ -21,5 +21,5 @@ pub use records::{
     CameraRecord, EstimateRecord, EstimateRow, FitRecord, FitRow, ModelHistoryRow, ModelVersionRecord, ModelVersionRow,
     SessionRecord, SessionRow, ShotRecord, ShotRow, ShotStatus, ShotUpsert, TrackRecord, TrajectoryRecord, ValueSe,
 };
-pub use schema::{MIGRATIONS, Migration, Table, latest_version};
+pub use schema::{ESTIMATE_QUANTITIES, MIGRATIONS, Migration, Table, latest_version};
 pub use store::{Store, StoreLock, Tx};

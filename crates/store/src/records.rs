@@ -235,12 +235,51 @@ pub struct EstimateRecord {
     pub spin_in: Option<ValueSe>,
     /// Spin after impact, rad/s, if measured.
     pub spin_out: Option<ValueSe>,
-    /// Maximum penetration, m.
-    pub delta_max_m: ValueSe,
+    /// Maximum penetration, mm (the unit of `estimates.csv`).
+    pub delta_max_mm: ValueSe,
     /// Estimator notes.
     pub notes: Vec<String>,
     /// The estimator's full output as JSON (phases, flight arcs …) for later stages, if the caller keeps it.
     pub detail: Option<String>,
+}
+
+impl EstimateRecord {
+    /// The measured quantities in the order of [`crate::ESTIMATE_QUANTITIES`] (their columns); `None` for a
+    /// spin not measured.
+    pub fn quantities(&self) -> [Option<ValueSe>; 10] {
+        [
+            Some(self.v_in_t),
+            Some(self.v_in_n),
+            Some(self.v_out_t),
+            Some(self.v_out_n),
+            Some(self.cor),
+            Some(self.mu),
+            Some(self.contact_ms),
+            Some(self.delta_max_mm),
+            self.spin_in,
+            self.spin_out,
+        ]
+    }
+
+    /// The record with these quantities (in [`EstimateRecord::quantities`]'s order), notes and detail; a
+    /// quantity other than a spin that is `None` is NaN.
+    pub fn from_quantities(q: [Option<ValueSe>; 10], notes: Vec<String>, detail: Option<String>) -> Self {
+        let v = |x: Option<ValueSe>| x.unwrap_or(ValueSe::new(f64::NAN, f64::NAN));
+        EstimateRecord {
+            v_in_t: v(q[0]),
+            v_in_n: v(q[1]),
+            v_out_t: v(q[2]),
+            v_out_n: v(q[3]),
+            cor: v(q[4]),
+            mu: v(q[5]),
+            contact_ms: v(q[6]),
+            delta_max_mm: v(q[7]),
+            spin_in: q[8],
+            spin_out: q[9],
+            notes,
+            detail,
+        }
+    }
 }
 
 /// An estimate joined with its shot's conditions.

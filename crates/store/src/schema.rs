@@ -145,7 +145,62 @@ CREATE INDEX fits_by_model ON fits(model_version_id, id);
         description: "tracks.camera: the camera file's header (model, rate, exposure, bit depth, trigger) as JSON",
         sql: "ALTER TABLE tracks ADD COLUMN camera TEXT CHECK (camera IS NULL OR json_valid(camera));",
     },
+    Migration {
+        version: 4,
+        description: "estimates: the quantities named as in estimates.csv, units last; delta_max in mm",
+        sql: "ALTER TABLE estimates RENAME COLUMN v_in_t TO v_in_t_m_s;
+ALTER TABLE estimates RENAME COLUMN v_in_t_se TO v_in_t_se_m_s;
+ALTER TABLE estimates RENAME COLUMN v_in_n TO v_in_n_m_s;
+ALTER TABLE estimates RENAME COLUMN v_in_n_se TO v_in_n_se_m_s;
+ALTER TABLE estimates RENAME COLUMN v_out_t TO v_out_t_m_s;
+ALTER TABLE estimates RENAME COLUMN v_out_t_se TO v_out_t_se_m_s;
+ALTER TABLE estimates RENAME COLUMN v_out_n TO v_out_n_m_s;
+ALTER TABLE estimates RENAME COLUMN v_out_n_se TO v_out_n_se_m_s;
+ALTER TABLE estimates RENAME COLUMN mu TO mu_eff;
+ALTER TABLE estimates RENAME COLUMN mu_se TO mu_eff_se;
+ALTER TABLE estimates RENAME COLUMN contact_ms_se TO contact_se_ms;
+ALTER TABLE estimates RENAME COLUMN spin_in TO spin_in_rad_s;
+ALTER TABLE estimates RENAME COLUMN spin_in_se TO spin_in_se_rad_s;
+ALTER TABLE estimates RENAME COLUMN spin_out TO spin_out_rad_s;
+ALTER TABLE estimates RENAME COLUMN spin_out_se TO spin_out_se_rad_s;
+ALTER TABLE estimates RENAME COLUMN delta_max_m TO delta_max_mm;
+ALTER TABLE estimates RENAME COLUMN delta_max_m_se TO delta_max_se_mm;
+UPDATE estimates SET delta_max_mm = delta_max_mm * 1e3, delta_max_se_mm = delta_max_se_mm * 1e3;",
+    },
 ];
+
+/// The measured quantities of an estimate, each as its (value, standard error) columns, units last
+/// (`docs/outputs.md`): the columns of the `estimates` table and the same-named columns of `estimates.csv`,
+/// in that file's order. [`crate::EstimateRecord::quantities`] gives the values in this order.
+pub const ESTIMATE_QUANTITIES: [[&str; 2]; 10] = [
+    ["v_in_t_m_s", "v_in_t_se_m_s"],
+    ["v_in_n_m_s", "v_in_n_se_m_s"],
+    ["v_out_t_m_s", "v_out_t_se_m_s"],
+    ["v_out_n_m_s", "v_out_n_se_m_s"],
+    ["cor", "cor_se"],
+    ["mu_eff", "mu_eff_se"],
+    ["contact_ms", "contact_se_ms"],
+    ["delta_max_mm", "delta_max_se_mm"],
+    ["spin_in_rad_s", "spin_in_se_rad_s"],
+    ["spin_out_rad_s", "spin_out_se_rad_s"],
+];
+
+/// The `estimates` table's columns in export order: its key, [`ESTIMATE_QUANTITIES`] (value, error), then
+/// the notes, the time and the detail.
+const ESTIMATES_COLUMNS: [&str; 24] = {
+    let mut out = [""; 24];
+    out[0] = "shot_id";
+    let mut i = 0;
+    while i < ESTIMATE_QUANTITIES.len() {
+        out[1 + 2 * i] = ESTIMATE_QUANTITIES[i][0];
+        out[2 + 2 * i] = ESTIMATE_QUANTITIES[i][1];
+        i += 1;
+    }
+    out[21] = "notes";
+    out[22] = "created_at";
+    out[23] = "detail";
+    out
+};
 
 /// The newest schema version this build knows.
 pub fn latest_version() -> i64 {
@@ -244,32 +299,7 @@ impl Table {
             Table::Trajectory => &[
                 "shot_id", "frame", "t_s", "x_px", "y_px", "r_px", "sigma_px", "quality", "status", "x_m", "y_m",
             ],
-            Table::Estimates => &[
-                "shot_id",
-                "v_in_t",
-                "v_in_t_se",
-                "v_in_n",
-                "v_in_n_se",
-                "v_out_t",
-                "v_out_t_se",
-                "v_out_n",
-                "v_out_n_se",
-                "cor",
-                "cor_se",
-                "mu",
-                "mu_se",
-                "contact_ms",
-                "contact_ms_se",
-                "spin_in",
-                "spin_in_se",
-                "spin_out",
-                "spin_out_se",
-                "delta_max_m",
-                "delta_max_m_se",
-                "notes",
-                "created_at",
-                "detail",
-            ],
+            Table::Estimates => &ESTIMATES_COLUMNS,
             Table::ModelVersions => &["id", "name", "toml", "parent_id", "created_at"],
             Table::Fits => &[
                 "id",

@@ -7,7 +7,7 @@ use rusqlite::{Connection, OptionalExtension, Row, TransactionBehavior, params};
 
 use crate::error::{Result, StoreError};
 use crate::records::*;
-use crate::schema::{MIGRATIONS, latest_version, now_sql};
+use crate::schema::{ESTIMATE_QUANTITIES, MIGRATIONS, latest_version, now_sql};
 
 /// How long a write waits for another process's write to finish before failing with "database is locked".
 const BUSY_TIMEOUT: Duration = Duration::from_secs(30);
@@ -679,32 +679,24 @@ impl Tx<'_> {
     pub fn put_estimate(&self, shot_id: i64, r: &EstimateRecord) -> Result<()> {
         self.ensure("shots", shot_id)?;
         let notes = to_json(self.path, "estimates", "notes", &r.notes)?;
-        let v = |x: &ValueSe| (nn(x.value), nn(x.se));
-        let o = |x: &Option<ValueSe>| x.as_ref().map_or((None, None), v);
-        let (a, b, c, d, e, f, g, h, i, j) = (
-            v(&r.v_in_t),
-            v(&r.v_in_n),
-            v(&r.v_out_t),
-            v(&r.v_out_n),
-            v(&r.cor),
-            v(&r.mu),
-            v(&r.contact_ms),
-            o(&r.spin_in),
-            o(&r.spin_out),
-            v(&r.delta_max_m),
+        let columns: Vec<&str> = ESTIMATE_QUANTITIES.iter().flatten().copied().collect();
+        let placeholders: Vec<String> = (2..columns.len() + 4).map(|i| format!("?{i}")).collect();
+        let mut values: Vec<Option<f64>> = Vec::with_capacity(columns.len());
+        for q in r.quantities() {
+            values.push(q.and_then(|x| nn(x.value)));
+            values.push(q.and_then(|x| nn(x.se)));
+        }
+        let sql_text = format!(
+            "INSERT OR REPLACE INTO estimates (shot_id, {}, notes, detail) VALUES (?1, {})",
+            columns.join(", "),
+            placeholders.join(", ")
         );
+        let mut params: Vec<&dyn rusqlite::ToSql> = vec![&shot_id];
+        params.extend(values.iter().map(|v| v as &dyn rusqlite::ToSql));
+        params.push(&notes);
+        params.push(&r.detail);
         self.tx
-            .execute(
-                "INSERT OR REPLACE INTO estimates (shot_id, v_in_t, v_in_t_se, v_in_n, v_in_n_se, v_out_t,
-                    v_out_t_se, v_out_n, v_out_n_se, cor, cor_se, mu, mu_se, contact_ms, contact_ms_se, spin_in,
-                    spin_in_se, spin_out, spin_out_se, delta_max_m, delta_max_m_se, notes, detail)
-                 VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15, ?16, ?17, ?18, ?19,
-                         ?20, ?21, ?22, ?23)",
-                params![
-                    shot_id, a.0, a.1, b.0, b.1, c.0, c.1, d.0, d.1, e.0, e.1, f.0, f.1, g.0, g.1, h.0, h.1, i.0, i.1,
-                    j.0, j.1, notes, r.detail
-                ],
-            )
+            .execute(&sql_text, params.as_slice())
             .map_err(sql(self.path, "estimates"))?;
         self.set_status(shot_id, ShotStatus::Estimated, None)
     }
@@ -933,24 +925,28 @@ fn q_track(conn: &Connection, path: &Path, shot_id: i64) -> Result<Option<TrackR
 /// Estimates joined with shots where `column = id` (`e.shot_id` or `s.session_id`).
 fn q_estimates(conn: &Connection, path: &Path, column: &str, id: i64) -> Result<Vec<EstimateRow>> {
     let err = || sql(path, "estimates");
+    let quantities: Vec<String> = ESTIMATE_QUANTITIES.iter().flatten().map(|c| format!("e.{c}")).collect();
+    // Columns: 0–4 the shot, then each quantity's value and error, then the notes and the detail.
+    const FIRST: usize = 5;
+    let notes_at = FIRST + 2 * ESTIMATE_QUANTITIES.len();
     let mut stmt = conn
         .prepare(&format!(
-            "SELECT e.shot_id, s.clip, s.surface, s.angle_deg, s.drop_height_m,
-                    e.v_in_t, e.v_in_t_se, e.v_in_n, e.v_in_n_se, e.v_out_t, e.v_out_t_se, e.v_out_n, e.v_out_n_se,
-                    e.cor, e.cor_se, e.mu, e.mu_se, e.contact_ms, e.contact_ms_se, e.spin_in, e.spin_in_se,
-                    e.spin_out, e.spin_out_se, e.delta_max_m, e.delta_max_m_se, e.notes, e.detail
-             FROM estimates e JOIN shots s ON s.id = e.shot_id WHERE {column} = ?1 ORDER BY s.id"
+            "SELECT e.shot_id, s.clip, s.surface, s.angle_deg, s.drop_height_m, {}, e.notes, e.detail
+             FROM estimates e JOIN shots s ON s.id = e.shot_id WHERE {column} = ?1 ORDER BY s.id",
+            quantities.join(", ")
         ))
         .map_err(err())?;
     let raw = stmt
         .query_map([id], |r| {
-            let v = |i: usize| -> rusqlite::Result<ValueSe> { Ok(ValueSe::new(get_f64(r, i)?, get_f64(r, i + 1)?)) };
-            let o = |i: usize| -> rusqlite::Result<Option<ValueSe>> {
+            let mut q = [None; 10];
+            for (k, slot) in q.iter_mut().enumerate() {
+                let i = FIRST + 2 * k;
                 let value: Option<f64> = r.get(i)?;
                 let se: Option<f64> = r.get(i + 1)?;
-                Ok((value.is_some() || se.is_some())
-                    .then(|| ValueSe::new(value.unwrap_or(f64::NAN), se.unwrap_or(f64::NAN))))
-            };
+                // Two NULLs: not measured (a spin), which `from_quantities` reads as NaN for the others.
+                *slot = (value.is_some() || se.is_some())
+                    .then(|| ValueSe::new(value.unwrap_or(f64::NAN), se.unwrap_or(f64::NAN)));
+            }
             Ok((
                 EstimateRow {
                     shot_id: r.get(0)?,
@@ -958,22 +954,9 @@ fn q_estimates(conn: &Connection, path: &Path, column: &str, id: i64) -> Result<
                     surface: r.get(2)?,
                     angle_deg: get_f64(r, 3)?,
                     drop_height_m: get_f64(r, 4)?,
-                    estimate: EstimateRecord {
-                        v_in_t: v(5)?,
-                        v_in_n: v(7)?,
-                        v_out_t: v(9)?,
-                        v_out_n: v(11)?,
-                        cor: v(13)?,
-                        mu: v(15)?,
-                        contact_ms: v(17)?,
-                        spin_in: o(19)?,
-                        spin_out: o(21)?,
-                        delta_max_m: v(23)?,
-                        notes: Vec::new(),
-                        detail: r.get(26)?,
-                    },
+                    estimate: EstimateRecord::from_quantities(q, Vec::new(), r.get(notes_at + 1)?),
                 },
-                r.get::<_, String>(25)?,
+                r.get::<_, String>(notes_at)?,
             ))
         })
         .map_err(err())?

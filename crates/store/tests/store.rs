@@ -455,3 +455,52 @@ fn clip_fingerprint_follows_frames_and_settings() {
     let err = fingerprint_clip_dir(&dir.path().join("missing"), "", ClipFingerprint::Metadata).unwrap_err();
     assert!(err.to_string().contains("missing"), "{err}");
 }
+
+#[test]
+fn a_version_3_store_migrates_its_estimates_to_the_csv_names_and_millimetres() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("old.sqlite");
+    {
+        // The store as version 3 left it: migrations 1–3 and one estimate in metres.
+        let conn = rusqlite::Connection::open(&path).unwrap();
+        conn.execute_batch(
+            "CREATE TABLE schema_version (version INTEGER PRIMARY KEY, description TEXT NOT NULL,
+             applied_at TEXT NOT NULL DEFAULT 'then')",
+        )
+        .unwrap();
+        for m in &MIGRATIONS[..3] {
+            conn.execute_batch(m.sql).unwrap();
+            conn.execute(
+                "INSERT INTO schema_version (version, description) VALUES (?1, ?2)",
+                rusqlite::params![m.version, m.description],
+            )
+            .unwrap();
+        }
+        conn.execute_batch(
+            "INSERT INTO sessions (path, settings_hash, session_toml) VALUES ('/s', 'h', '');
+             INSERT INTO shots (session_id, clip, surface, angle_deg, drop_height_m, fps, metadata, frames_hash, status)
+                 VALUES (1, 'c1', 'steel', 0, 0.5, 10000, '{}', 'f', 'estimated');
+             INSERT INTO estimates (shot_id, v_in_t, v_in_t_se, v_in_n, v_in_n_se, v_out_t, v_out_t_se, v_out_n,
+                 v_out_n_se, cor, cor_se, mu, mu_se, contact_ms, contact_ms_se, spin_in, spin_in_se, spin_out,
+                 spin_out_se, delta_max_m, delta_max_m_se, notes)
+                 VALUES (1, 0.1, 0.01, -2.0, 0.02, 0.3, 0.03, 1.5, 0.04, 0.75, 0.005, 0.2, 0.01, 4.5, 0.1, NULL,
+                 NULL, -12.0, 0.5, 0.00125, 0.00005, '[]');",
+        )
+        .unwrap();
+    }
+    let store = Store::open(&path).unwrap();
+    assert_eq!(store.schema_version().unwrap(), latest_version());
+    let e = store.estimate(1).unwrap().unwrap();
+    assert_eq!((e.v_in_n.value, e.mu.se, e.contact_ms.value), (-2.0, 0.01, 4.5));
+    assert_eq!(e.delta_max_mm, ValueSe::new(0.00125 * 1e3, 0.00005 * 1e3));
+    assert_eq!((e.spin_in, e.spin_out), (None, Some(ValueSe::new(-12.0, 0.5))));
+    // The export's header is the one column list, and it names what the table holds.
+    let mut csv = Vec::new();
+    store.export_csv(Table::Estimates, &mut csv).unwrap();
+    let header = String::from_utf8(csv).unwrap().lines().next().unwrap().to_string();
+    let quantities: Vec<&str> = ESTIMATE_QUANTITIES.iter().flatten().copied().collect();
+    assert_eq!(
+        header,
+        format!("shot_id,{},notes,created_at,detail", quantities.join(","))
+    );
+}

@@ -8,6 +8,7 @@
 //! that stayed put. When the difference holds no such circle (a ball too large or slow for the median to
 //! forget it), the frames themselves are searched the same way.
 
+use crate::ball_search::{BALL_CANDIDATES, MIN_BALL_RADIUS_PX, hint_window, radius_window};
 use crate::clip::{ClipTracking, TrackError, on_plane, with_plane};
 use crate::hough::{Circle, CircleDetection, detect_circles, radius_bands};
 use crate::plane::{Pixel, Plane};
@@ -26,10 +27,6 @@ pub(crate) struct Acquired {
     /// Another moving ball-like circle seen at acquisition: (frame index, x, y) px.
     pub second: Option<(usize, f64, f64)>,
 }
-
-/// The smallest ball radius searched without a scale, px: below it a ball's rim has too few pixels for a
-/// sub-pixel circle.
-pub const MIN_BALL_RADIUS_PX: f64 = 8.0;
 
 /// The least quality of a circle that acquisition considers.
 const CANDIDATE_QUALITY: f64 = 0.6;
@@ -60,109 +57,168 @@ enum Voters {
 /// crossing a ruler, or in heavy noise); moving votes before the frame's own. When nothing moves, the error
 /// lists the static circles seen. With a scale hint only radii within ±20 % of the ball's are searched.
 pub(crate) fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32, noise: f32) -> Result<Acquired, TrackError> {
-    let n = clip.len();
     let (w, h) = opts.roi.map_or(clip.dimensions(), |r| (r.width, r.height));
     let (min_radius, max_radius) = match opts.scale_hint_m_per_px {
         Some(scale) => {
             let r = opts.ball_diameter_m / (2.0 * scale);
-            (0.8 * r, 1.2 * r)
+            hint_window(r)
         }
         None => (MIN_BALL_RADIUS_PX, w.min(h) as f64 / 2.0),
     };
-    let gap = sighting_gap(clip.fps(), n);
     let bands = radius_bands(min_radius, max_radius);
     let mut frames = FrameCache::new(clip, opts, gain);
     let background = frames.background()?;
-    let mut found: HashMap<(usize, usize, Votes, Voters), Vec<Seen>> = HashMap::new();
-    // The clearest circles that did not move, for the error: (x, y, r, quality).
-    let mut still: Vec<(f64, f64, f64, f64)> = Vec::new();
+    let mut search = PairSearch {
+        clip,
+        width: w as f64,
+        gap: sighting_gap(clip.fps(), clip.len()),
+        noise,
+        frames,
+        background,
+        found: HashMap::new(),
+        still: Vec::new(),
+    };
     // Clean circles before doubtful ones; then an octave of radii at a time, largest first, so the ball's rim
     // comes before the smaller circles drawn on it (the seam's lobes, which move with it); then the strongest
     // voters before all significant ones (cheaper, and what a clear ball needs), moving votes before the
     // frame's; then pairs of frames through the first half of the clip.
     for threshold in [CLEAN_QUALITY, CANDIDATE_QUALITY] {
-        for (band, &(lo, hi)) in bands.iter().enumerate() {
+        for (band, &radii) in bands.iter().enumerate() {
             for voters in [Voters::Strongest, Voters::AboveNoise] {
                 for votes in [Votes::Moving, Votes::Frame] {
-                    if votes == Votes::Moving && background.is_none() {
+                    if votes == Votes::Moving && search.background.is_none() {
                         continue;
                     }
-                    let mut circles = |k: usize| -> Result<Vec<Seen>, TrackError> {
-                        if let Some(c) = found.get(&(k, band, votes, voters)) {
-                            return Ok(c.clone());
-                        }
-                        let det = CircleDetection {
-                            min_radius: lo,
-                            max_radius: hi,
-                            // A seam drawn as a dark line can out-vote the rim: keep enough candidates for the
-                            // rim to be among them.
-                            max_candidates: 24,
-                            noise_sigma: (voters == Voters::AboveNoise).then_some(noise as f64),
-                            ..CircleDetection::default()
-                        };
-                        let c = frames.candidates(k, &det, votes, background.as_deref())?;
-                        found.insert((k, band, votes, voters), c.clone());
-                        Ok(c)
+                    let pass = Pass {
+                        threshold,
+                        band,
+                        radii,
+                        votes,
+                        voters,
                     };
-                    let mut k = 0;
-                    while k + gap < n && k <= n / 2 {
-                        let good = |s: &Seen| s.circle.support > threshold;
-                        let a: Vec<Seen> = circles(k)?.into_iter().filter(good).collect();
-                        let b: Vec<Seen> = circles(k + gap)?.into_iter().filter(good).collect();
-                        let (a_moved, a_static) = split_static(&a, &b);
-                        let (b_moved, _) = split_static(&b, &a);
-                        let loose = |s: &Seen| s.circle.support > CANDIDATE_QUALITY;
-                        let a_all: Vec<Seen> = circles(k)?.into_iter().filter(loose).collect();
-                        let b_all: Vec<Seen> = circles(k + gap)?.into_iter().filter(loose).collect();
-                        let (a_loose, _) = split_static(&a_all, &b_all);
-                        let (b_loose, _) = split_static(&b_all, &a_all);
-                        if threshold == CLEAN_QUALITY && votes == Votes::Frame && voters == Voters::Strongest {
-                            for c in a_static.iter().map(|s| &s.circle) {
-                                if !still.iter().any(|s| (s.0 - c.x).hypot(s.1 - c.y) < 0.5 * c.r) {
-                                    still.push((c.x, c.y, c.r, c.support));
-                                }
-                            }
-                        }
-                        if let Some(MovingPair { a: ca, b: cb, other }) = moving_pair(
-                            &a_moved,
-                            &b_moved,
-                            (&a_loose, &b_loose),
-                            w as f64,
-                            threshold,
-                            |mx, my, r, reach, least| {
-                                Ok(gap < 2
-                                    || circles(k + gap / 2)?.iter().map(|s| &s.circle).any(|c| {
-                                        c.support > least
-                                            && (c.x - mx).hypot(c.y - my) <= reach
-                                            && (c.r - r).abs() <= 0.05 * r + 1.0
-                                    }))
-                            },
-                        )? {
-                            let r = 0.5 * (ca.r + cb.r);
-                            // `k` counts files; time follows frame indices, which count dropped frames too.
-                            let t = |pos: usize| clip.time_of(clip.files()[pos].index);
-                            return Ok(Acquired {
-                                radius: (0.85 * r, 1.15 * r),
-                                seed: ((t(k), ca.x, ca.y), (t(k + gap), cb.x, cb.y)),
-                                second: other.map(|o| (clip.files()[k].index as usize, o.x, o.y)),
-                            });
-                        }
-                        k += gap;
+                    if let Some(found) = search.through_clip(&pass)? {
+                        return Ok(found);
                     }
                 }
             }
         }
     }
+    Err(nothing_moved(clip, search.still, min_radius, max_radius))
+}
+
+/// One pass of the search: the least quality of a sighting, the radius band (its index and range, px), where
+/// the votes come from and which edges vote.
+struct Pass {
+    threshold: f64,
+    band: usize,
+    radii: (f64, f64),
+    votes: Votes,
+    voters: Voters,
+}
+
+/// The search for a moving pair of sightings, with the circles already found in each frame and pass.
+struct PairSearch<'a> {
+    clip: &'a Clip,
+    /// The searched region's width, px.
+    width: f64,
+    /// Frames between the two sightings of a pair.
+    gap: usize,
+    /// The first frame's noise σ (0–255 scale), for [`Voters::AboveNoise`].
+    noise: f32,
+    frames: FrameCache<'a>,
+    background: Option<Vec<f32>>,
+    found: HashMap<(usize, usize, Votes, Voters), Vec<Seen>>,
+    /// The clearest circles that did not move, for the error: (x, y, r, quality).
+    still: Vec<(f64, f64, f64, f64)>,
+}
+
+impl PairSearch<'_> {
+    /// The circles seen in file `k` in this pass (detected once, then remembered).
+    fn circles(&mut self, k: usize, pass: &Pass) -> Result<Vec<Seen>, TrackError> {
+        let key = (k, pass.band, pass.votes, pass.voters);
+        if let Some(c) = self.found.get(&key) {
+            return Ok(c.clone());
+        }
+        let det = CircleDetection {
+            min_radius: pass.radii.0,
+            max_radius: pass.radii.1,
+            max_candidates: BALL_CANDIDATES,
+            noise_sigma: (pass.voters == Voters::AboveNoise).then_some(self.noise as f64),
+            ..CircleDetection::default()
+        };
+        let c = self
+            .frames
+            .candidates(k, &det, pass.votes, self.background.as_deref())?;
+        self.found.insert(key, c.clone());
+        Ok(c)
+    }
+
+    /// Pairs of files `gap` apart through the first half of the clip, in this pass: the first moving pair
+    /// ([`moving_pair`]) as the ball, else `None`. The clean frame pass also notes the circles that stayed.
+    fn through_clip(&mut self, pass: &Pass) -> Result<Option<Acquired>, TrackError> {
+        let (n, gap, width) = (self.clip.len(), self.gap, self.width);
+        let mut k = 0;
+        while k + gap < n && k <= n / 2 {
+            let good = |s: &Seen| s.circle.support > pass.threshold;
+            let a: Vec<Seen> = self.circles(k, pass)?.into_iter().filter(good).collect();
+            let b: Vec<Seen> = self.circles(k + gap, pass)?.into_iter().filter(good).collect();
+            let (a_moved, a_static) = split_static(&a, &b);
+            let (b_moved, _) = split_static(&b, &a);
+            let loose = |s: &Seen| s.circle.support > CANDIDATE_QUALITY;
+            let a_all: Vec<Seen> = self.circles(k, pass)?.into_iter().filter(loose).collect();
+            let b_all: Vec<Seen> = self.circles(k + gap, pass)?.into_iter().filter(loose).collect();
+            let (a_loose, _) = split_static(&a_all, &b_all);
+            let (b_loose, _) = split_static(&b_all, &a_all);
+            if pass.threshold == CLEAN_QUALITY && pass.votes == Votes::Frame && pass.voters == Voters::Strongest {
+                for c in a_static.iter().map(|s| &s.circle) {
+                    if !self.still.iter().any(|s| (s.0 - c.x).hypot(s.1 - c.y) < 0.5 * c.r) {
+                        self.still.push((c.x, c.y, c.r, c.support));
+                    }
+                }
+            }
+            if let Some(MovingPair { a: ca, b: cb, other }) = moving_pair(
+                &a_moved,
+                &b_moved,
+                (&a_loose, &b_loose),
+                width,
+                pass.threshold,
+                |mx, my, r, reach, least| {
+                    Ok(gap < 2
+                        || self.circles(k + gap / 2, pass)?.iter().map(|s| &s.circle).any(|c| {
+                            c.support > least
+                                && (c.x - mx).hypot(c.y - my) <= reach
+                                && (c.r - r).abs() <= 0.05 * r + 1.0
+                        }))
+                },
+            )? {
+                let r = 0.5 * (ca.r + cb.r);
+                // `k` counts files; time follows frame indices, which count dropped frames too.
+                let clip = self.clip;
+                let t = |pos: usize| clip.time_of(clip.files()[pos].index);
+                return Ok(Some(Acquired {
+                    radius: radius_window(r),
+                    seed: ((t(k), ca.x, ca.y), (t(k + gap), cb.x, cb.y)),
+                    second: other.map(|o| (clip.files()[k].index as usize, o.x, o.y)),
+                }));
+            }
+            k += gap;
+        }
+        Ok(None)
+    }
+}
+
+/// The error when no pair moved: no ball at all, or the clearest circles that stayed where they were.
+fn nothing_moved(clip: &Clip, mut still: Vec<(f64, f64, f64, f64)>, min_radius: f64, max_radius: f64) -> TrackError {
     still.sort_by(|p, q| q.3.total_cmp(&p.3));
     let clip_name = clip.dir().display().to_string();
     if still.is_empty() {
-        return Err(TrackError::NoBall {
+        return TrackError::NoBall {
             clip: clip_name,
             min_radius,
             max_radius,
-        });
+        };
     }
-    Err(TrackError::NothingMoves {
+    TrackError::NothingMoves {
         clip: clip_name,
         circles: still
             .iter()
@@ -170,7 +226,7 @@ pub(crate) fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32, noise: f32) -
             .map(|c| format!("radius {:.1} px at ({:.0}, {:.0})", c.2, c.0, c.1))
             .collect::<Vec<_>>()
             .join(", "),
-    })
+    }
 }
 
 /// The least distance between a pair's two sightings for it to count as moving, px.

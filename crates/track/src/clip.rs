@@ -11,6 +11,7 @@ use crate::plane::{Pixel, Plane};
 use crate::refine::{EdgeSearch, NOISY_SIGMA};
 use crate::surface::SurfaceLine;
 use crate::tracker::{BallFix, CLEAN_QUALITY, Status, TrackOptions, Tracker};
+use crate::trajectory::TrajectoryRow;
 use bouncelab_frames::{CameraInfo, Clip, ClipSettings, ContactLine, Frame, FramesError, GrayPixels, ReadOptions, Roi};
 use serde::Serialize;
 use std::time::Instant;
@@ -103,31 +104,6 @@ pub struct Scale {
     pub frames: usize,
 }
 
-/// One frame of a trajectory in pixels and in the local frame (the `trajectories/<clip>.csv` row).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct TrajectoryRow {
-    /// Frame index.
-    pub frame: usize,
-    /// Time, s.
-    pub t_s: f64,
-    /// Centre x, px.
-    pub x_px: f64,
-    /// Centre y, px.
-    pub y_px: f64,
-    /// Radius, px.
-    pub r_px: f64,
-    /// Standard error of each centre coordinate, px.
-    pub sigma_px: f64,
-    /// Quality 0–1.
-    pub quality: f64,
-    /// Status name.
-    pub status: &'static str,
-    /// Along the surface, down-slope, m (origin at the contact column).
-    pub x_m: f64,
-    /// Above the surface line, m.
-    pub y_m: f64,
-}
-
 /// A tracked clip.
 #[derive(Debug, Clone)]
 pub struct Track {
@@ -196,7 +172,7 @@ impl Track {
                     r_px: f.r_px,
                     sigma_px: f.sigma_px,
                     quality: f.quality,
-                    status: f.status.name(),
+                    status: f.status,
                     x_m,
                     y_m,
                 }
@@ -253,33 +229,8 @@ pub fn track_clip(
     let mut warnings = Vec::new();
     // The stream starts decoding at once, so its first frames are ready when acquisition is done.
     let frames = clip.frames_with(&opts.read)?;
-    let roi = opts.roi;
-    let (gain, noise) = match clip.read(0, opts.read.png_decoder) {
-        Some(first) => {
-            let first = in_region(first?, roi.as_ref());
-            let gain = with_plane(&first.pixels, 1.0, |p| on_plane!(p, p => crate::plane::level_gain(&p)));
-            let noise = with_plane(
-                &first.pixels,
-                gain,
-                |p| on_plane!(p, p => crate::plane::noise_sigma(&p)),
-            );
-            (gain, noise)
-        }
-        None => (1.0, 0.0),
-    };
-    // In heavy sensor noise a ray's largest step is as often a noise spike as the rim: sample the rays smoothed.
-    let noisy = ClipTracking {
-        tracker: TrackOptions {
-            ball_diameter_m: Some(opts.ball_diameter_m),
-            search: EdgeSearch {
-                smooth: opts.tracker.search.smooth || noise > NOISY_SIGMA,
-                ..opts.tracker.search.clone()
-            },
-            ..opts.tracker.clone()
-        },
-        ..opts.clone()
-    };
-    let opts = &noisy;
+    let (gain, noise) = first_frame_levels(clip, opts)?;
+    let opts = &for_noise(opts, noise);
     if gain >= 2.0 {
         warnings.push(format!(
             "the frames use little of their gray scale: levels stretched {gain:.1}× for the ball and line searches"
@@ -297,17 +248,131 @@ pub fn track_clip(
         ..opts.tracker.clone()
     });
     tracker.seed(seed.0, seed.1);
-    // A line the user gives, in the searched region's pixels.
-    let (w, _) = clip.dimensions();
-    let (ox, oy) = roi.map_or((0.0, 0.0), |r| (r.x as f64, r.y as f64));
-    let given = opts
-        .contact_line
-        .map(|l| SurfaceLine::given((w as f64 - 1.0) / 2.0 - ox, l.y_px - oy, l.tilt_deg));
-    if let Some(line) = given {
+    if let Some(line) = given_line(clip, opts) {
         tracker.set_surface(line);
     }
+    let forward = track_forward(frames, clip.len(), opts.roi, gain, &mut tracker, &mut progress)?;
+    warnings.extend(tracker.warnings().iter().cloned());
+    let mut fixes = forward.fixes;
+    retrack_backward(clip, opts, gain, radius, &tracker, &mut fixes, &mut warnings)?;
+    let measured = fixes.iter().filter(|f| f.status.measured()).count();
+    if forward.saturated > 0 {
+        warnings.push(format!(
+            "the ball's rim is saturated (pixels at the file's full scale) in {} of {measured} measured frames: its edge, and so the centre and radius there, are biased; lower the exposure or the gain",
+            forward.saturated
+        ));
+    }
+    if measured == 0 {
+        return Err(TrackError::NoBall {
+            clip: clip.dir().display().to_string(),
+            min_radius: radius.0,
+            max_radius: radius.1,
+        });
+    }
+    let absent = fixes.iter().filter(|f| f.status == Status::Absent).count();
+    if absent > 0 {
+        warnings.push(format!("ball not found in {absent} of {} frames", fixes.len()));
+    }
+    let scale = scale_from(
+        &fixes,
+        tracker.surface(),
+        opts.ball_diameter_m,
+        tracker.edge_definition_px(),
+        tracker.rim_shape().map_or(0.0, |s| s.rms_px()),
+    );
+    let (ox, oy) = roi_origin(opts.roi.as_ref());
+    // Back to the whole frame's pixels.
+    for f in &mut fixes {
+        f.x_px += ox;
+        f.y_px += oy;
+    }
+    let whole = |l: &SurfaceLine| SurfaceLine {
+        x0: l.x0 + ox,
+        y0: l.y0 + oy,
+        ..*l
+    };
+    Ok(Track {
+        fixes,
+        surface: tracker.surface().map(whole),
+        surface_alternatives: tracker.surface_alternatives().iter().map(whole).collect(),
+        scale,
+        warnings,
+        seconds_waiting: forward.seconds_waiting,
+        seconds_tracking: forward.seconds_tracking,
+        downslope_negative_x: opts.downslope_negative_x,
+        camera: clip.camera().clone(),
+        saturated_frames: forward.saturated,
+    })
+}
+
+/// The first frame's (searched region's) level gain ([`crate::plane::level_gain`]) and sensor noise σ
+/// (0–255 scale) at that gain; (1, 0) for an empty clip.
+fn first_frame_levels(clip: &Clip, opts: &ClipTracking) -> Result<(f32, f32), TrackError> {
+    let Some(first) = clip.read(0, opts.read.png_decoder) else {
+        return Ok((1.0, 0.0));
+    };
+    let first = in_region(first?, opts.roi.as_ref());
+    let gain = with_plane(&first.pixels, 1.0, |p| on_plane!(p, p => crate::plane::level_gain(&p)));
+    let noise = with_plane(
+        &first.pixels,
+        gain,
+        |p| on_plane!(p, p => crate::plane::noise_sigma(&p)),
+    );
+    Ok((gain, noise))
+}
+
+/// The options with the ball's diameter given to the tracker and, in heavy sensor noise (a ray's largest
+/// step as often a noise spike as the rim), the rays sampled smoothed.
+fn for_noise(opts: &ClipTracking, noise: f32) -> ClipTracking {
+    ClipTracking {
+        tracker: TrackOptions {
+            ball_diameter_m: Some(opts.ball_diameter_m),
+            search: EdgeSearch {
+                smooth: opts.tracker.search.smooth || noise > NOISY_SIGMA,
+                ..opts.tracker.search.clone()
+            },
+            ..opts.tracker.clone()
+        },
+        ..opts.clone()
+    }
+}
+
+/// The region of interest's top-left corner in the whole frame, px ((0, 0) without one).
+fn roi_origin(roi: Option<&Roi>) -> (f64, f64) {
+    roi.map_or((0.0, 0.0), |r| (r.x as f64, r.y as f64))
+}
+
+/// The contact line the user gives, in the searched region's pixels.
+fn given_line(clip: &Clip, opts: &ClipTracking) -> Option<SurfaceLine> {
+    let (w, _) = clip.dimensions();
+    let (ox, oy) = roi_origin(opts.roi.as_ref());
+    opts.contact_line
+        .map(|l| SurfaceLine::given((w as f64 - 1.0) / 2.0 - ox, l.y_px - oy, l.tilt_deg))
+}
+
+/// What the forward pass over the clip measured.
+struct Forward {
+    /// One fix per decoded frame, in the searched region's pixels.
+    fixes: Vec<BallFix>,
+    /// Measured frames whose rim lies in saturated pixels.
+    saturated: usize,
+    /// Seconds waiting for decoded frames.
+    seconds_waiting: f64,
+    /// Seconds tracking.
+    seconds_tracking: f64,
+}
+
+/// Streams every frame through `tracker`, in order, counting the measured frames whose rim is saturated.
+fn track_forward(
+    frames: bouncelab_frames::FrameStream<'_>,
+    total: usize,
+    roi: Option<Roi>,
+    gain: f32,
+    tracker: &mut Tracker,
+    progress: &mut impl FnMut(usize, usize),
+) -> Result<Forward, TrackError> {
     let mut saturated = 0;
-    let (fixes, waiting, tracking) = stream_fixes(frames, clip.len(), &mut progress, |frame| {
+    let (fixes, seconds_waiting, seconds_tracking) = stream_fixes(frames, total, progress, |frame| {
         // Only a region is copied; a whole frame is read where it lies.
         let cut;
         let frame = match roi {
@@ -320,26 +385,44 @@ pub fn track_clip(
         let fix = with_plane(
             &frame.pixels,
             gain,
-            |p| on_plane!(p, p => observe(&mut tracker, frame.index as usize, frame.t_s, &p)),
+            |p| on_plane!(p, p => observe(tracker, frame.index as usize, frame.t_s, &p)),
         );
         if fix.status.measured() && rim_saturated(&frame.pixels, &fix) {
             saturated += 1;
         }
         fix
     })?;
-    warnings.extend(tracker.warnings().iter().cloned());
-    let mut fixes = fixes;
+    Ok(Forward {
+        fixes,
+        saturated,
+        seconds_waiting,
+        seconds_tracking,
+    })
+}
+
+/// Tracks the frames before the forward track first settled again, backward from there ([`retrack_start`]),
+/// with a fresh tracker on the forward one's surface line; when fixes are replaced, the forward pass's
+/// warnings about those frames are dropped and the re-measurement is said.
+fn retrack_backward(
+    clip: &Clip,
+    opts: &ClipTracking,
+    gain: f32,
+    radius: (f64, f64),
+    forward: &Tracker,
+    fixes: &mut [BallFix],
+    warnings: &mut Vec<String>,
+) -> Result<(), TrackError> {
     let mut back = Tracker::new(TrackOptions {
         radius_px: Some(radius),
         ..opts.tracker.clone()
     });
-    if let Some(line) = tracker.surface() {
+    if let Some(line) = forward.surface() {
         back.set_surface(*line);
     }
-    let retracked = retrack_start(&mut fixes, &mut back, |tr, k, frame, t_back| {
+    let retracked = retrack_start(fixes, &mut back, |tr, k, frame, t_back| {
         let image = in_region(
             clip.read(k, opts.read.png_decoder).expect("index in range")?,
-            roi.as_ref(),
+            opts.roi.as_ref(),
         );
         Ok(with_plane(
             &image.pixels,
@@ -363,52 +446,7 @@ pub fn track_clip(
             fixes[settled].frame
         ));
     }
-    let measured = fixes.iter().filter(|f| f.status.measured()).count();
-    if saturated > 0 {
-        warnings.push(format!(
-            "the ball's rim is saturated (pixels at the file's full scale) in {saturated} of {measured} measured frames: its edge, and so the centre and radius there, are biased; lower the exposure or the gain"
-        ));
-    }
-    if measured == 0 {
-        return Err(TrackError::NoBall {
-            clip: clip.dir().display().to_string(),
-            min_radius: radius.0,
-            max_radius: radius.1,
-        });
-    }
-    let absent = fixes.iter().filter(|f| f.status == Status::Absent).count();
-    if absent > 0 {
-        warnings.push(format!("ball not found in {absent} of {} frames", fixes.len()));
-    }
-    let scale = scale_from(
-        &fixes,
-        tracker.surface(),
-        opts.ball_diameter_m,
-        tracker.edge_definition_px(),
-        tracker.rim_shape().map_or(0.0, |s| s.rms_px()),
-    );
-    // Back to the whole frame's pixels.
-    for f in &mut fixes {
-        f.x_px += ox;
-        f.y_px += oy;
-    }
-    let whole = |l: &SurfaceLine| SurfaceLine {
-        x0: l.x0 + ox,
-        y0: l.y0 + oy,
-        ..*l
-    };
-    Ok(Track {
-        fixes,
-        surface: tracker.surface().map(whole),
-        surface_alternatives: tracker.surface_alternatives().iter().map(whole).collect(),
-        scale,
-        warnings,
-        seconds_waiting: waiting,
-        seconds_tracking: tracking,
-        downslope_negative_x: opts.downslope_negative_x,
-        camera: clip.camera().clone(),
-        saturated_frames: saturated,
-    })
+    Ok(())
 }
 
 /// Share of the samples around a rim at the file's full scale above which the rim counts as saturated.

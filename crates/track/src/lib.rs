@@ -11,8 +11,9 @@
 //! Everything works on [`Plane`], a borrowed 8- or 16-bit grayscale image, so no frame is copied.
 
 mod acquire;
+mod ball_search;
+mod circle_fit;
 mod clip;
-mod fit;
 mod hough;
 mod local;
 mod motion;
@@ -23,9 +24,10 @@ mod refine;
 mod surface;
 mod texture;
 mod tracker;
+mod trajectory;
 
-pub use clip::{ClipTracking, Scale, Track, TrackError, TrajectoryRow, track_clip};
-pub use fit::{CircleFit, fit_circle};
+pub use circle_fit::{CircleFit, fit_circle};
+pub use clip::{ClipTracking, Scale, Track, TrackError, track_clip};
 pub use hough::{Circle, CircleDetection, detect_circles, outermost, radius_bands};
 pub use local::SurfaceFrame;
 pub use plane::{Pixel, Plane};
@@ -34,7 +36,11 @@ pub use refine::{
 };
 pub use surface::{LineCue, SurfaceLine, SurfaceLines, find_surface_line, find_surface_lines};
 pub use texture::{horizontal_gradient_energy, texture_line, texture_lines};
-pub use tracker::{BallFix, Status, TrackOptions, Tracker};
+pub use tracker::{BallFix, Status, TrackOptions, Tracker, UnknownStatus};
+pub use trajectory::{TRAJECTORY_COLUMNS, TrajectoryRow};
 
+/// Synthetic frames for tests, benches and examples (here and in dependents' dev-dependencies, through the
+/// `testutil` feature); not part of the library proper.
+#[cfg(any(test, feature = "testutil"))]
 #[doc(hidden)]
 pub mod testutil;

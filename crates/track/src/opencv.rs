@@ -41,6 +41,7 @@
 //! [`track_clip_opencv`] runs the detection on every frame of a clip (no refinement, no prediction) and
 //! keeps per frame the candidate of the expected size nearest the previous centre.
 
+use crate::ball_search::{MIN_BALL_RADIUS_PX, hint_window, radius_window};
 use crate::clip::{ClipTracking, Track, TrackError};
 use crate::hough::{Circle, CircleDetection};
 use crate::plane::{Pixel, Plane};
@@ -273,12 +274,12 @@ fn radius_range(
 ) -> Result<Option<(f64, f64)>, TrackError> {
     if let Some(scale) = opts.scale_hint_m_per_px {
         let r = opts.ball_diameter_m / (2.0 * scale);
-        return Ok(Some((0.8 * r, 1.2 * r)));
+        return Ok(Some(hint_window(r)));
     }
     let n = clip.len();
     let (w, h) = clip.dimensions();
     let det = CircleDetection {
-        min_radius: 8.0,
+        min_radius: MIN_BALL_RADIUS_PX,
         max_radius: w.min(h) as f64 / 2.0,
         ..CircleDetection::default()
     };
@@ -297,7 +298,7 @@ fn radius_range(
                 let moved = (ca.x - cb.x).hypot(ca.y - cb.y);
                 if same_size && moved > 1.5 && moved < 0.5 * w as f64 {
                     let r = 0.5 * (ca.r + cb.r);
-                    return Ok(Some((0.85 * r, 1.15 * r)));
+                    return Ok(Some(radius_window(r)));
                 }
             }
         }
@@ -310,7 +311,7 @@ fn radius_range(
         warnings.push(format!(
             "could not tell the ball by its motion; tracking circles of radius ≈ {r:.1} px — give the scale to be sure"
         ));
-        return Ok(Some((0.85 * r, 1.15 * r)));
+        return Ok(Some(radius_window(r)));
     }
     Ok(None)
 }
@@ -335,7 +336,7 @@ pub fn track_clip_opencv(
         let (w, h) = clip.dimensions();
         return Err(TrackError::NoBall {
             clip: clip.dir().display().to_string(),
-            min_radius: 8.0,
+            min_radius: MIN_BALL_RADIUS_PX,
             max_radius: w.min(h) as f64 / 2.0,
         });
     };

@@ -6,7 +6,7 @@
 //! pressed into or hidden by the surface), and so are rays leaving the image. The edge points then go to the
 //! robust circle fit. Cost: rays × samples bilinear reads (128 × 17 ≈ 2,200, ≈ 10 µs) plus the fit.
 
-use crate::fit::{CircleFit, fit_circle};
+use crate::circle_fit::{CircleFit, fit_circle};
 use crate::plane::{Pixel, Plane, parabola_offset};
 use crate::surface::SurfaceLine;
 
@@ -145,7 +145,7 @@ impl RimShapeLearner {
                 }
             }
         }
-        let inv = crate::fit::invert3(&ata)?;
+        let inv = crate::circle_fit::invert3(&ata)?;
         let coef: Vec<f64> = (0..3).map(|j| (0..3).map(|k| inv[j][k] * atb[k]).sum()).collect();
         let rest: Vec<f64> = (0..n)
             .map(|i| {
@@ -315,8 +315,173 @@ fn refine_once<P: Pixel>(
     search: &EdgeSearch,
     half_width: f64,
     surface: Option<&SurfaceLine>,
-    mut raw_points: Option<&mut Vec<(usize, [f64; 2])>>,
+    raw_points: Option<&mut Vec<(usize, [f64; 2])>>,
 ) -> Option<Refined> {
+    let mut edges = rim_edges(img, (x, y, r), search, half_width, surface, raw_points);
+    edges.apply_rim_shape();
+    let mut fit = fit_circle(&edges.points, x, y, r)?;
+    inflate_for_correlated_rays(&mut fit, &edges.points, &edges.shifts);
+    let mid = edges.contrasts.len() / 2;
+    let contrast = *edges.contrasts.select_nth_unstable_by(mid, f32::total_cmp).1;
+    let edge_definition_px = if edges.offsets.len() >= 8 {
+        let mid = edges.offsets.len() / 2;
+        *edges.offsets.select_nth_unstable_by(mid, f64::total_cmp).1
+    } else {
+        f64::NAN
+    };
+    Some(Refined {
+        fit,
+        rays_with_edge: edges.points.len(),
+        rays_outside: edges.outside,
+        rays_hidden: edges.hidden,
+        rays: edges.rays,
+        contrast,
+        edge_definition_px,
+    })
+}
+
+/// The edge points one pass of [`refine_once`] found along its rays, in ray order, with what each ray saw.
+struct RimEdges {
+    /// Rays cast.
+    rays: usize,
+    /// Edge points, px.
+    points: Vec<[f64; 2]>,
+    /// Per point: the rim-shape offset of its ray (0 without a shape), px, and the ray's direction (cos, sin).
+    shifts: Vec<(f64, f64, f64)>,
+    /// Per point: the edge's brightness step, 0–255 scale per px.
+    contrasts: Vec<f32>,
+    /// Edge definitions ([`half_level_offset`]) where measured, px.
+    offsets: Vec<f64>,
+    /// Rays leaving the image.
+    outside: usize,
+    /// Rays stopped by the surface line.
+    hidden: usize,
+}
+
+impl RimEdges {
+    /// Subtracts the rim shape along each ray when part of the rim is hidden; a full rim's fit absorbs what
+    /// the shape corrects, so full-rim frames are measured exactly as without it (their offsets zeroed).
+    fn apply_rim_shape(&mut self) {
+        if self.hidden > 0 {
+            for (p, &(sh, c, s)) in self.points.iter_mut().zip(&self.shifts) {
+                p[0] -= sh * c;
+                p[1] -= sh * s;
+            }
+        } else {
+            self.shifts.iter_mut().for_each(|s| s.0 = 0.0);
+        }
+    }
+}
+
+/// Where a ray's search can run: the number of samples, or why it cannot.
+enum RaySpan {
+    /// Samples along the ray.
+    Samples(usize),
+    /// The rim point is at or below the surface line, or too little of the ray lies above it.
+    Hidden,
+    /// The ray leaves the image.
+    Outside,
+}
+
+/// The samples along the ray from `start` in direction (c, s) about (x, y) that can be searched.
+fn ray_span<P: Pixel>(
+    img: &Plane<P>,
+    (x, y, r): (f64, f64, f64),
+    (c, s): (f64, f64),
+    start: f64,
+    samples: usize,
+    search: &EdgeSearch,
+    surface: Option<&SurfaceLine>,
+) -> RaySpan {
+    // The search stops short of the surface line: below it is the band, whose own edge (and, on a ragged
+    // band, its highest grains) must not be taken for the ball's rim.
+    let mut len = samples;
+    if let Some(line) = surface {
+        let margin = search.surface_margin + line.ragged_reach_px();
+        let (rx, ry) = (x + r * c, y + r * s);
+        if ry > line.y_at(rx) - margin {
+            return RaySpan::Hidden;
+        }
+        let towards = s - line.slope * c;
+        if towards > 1e-9 {
+            let reach = (line.y_at(x) - margin - y) / towards;
+            len = len.min(((reach - start) / search.step).floor().max(0.0) as usize + 1);
+            if len < samples / 2 + 3 {
+                return RaySpan::Hidden;
+            }
+        }
+    }
+    // A straight segment is inside the image when both its ends are (with the smoothing's half pixel).
+    let (wmax, hmax) = ((img.width - 1) as f64, (img.height - 1) as f64);
+    let end = start + (len - 1) as f64 * search.step;
+    let m = if search.smooth { 0.51 } else { 0.01 };
+    let inside = |d: f64| {
+        let (px, py) = (x + d * c, y + d * s);
+        px >= m && py >= m && px < wmax - m && py < hmax - m
+    };
+    if !inside(start) || !inside(end) {
+        return RaySpan::Outside;
+    }
+    RaySpan::Samples(len)
+}
+
+/// Fills `profile` with the image sampled along the ray from (x, y) + start·(c, s), `step` apart.
+fn sample_ray<P: Pixel>(
+    img: &Plane<P>,
+    profile: &mut [f32],
+    (x, y): (f64, f64),
+    (c, s): (f64, f64),
+    start: f64,
+    search: &EdgeSearch,
+) {
+    let (mut px, mut py) = ((x + start * c) as f32, (y + start * s) as f32);
+    let (sx, sy) = ((search.step * c) as f32, (search.step * s) as f32);
+    if search.smooth {
+        for p in profile.iter_mut() {
+            *p = img.sample_smooth_inside(px, py);
+            px += sx;
+            py += sy;
+        }
+    } else {
+        for p in profile.iter_mut() {
+            *p = img.sample_inside(px, py);
+            px += sx;
+            py += sy;
+        }
+    }
+}
+
+/// The profile's strongest brightness step: (sample index, step per px on the 0–255 scale, sub-sample
+/// offset of the peak), or `None` when it is weaker than `search.min_contrast` or too near an end for the
+/// parabola.
+fn strongest_edge(profile: &[f32], search: &EdgeSearch) -> Option<(usize, f32, f64)> {
+    let len = profile.len();
+    let (mut best, mut best_j) = (0.0f32, 0);
+    for j in 1..len - 1 {
+        let d = (profile[j + 1] - profile[j - 1]).abs();
+        if d > best {
+            best = d;
+            best_j = j;
+        }
+    }
+    let per_px = best / (2.0 * search.step as f32);
+    if per_px < search.min_contrast || best_j < 2 || best_j + 3 > len {
+        return None;
+    }
+    let m = |j: usize| (profile[j + 1] - profile[j - 1]).abs() as f64;
+    Some((best_j, per_px, parabola_offset(m(best_j - 1), m(best_j), m(best_j + 1))))
+}
+
+/// The rim's edge along each of `search.rays` rays about the guess (x, y, r), searched ± `half_width`
+/// across it; `raw_points` also receives each edge as (ray, point).
+fn rim_edges<P: Pixel>(
+    img: &Plane<P>,
+    (x, y, r): (f64, f64, f64),
+    search: &EdgeSearch,
+    half_width: f64,
+    surface: Option<&SurfaceLine>,
+    mut raw_points: Option<&mut Vec<(usize, [f64; 2])>>,
+) -> RimEdges {
     let n = search.rays.max(8);
     let shape = search
         .rim_shape
@@ -325,117 +490,67 @@ fn refine_once<P: Pixel>(
         .filter(|o| o.len() == n);
     let samples = ((2.0 * half_width / search.step).round() as usize).max(4) + 1;
     let mut profile = vec![0.0f32; samples];
-    let mut points = Vec::with_capacity(n);
-    // The rim-shape offset of each point's ray (0 without a shape) and the ray's direction.
-    let mut shifts: Vec<(f64, f64, f64)> = Vec::with_capacity(n);
-    let mut contrasts = Vec::with_capacity(n);
-    let mut offsets: Vec<f64> = Vec::with_capacity(n);
-    let (mut outside, mut hidden) = (0, 0);
+    let mut edges = RimEdges {
+        rays: n,
+        points: Vec::with_capacity(n),
+        shifts: Vec::with_capacity(n),
+        contrasts: Vec::with_capacity(n),
+        offsets: Vec::with_capacity(n),
+        outside: 0,
+        hidden: 0,
+    };
     // Ray directions by rotating one unit vector: no sin/cos per ray.
     let (dc, ds) = (std::f64::consts::TAU / n as f64).sin_cos();
     let (dc, ds) = (ds, dc); // (cos Δ, sin Δ)
     let (mut c, mut s) = (1.0f64, 0.0f64);
-    let (wmax, hmax) = ((img.width - 1) as f64, (img.height - 1) as f64);
     for ray in 0..n {
         let (c0, s0) = (c, s);
         (c, s) = (c0 * dc - s0 * ds, s0 * dc + c0 * ds);
         let (c, s) = (c0, s0);
         let start = r - half_width;
-        // The search stops short of the surface line: below it is the band, whose own edge (and, on a
-        // ragged band, its highest grains) must not be taken for the ball's rim.
-        let mut len = samples;
-        if let Some(line) = surface {
-            let margin = search.surface_margin + line.ragged_reach_px();
-            let (rx, ry) = (x + r * c, y + r * s);
-            if ry > line.y_at(rx) - margin {
-                hidden += 1;
+        let len = match ray_span(img, (x, y, r), (c, s), start, samples, search, surface) {
+            RaySpan::Samples(len) => len,
+            RaySpan::Hidden => {
+                edges.hidden += 1;
                 continue;
             }
-            let towards = s - line.slope * c;
-            if towards > 1e-9 {
-                let reach = (line.y_at(x) - margin - y) / towards;
-                len = len.min(((reach - start) / search.step).floor().max(0.0) as usize + 1);
-                if len < samples / 2 + 3 {
-                    hidden += 1;
-                    continue;
-                }
+            RaySpan::Outside => {
+                edges.outside += 1;
+                continue;
             }
-        }
-        // A straight segment is inside the image when both its ends are (with the smoothing's half pixel).
-        let end = start + (len - 1) as f64 * search.step;
-        let m = if search.smooth { 0.51 } else { 0.01 };
-        let inside = |d: f64| {
-            let (px, py) = (x + d * c, y + d * s);
-            px >= m && py >= m && px < wmax - m && py < hmax - m
         };
-        if !inside(start) || !inside(end) {
-            outside += 1;
-            continue;
-        }
         let profile = &mut profile[..len];
-        let (mut px, mut py) = ((x + start * c) as f32, (y + start * s) as f32);
-        let (sx, sy) = ((search.step * c) as f32, (search.step * s) as f32);
-        if search.smooth {
-            for p in profile.iter_mut() {
-                *p = img.sample_smooth_inside(px, py);
-                px += sx;
-                py += sy;
-            }
-        } else {
-            for p in profile.iter_mut() {
-                *p = img.sample_inside(px, py);
-                px += sx;
-                py += sy;
-            }
-        }
-        let (mut best, mut best_j) = (0.0f32, 0);
-        for j in 1..len - 1 {
-            let d = (profile[j + 1] - profile[j - 1]).abs();
-            if d > best {
-                best = d;
-                best_j = j;
-            }
-        }
-        let per_px = best / (2.0 * search.step as f32);
-        if per_px < search.min_contrast || best_j < 2 || best_j + 3 > len {
+        sample_ray(img, profile, (x, y), (c, s), start, search);
+        let Some((best_j, per_px, off)) = strongest_edge(profile, search) else {
             continue;
-        }
-        let m = |j: usize| (profile[j + 1] - profile[j - 1]).abs() as f64;
-        let off = parabola_offset(m(best_j - 1), m(best_j), m(best_j + 1));
+        };
         let d = start + (best_j as f64 + off) * search.step;
         if let Some(raw) = raw_points.as_deref_mut() {
             raw.push((ray, [x + d * c, y + d * s]));
         }
-        points.push([x + d * c, y + d * s]);
-        shifts.push((shape.map_or(0.0, |o| o[ray]), c, s));
-        contrasts.push(per_px);
+        edges.points.push([x + d * c, y + d * s]);
+        edges.shifts.push((shape.map_or(0.0, |o| o[ray]), c, s));
+        edges.contrasts.push(per_px);
         if search.edge_definition
             && let Some(o) = half_level_offset(profile, best_j, best_j as f64 + off)
         {
-            offsets.push(o * search.step);
+            edges.offsets.push(o * search.step);
         }
     }
-    // The shape matters only when part of the rim is hidden (a full rim's fit absorbs what it corrects), so
-    // full-rim frames are measured exactly as without it.
-    if hidden > 0 {
-        for (p, &(sh, c, s)) in points.iter_mut().zip(&shifts) {
-            p[0] -= sh * c;
-            p[1] -= sh * s;
-        }
-    } else {
-        shifts.iter_mut().for_each(|s| s.0 = 0.0);
-    }
-    let mut fit = fit_circle(&points, x, y, r)?;
-    // Neighbouring rays see overlapping texture, so their edge errors are correlated and the fit's σ (which
-    // assumes independent points) is optimistic. Inflate it by the AR(1) factor √((1+ρ)/(1−ρ)), with ρ the
-    // lag-1 correlation of the residuals around the rim (points are in ray order), measured on this frame.
-    //
-    // With a rim shape the residuals are taken before its correction: the part of the rim's departure from a
-    // circle that the shape cannot hold (its mean and first harmonic, which move the radius and centre
-    // exactly as a shift would) is of the size of the part it corrects, so σ keeps both.
+    edges
+}
+
+/// Neighbouring rays see overlapping texture, so their edge errors are correlated and the fit's σ (which
+/// assumes independent points) is optimistic: σ is inflated by the AR(1) factor √((1+ρ)/(1−ρ)), with ρ the
+/// lag-1 correlation of the residuals around the rim (points are in ray order), measured on this frame.
+///
+/// With a rim shape the residuals are taken before its correction: the part of the rim's departure from a
+/// circle that the shape cannot hold (its mean and first harmonic, which move the radius and centre exactly
+/// as a shift would) is of the size of the part it corrects, so σ keeps both.
+fn inflate_for_correlated_rays(fit: &mut CircleFit, points: &[[f64; 2]], shifts: &[(f64, f64, f64)]) {
     let (res, corrected): (Vec<f64>, Vec<f64>) = points
         .iter()
-        .zip(&shifts)
+        .zip(shifts)
         .map(|(p, (sh, _, _))| {
             let e = (p[0] - fit.x).hypot(p[1] - fit.y) - fit.r;
             (e + sh, e)
@@ -455,23 +570,6 @@ fn refine_once<P: Pixel>(
         fit.sigma_y *= k;
         fit.sigma_r *= k;
     }
-    let mid = contrasts.len() / 2;
-    let contrast = *contrasts.select_nth_unstable_by(mid, f32::total_cmp).1;
-    let edge_definition_px = if offsets.len() >= 8 {
-        let mid = offsets.len() / 2;
-        *offsets.select_nth_unstable_by(mid, f64::total_cmp).1
-    } else {
-        f64::NAN
-    };
-    Some(Refined {
-        fit,
-        rays_with_edge: points.len(),
-        rays_outside: outside,
-        rays_hidden: hidden,
-        rays: n,
-        contrast,
-        edge_definition_px,
-    })
 }
 
 /// Where the profile crosses half-way between its levels inside and outside the edge, relative to the

@@ -1,6 +1,7 @@
 //! Frame-to-frame tracking: predict, refine around the prediction, re-detect when that fails, and say
 //! what happened in every frame.
 
+use crate::ball_search::{BALL_CANDIDATES, MIN_BALL_RADIUS_PX, radius_window};
 use crate::hough::{Circle, CircleDetection};
 use crate::motion::fit_motion;
 use crate::plane::{Pixel, Plane};
@@ -27,7 +28,16 @@ pub enum Status {
 }
 
 impl Status {
-    /// Name as written in files.
+    /// Every status, in the order of the overlay's legend.
+    pub const ALL: [Status; 5] = [
+        Status::Ok,
+        Status::Occluded,
+        Status::CutByBorder,
+        Status::Absent,
+        Status::Ambiguous,
+    ];
+
+    /// Name as written in files and in the store (the same as its serde name).
     pub fn name(self) -> &'static str {
         match self {
             Status::Ok => "ok",
@@ -38,10 +48,44 @@ impl Status {
         }
     }
 
-    /// True if the frame gives a usable centre.
+    /// The status written as `name` ([`Status::name`]); an error naming the value for anything else, so a
+    /// stored or edited trajectory with a status this build does not know is refused, not skipped.
+    pub fn from_name(name: &str) -> Result<Status, UnknownStatus> {
+        Status::ALL
+            .into_iter()
+            .find(|s| s.name() == name)
+            .ok_or_else(|| UnknownStatus { name: name.to_string() })
+    }
+
+    /// True if the frame gives a centre and a radius (ok, occluded, cut by the border): counted as measured,
+    /// drawn, used to place the local frame.
     pub fn measured(self) -> bool {
         matches!(self, Status::Ok | Status::Occluded | Status::CutByBorder)
     }
+
+    /// True if the frame's centre is weighed in a fit of the trajectory (ok, occluded): the estimator's
+    /// flight arcs and the model's fit both use exactly these frames, so the model is fitted to the frames
+    /// its start state came from. A frame cut by the border is measured (drawn, counted) but fitted by
+    /// neither.
+    pub fn fitted(self) -> bool {
+        matches!(self, Status::Ok | Status::Occluded)
+    }
+}
+
+impl std::str::FromStr for Status {
+    type Err = UnknownStatus;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Status::from_name(s)
+    }
+}
+
+/// A status name that is none of [`Status::ALL`]'s.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unknown status `{name}` (known: ok, occluded, cut_by_border, absent, ambiguous)")]
+pub struct UnknownStatus {
+    /// The name found.
+    pub name: String,
 }
 
 /// The ball in one frame (NaN coordinates when not measured).
@@ -288,9 +332,17 @@ impl Tracker {
 
     /// Measures the ball in one frame. Frames must come in time order.
     pub fn observe<P: Pixel>(&mut self, frame: usize, t_s: f64, img: &Plane<P>) -> BallFix {
-        // Where the ball is expected, a line above it is not the surface; until the ball is known (a tracker
-        // never seeded, before its first fix) no line is looked for, as the rims of round things side by
-        // side can pass for the top of a band.
+        self.look_for_surface(t_s, img);
+        if let Some(fix) = self.around_prediction(frame, t_s, img) {
+            return fix;
+        }
+        self.redetect(frame, t_s, img)
+    }
+
+    /// Looks for the surface line while none is known (five tries). Where the ball is expected, a line above
+    /// it is not the surface; until the ball is known (a tracker never seeded, before its first fix) no line
+    /// is looked for, as the rims of round things side by side can pass for the top of a band.
+    fn look_for_surface<P: Pixel>(&mut self, t_s: f64, img: &Plane<P>) {
         let ball = self
             .predict(t_s)
             .zip(self.expected_radius())
@@ -302,9 +354,12 @@ impl Tracker {
                 self.surface_alternatives = lines.alternatives;
             }
         }
-        // 1. Around the prediction.
-        // A confident track needs one narrow pass; the window widens when the last prediction missed (a
-        // sudden change of motion).
+    }
+
+    /// The ball refined around its predicted position, when that gives a plausible circle of the same rim. A
+    /// confident track needs one narrow pass; the window widens when the last prediction missed (a sudden
+    /// change of motion).
+    fn around_prediction<P: Pixel>(&mut self, frame: usize, t_s: f64, img: &Plane<P>) -> Option<BallFix> {
         let confident = self.history.len() >= 3 && self.last_innovation < 0.5;
         let half_width = if confident {
             CONFIDENT_HALF_WIDTH
@@ -337,21 +392,25 @@ impl Tracker {
         {
             self.last_innovation = (found.fit.x - px).hypot(found.fit.y - py);
             self.note_innovation(self.last_innovation);
-            return self.accept(frame, t_s, img, found, Status::Ok);
+            return Some(self.accept(frame, t_s, img, found, Status::Ok));
         }
         self.last_innovation = 0.0;
         self.rim_rays.clear();
-        // 2. Detection in the whole frame.
+        None
+    }
+
+    /// The ball detected in the whole frame: the first sighting when there is no track to continue, else the
+    /// candidate nearest the track among those where the ball can be (`absent` when there is none).
+    fn redetect<P: Pixel>(&mut self, frame: usize, t_s: f64, img: &Plane<P>) -> BallFix {
         let (lo, hi) = match (self.expected_radius(), self.opts.radius_px) {
-            (Some(r), _) => (0.85 * r, 1.15 * r),
+            (Some(r), _) => radius_window(r),
             (None, Some(range)) => range,
-            (None, None) => (8.0, img.width.min(img.height) as f64 / 2.0),
+            (None, None) => (MIN_BALL_RADIUS_PX, img.width.min(img.height) as f64 / 2.0),
         };
         let det = CircleDetection {
             min_radius: lo,
             max_radius: hi,
-            // A seam drawn as a dark line can out-vote the rim: keep enough candidates for the rim to be among them.
-            max_candidates: 24,
+            max_candidates: BALL_CANDIDATES,
             ..CircleDetection::default()
         };
         let mut cands = refined_candidates(img, &det, &self.opts.search, self.surface.as_ref(), 0.3);

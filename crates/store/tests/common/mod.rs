@@ -71,7 +71,7 @@ pub fn estimate(k: f64) -> EstimateRecord {
         contact_ms: v(4.46),
         spin_in: None,
         spin_out: Some(v(-15.0)),
-        delta_max_m: v(0.004),
+        delta_max_mm: v(4.0),
         notes: vec!["spin in: seam not visible".into()],
         detail: Some(format!("{{\"k\": {k}}}")),
     }
