@@ -10,6 +10,7 @@
 
 mod ballistic;
 mod contact;
+mod refit_level;
 mod roll;
 mod shot;
 mod spin;
