@@ -1,11 +1,12 @@
 //! The pipeline over a session folder: frames → track → estimate → fit → compare → diagnose → stats → report,
 //! incremental through the results store.
 //!
-//! This crate owns no science: it runs each stage's library in order and writes the files of `docs/outputs.md`. Its one
-//! design choice is that the SQLite store sits between measuring and everything after it: shots are tracked in
-//! parallel and each one is committed on its own, the later stages read every shot back from the store, so an
-//! unchanged shot is never tracked again and a run killed at any instant resumes where it stopped. Progress is
-//! reported to a [`Progress`] (the CLI draws bars on a terminal, plain lines otherwise).
+//! This crate owns no science: [`analyze`] runs each stage's library in order as named steps (the model is fitted
+//! and compared once, and the missing-effect search starts from that fit) and writes the files of
+//! `docs/outputs.md`. Its one design choice is that the SQLite store sits between measuring and everything after
+//! it: shots are tracked in parallel and each one is committed on its own, the later stages read every shot back
+//! from the store, so an unchanged shot is never tracked again and a run killed at any instant resumes where it
+//! stopped. Progress is reported to a [`Progress`] (the CLI draws bars on a terminal, plain lines otherwise).
 
 mod error;
 mod evidence;
