@@ -1,37 +1,44 @@
 //! The pipeline over a session folder: frames → track → estimate → fit → compare → diagnose → stats → report,
 //! incremental through the results store.
 //!
-//! This crate owns no science: it runs each stage's library in order and writes the files of `docs/outputs.md`. Its one
-//! design choice is that the SQLite store sits between measuring and everything after it: shots are tracked in
-//! parallel and each one is committed on its own, the later stages read every shot back from the store, so an
-//! unchanged shot is never tracked again and a run killed at any instant resumes where it stopped. Progress is
-//! reported to a [`Progress`] (the CLI draws bars on a terminal, plain lines otherwise).
+//! This crate owns no science: [`analyze`] runs each stage's library in order as named steps (the model is fitted
+//! and compared once, and the missing-effect search starts from that fit) and writes the files of
+//! `docs/outputs.md`. Its one design choice is that the SQLite store sits between measuring and everything after
+//! it: shots are tracked in parallel and each one is committed on its own, the later stages read every shot back
+//! from the store, so an unchanged shot is never tracked again and a run killed at any instant resumes where it
+//! stopped. Progress is reported to a [`Progress`] (the CLI draws bars on a terminal, plain lines otherwise).
 
 mod error;
+mod evidence;
+mod history;
 mod measure;
 mod outputs;
 mod report;
+mod search;
+mod session_model;
 mod shots;
 
+pub use bouncelab_stats::SessionStats;
 pub use error::AnalyzeError;
+pub use history::BeforeAfter;
 pub use measure::{MeasureSummary, measure_session};
 pub use outputs::{
     COMPARISON_COLUMNS, CURVE_COLUMNS, ESTIMATE_COLUMNS, FORCE_COLUMNS, PREDICTION_COLUMNS, SURFACE_COLUMNS,
     TrajectoryFiles, trajectory_files, write_comparison_csv, write_estimates_csv,
 };
 pub use report::{track_peak_deceleration, verdict_headline};
+pub use session_model::session_model;
 pub use shots::{ShotData, load_failed_tracks, load_shots, measured_shot};
 
-use bouncelab_compare::{Comparison, FailureReport, ShotExtras, SpinFrame};
-use bouncelab_diagnose::{Diagnosis, SearchOptions, find_missing_effect_with};
+use bouncelab_compare::{Comparison, FailureReport, ShotExtras};
+use bouncelab_diagnose::{Diagnosis, FittedBaseline};
 use bouncelab_fit::{FitOptions, FitResult, Problem, fit_problem};
 use bouncelab_frames::{ClipOptions, Session};
-use bouncelab_model::{EffectKind, EffectSetting, ModelSpec, ParamRef, ParamSetting};
-use bouncelab_stats::{
-    Ancova, AncovaInference, CorObservation, Dataset, PAPER_TERMS, TukeyHsd, ancova, ancova_inference, tukey_hsd_factor,
-};
-use bouncelab_store::{ClipFingerprint, Fingerprint, FitRecord, ModelHistoryRow, ModelVersionRecord, Store};
+use bouncelab_model::ModelSpec;
+use bouncelab_stats::CorObservation;
+use bouncelab_store::{ClipFingerprint, ModelHistoryRow, Store, TrackRecord};
 use std::path::{Path, PathBuf};
+use std::time::Instant;
 
 /// A stage of the analysis, for progress reports.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -82,8 +89,8 @@ pub trait Progress: Sync {
 }
 
 /// Progress that goes nowhere.
-pub struct Silent;
-impl Progress for Silent {}
+pub struct NoProgress;
+impl Progress for NoProgress {}
 
 /// Settings of [`analyze`].
 #[derive(Debug, Clone, PartialEq)]
@@ -124,7 +131,7 @@ pub struct Analysis {
     pub fit: FitResult,
     /// Every measured shot (conditions, track, estimate).
     pub shots: Vec<ShotData>,
-    /// Shots left out of the fit with the reason (see [`suspect_tracks`]).
+    /// Shots left out of the fit with the reason (see [`flagged_shots`], [`suspect_tracks`]).
     pub excluded: Vec<(String, String)>,
     /// This model's errors against the previous model version fitted to the same session, if any.
     pub before: Option<BeforeAfter>,
@@ -146,89 +153,10 @@ pub struct Analysis {
     pub timings: Vec<(Stage, f64)>,
 }
 
-/// The model for a session: `path` or the paper's, with the session's ball, and a surface table for every
-/// surface of the session that the file does not list (copying the file's own values, so each surface gets its
-/// own fitted parameters when any are free).
-pub fn session_model(
-    path: Option<&Path>,
-    session: &Session,
-    progress: &dyn Progress,
-) -> Result<ModelSpec, AnalyzeError> {
-    let mut spec = match path {
-        Some(p) => ModelSpec::load(p)?,
-        None => ModelSpec::paper(),
-    };
-    let radius = session.ball.diameter_m / 2.0;
-    if (spec.ball.radius_m - radius).abs() > 1e-9 || (spec.ball.mass_kg - session.ball.mass_kg).abs() > 1e-12 {
-        progress.note(&format!(
-            "the session's ball (diameter {} m, mass {} kg) replaces the model file's (radius {} m, mass {} kg)",
-            session.ball.diameter_m, session.ball.mass_kg, spec.ball.radius_m, spec.ball.mass_kg
-        ));
-        spec.ball.radius_m = radius;
-        spec.ball.mass_kg = session.ball.mass_kg;
-    }
-    add_surface_level(&mut spec);
-    if !spec.surfaces.is_empty() {
-        let base = spec.settings(None)?;
-        let free: Vec<_> = base.into_iter().filter(|(_, s)| s.free).collect();
-        let mut added = Vec::new();
-        for clip in &session.clips {
-            if !spec.surfaces.iter().any(|(n, _)| *n == clip.surface) {
-                spec.surfaces.push((clip.surface.clone(), free.clone()));
-                added.push(clip.surface.clone());
-            }
-        }
-        if !added.is_empty() {
-            progress.note(&format!(
-                "{} does not list surface(s) {}: fitted from the file's default values",
-                spec.origin,
-                added.join(", ")
-            ));
-        }
-    }
-    Ok(spec)
-}
-
-/// Fit range of the surface level, m (±5 px at the paper's 0.4 mm/px).
-const SURFACE_LEVEL_RANGE_M: f64 = 2e-3;
-
-/// Adds the `surface_level` nuisance, free per surface, unless the model file sets it itself: the surface
-/// line a tracker finds is the band's visible edge, a fraction of a pixel (more with the camera above the
-/// surface) off the plane the ball touches, and the contact's timing in every shot depends on it.
-fn add_surface_level(spec: &mut ModelSpec) {
-    let name = "surface_level";
-    if spec.has_effect(name) {
-        return;
-    }
-    let Some(info) = bouncelab_model::builtin(name) else {
-        return;
-    };
-    let free = ParamSetting {
-        value: 0.0,
-        free: true,
-        min: -SURFACE_LEVEL_RANGE_M,
-        max: SURFACE_LEVEL_RANGE_M,
-    };
-    spec.effects.push(EffectSetting {
-        name: name.into(),
-        kind: EffectKind::Builtin(info),
-        params: vec![("level_m".into(), Some(free))],
-    });
-    let r = ParamRef {
-        effect: name.into(),
-        param: "level_m".into(),
-    };
-    for (_, values) in &mut spec.surfaces {
-        values.push((r.clone(), free));
-    }
-}
-
-/// The surface level the fit found for `surface` (m; the `surface_level` nuisance), if it was fitted.
+/// The surface level the fit found for `surface` (m; the `surface_level` nuisance), if it was fitted
+/// ([`FitResult::surface_level_m`]).
 pub fn fitted_surface_level(fit: &FitResult, surface: &str) -> Option<f64> {
-    let own = format!("{surface}:surface_level.level_m");
-    fit.param(&own)
-        .or_else(|| fit.param("surface_level.level_m"))
-        .map(|p| p.value)
+    fit.surface_level_m(surface)
 }
 
 /// Runs the whole analysis of the session folder `session_dir`.
@@ -241,56 +169,157 @@ pub fn analyze(
     options: &AnalyzeOptions,
     progress: &dyn Progress,
 ) -> Result<Analysis, AnalyzeError> {
-    let mut timings = Vec::new();
+    let mut timings = Timings::default();
     let session = Session::load_with(session_dir, &options.clip_options)?;
     for w in &session.warnings {
         progress.note(&w.to_string());
     }
     let spec = session_model(options.model_path.as_deref(), &session, progress)?;
-    if let Some(parent) = options.store_path.parent().filter(|p| !p.as_os_str().is_empty()) {
-        create_dir(parent)?;
-    }
-    let mut store = Store::open(&options.store_path)?;
+    let mut store = open_store(&options.store_path)?;
 
-    let t = std::time::Instant::now();
-    let measure = measure_session(&session, &mut store, spec.gravity, options.fingerprint, progress)?;
-    timings.push((Stage::Track, t.elapsed().as_secs_f64()));
+    let measure = timings.time(Stage::Track, || {
+        measure_session(&session, &mut store, spec.gravity, options.fingerprint, progress)
+    })?;
     let listed = session.listed();
     let shots = load_shots(&store, measure.session_id, &listed)?;
     let failed_tracks = load_failed_tracks(&store, measure.session_id, &listed)?;
     let files = trajectory_files(listed.iter().copied());
     if shots.is_empty() {
-        // Nothing to fit, but what was measured is written: the trajectories of the shots that were
-        // tracked, an empty estimates.csv, and a report listing every shot's failure and how far it got.
-        create_dir(&options.out_dir)?;
-        outputs::clear_partials(&options.out_dir);
-        let tracks: Vec<_> = failed_tracks.iter().map(|(c, t, _)| (c.clone(), t.clone())).collect();
-        let mut written = vec![outputs::write_estimates_only(&options.out_dir, &shots, &spec, &files)?];
-        written.extend(outputs::write_failed_trajectories(&options.out_dir, &tracks, &files)?);
-        outputs::remove_stale_trajectories(&options.out_dir, &files)?;
-        written.push(report::write_failure(
-            &options.out_dir,
+        return Err(nothing_measured(
+            session_dir,
             &session,
             &measure,
             &failed_tracks,
+            &spec,
+            &files,
+            &options.out_dir,
         )?);
-        let first = measure
-            .failed
-            .first()
-            .map(|(c, m)| format!("{c}: {m}"))
-            .unwrap_or_else(|| "no shot listed".into());
-        return Err(AnalyzeError::NothingMeasured {
-            session: session_dir.to_path_buf(),
-            total: listed.len(),
-            first,
-            written,
-        });
     }
 
-    let t = std::time::Instant::now();
-    progress.start(Stage::Fit, 1);
-    let mut excluded = flagged_shots(&shots);
-    for (clip, why) in suspect_tracks(&shots) {
+    let FitStage {
+        excluded,
+        fitted,
+        problem,
+        fit,
+    } = timings.time(Stage::Fit, || fit_stage(&spec, &shots, progress))?;
+    let recorded = history::record_fit(&mut store, measure.session_id, options, &fit)?;
+    let extras = evidence::fitted_extras(&fitted, &fit, spec.ball.radius_m);
+    let (comparison, failure) = timings.time(Stage::Compare, || compare_stage(&problem, &fit, &extras, progress))?;
+    let baseline = FittedBaseline::new(&fit, &comparison, &failure);
+    let diagnosis = timings.time(Stage::Diagnose, || {
+        search::search_stage(
+            &spec,
+            &recorded.model_text,
+            &fitted,
+            &extras,
+            baseline,
+            options,
+            progress,
+        )
+    })?;
+    let stats = timings.time(Stage::Stats, || stats_stage(&shots, progress));
+
+    let written = Written {
+        shots: &shots,
+        fit: &fit,
+        spec: &spec,
+        files: &files,
+        failed_tracks: &failed_tracks,
+        comparison: &comparison,
+        stats: &stats,
+        diagnosis: &diagnosis,
+        version: recorded.version,
+    };
+    let outputs = timings.time(Stage::Report, || write_outputs(&options.out_dir, &written))?;
+    let started_report = Instant::now();
+    let fitted_at = store.latest_fit(measure.session_id)?.map(|f| f.created_at);
+    let mut analysis = Analysis {
+        fitted_at,
+        session_dir: session_dir.to_path_buf(),
+        shots_listed: listed.len(),
+        measure,
+        model_origin: spec.origin.clone(),
+        model: spec,
+        model_version: recorded.version,
+        previous_diagnosis: recorded.previous_diagnosis,
+        fit,
+        shots,
+        excluded,
+        before: recorded.before,
+        history: recorded.history,
+        comparison,
+        failure,
+        diagnosis,
+        stats,
+        outputs,
+        timings: timings.0,
+    };
+    write_report(&options.out_dir, &mut analysis, &session)?;
+    if let Some((_, t)) = analysis.timings.iter_mut().find(|(s, _)| *s == Stage::Report) {
+        *t += started_report.elapsed().as_secs_f64();
+    }
+    Ok(analysis)
+}
+
+/// Seconds per stage, in the order the stages ran.
+#[derive(Default)]
+struct Timings(Vec<(Stage, f64)>);
+
+impl Timings {
+    /// Runs `stage` (`f`) and records how long it took.
+    fn time<T>(&mut self, stage: Stage, f: impl FnOnce() -> T) -> T {
+        let since = Instant::now();
+        let out = f();
+        self.0.push((stage, since.elapsed().as_secs_f64()));
+        out
+    }
+}
+
+/// The results store at `path`, its folder created.
+fn open_store(path: &Path) -> Result<Store, AnalyzeError> {
+    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        create_dir(parent)?;
+    }
+    Ok(Store::open(path)?)
+}
+
+/// With no shot measured there is nothing to fit, but what was measured is written: the trajectories of
+/// the shots that were tracked, an empty estimates.csv, and a report listing every shot's failure and how
+/// far it got. Returns the error to give (or the one that stopped the writing).
+fn nothing_measured(
+    session_dir: &Path,
+    session: &Session,
+    measure: &MeasureSummary,
+    failed_tracks: &[(String, TrackRecord, String)],
+    spec: &ModelSpec,
+    files: &TrajectoryFiles,
+    out_dir: &Path,
+) -> Result<AnalyzeError, AnalyzeError> {
+    create_dir(out_dir)?;
+    outputs::clear_partials(out_dir);
+    let tracks: Vec<_> = failed_tracks.iter().map(|(c, t, _)| (c.clone(), t.clone())).collect();
+    let mut written = vec![outputs::write_estimates_only(out_dir, &[], spec, files)?];
+    written.extend(outputs::write_failed_trajectories(out_dir, &tracks, files)?);
+    outputs::remove_stale_trajectories(out_dir, files)?;
+    written.push(report::write_failure(out_dir, session, measure, failed_tracks)?);
+    let first = measure
+        .failed
+        .first()
+        .map(|(c, m)| format!("{c}: {m}"))
+        .unwrap_or_else(|| "no shot listed".into());
+    Ok(AnalyzeError::NothingMeasured {
+        session: session_dir.to_path_buf(),
+        total: session.listed().len(),
+        first,
+        written,
+    })
+}
+
+/// The shots left out of the fit with the reason: those whose estimate is flagged, then those whose
+/// flight fits are suspect ([`suspect_tracks`]); each is noted to `progress`.
+fn excluded_shots(shots: &[ShotData], progress: &dyn Progress) -> Vec<(String, String)> {
+    let mut excluded = flagged_shots(shots);
+    for (clip, why) in suspect_tracks(shots) {
         if !excluded.iter().any(|(c, _)| *c == clip) {
             excluded.push((clip, why));
         }
@@ -298,17 +327,36 @@ pub fn analyze(
     for (clip, why) in &excluded {
         progress.note(&format!("{clip} is left out of the fit: {why}"));
     }
+    excluded
+}
+
+/// What the fit stage leaves: the shots left out with the reason, those fitted, the problem and the fit.
+struct FitStage<'a> {
+    excluded: Vec<(String, String)>,
+    fitted: Vec<&'a ShotData>,
+    problem: Problem,
+    fit: FitResult,
+}
+
+/// The model fitted to the shots not excluded ([`excluded_shots`]): the surface level per surface (the
+/// nuisance of [`bouncelab_fit::add_surface_level`]) and, per shot, an offset from it within the surface
+/// line's stated error (a free offset per shot would also absorb most of a missing contact effect:
+/// restitution damping's 65 µm misfit falls to 16 µm). Every solver iteration is reported as the reduced χ²
+/// the result reports.
+fn fit_stage<'a>(
+    spec: &ModelSpec,
+    shots: &'a [ShotData],
+    progress: &dyn Progress,
+) -> Result<FitStage<'a>, AnalyzeError> {
+    progress.start(Stage::Fit, 1);
+    let excluded = excluded_shots(shots, progress);
     let fitted: Vec<&ShotData> = shots
         .iter()
         .filter(|s| !excluded.iter().any(|(c, _)| *c == s.clip))
         .collect();
     let measured: Vec<_> = fitted.iter().map(|s| s.measured.clone()).collect();
-    // The surface level per surface (the nuisance above) and, per shot, an offset from it within the
-    // surface line's stated error (a free offset per shot would also absorb most of a missing contact
-    // effect: restitution damping's 65 µm misfit falls to 16 µm).
     let fit_options = FitOptions::default();
-    let problem = Problem::new(&spec, measured, fit_options.sim)?.with_surface_offsets(fit_options.surface_offsets);
-    // The fit's degrees of freedom, so each iteration's cost is shown as the reduced χ² the result reports.
+    let problem = Problem::new(spec, measured, fit_options.sim)?.with_surface_offsets(fit_options.surface_offsets);
     let dof = problem
         .n_residuals()
         .saturating_sub(problem.params().len() + problem.nuisance_per_shot() * problem.shots().len())
@@ -326,95 +374,36 @@ pub fn analyze(
             fit.iterations
         ),
     );
-    timings.push((Stage::Fit, t.elapsed().as_secs_f64()));
-    let model_toml = match &options.model_path {
-        Some(p) => std::fs::read_to_string(p).map_err(|source| AnalyzeError::Io {
-            path: p.clone(),
-            source,
-        })?,
-        None => bouncelab_model::PAPER_MODEL_TOML.to_string(),
-    };
-    let version = store.add_model_version(&ModelVersionRecord {
-        name: model_name(options.model_path.as_deref()),
-        toml: model_toml,
-        parent_id: None,
-    })?;
-    let before = before_after(&store, measure.session_id, version, &fit)?;
-    let previous_diagnosis = before
-        .as_ref()
-        .and_then(|b| outputs::kept_diagnosis(&options.out_dir, b.before_version));
-    store.add_fit(&FitRecord {
-        session_id: Some(measure.session_id),
-        model_version_id: version,
-        json: fit.to_json(),
-        reduced_chi2: fit.reduced_chi2,
-        rms_m: fit.rms_m,
-        mae_pct: fit.mean_abs_cor_error_pct,
-    })?;
+    Ok(FitStage {
+        excluded,
+        fitted,
+        problem,
+        fit,
+    })
+}
 
-    let history = store.model_history(Some(measure.session_id))?;
-    let model_text = store
-        .model_versions()?
-        .into_iter()
-        .find(|v| v.id == version)
-        .map(|v| v.record.toml)
-        .unwrap_or_default();
-    let t = std::time::Instant::now();
+/// The fitted model against every fitted shot, and where it fails.
+fn compare_stage(
+    problem: &Problem,
+    fit: &FitResult,
+    extras: &[ShotExtras],
+    progress: &dyn Progress,
+) -> Result<(Comparison, FailureReport), AnalyzeError> {
     progress.start(Stage::Compare, 1);
     let theta: Vec<f64> = fit.parameters.iter().map(|p| p.value).collect();
-    // The measured contact time, re-read from the flight arcs at the surface level the fit found.
-    let radius = spec.ball.radius_m;
-    let extras: Vec<ShotExtras> = fitted
-        .iter()
-        .zip(&fit.shots)
-        .map(|(s, f)| {
-            let mut e = shot_extras(s);
-            let level = match (fitted_surface_level(&fit, &f.surface), f.surface_offset_m) {
-                (None, None) => None,
-                (a, b) => Some(a.unwrap_or(0.0) + b.unwrap_or(0.0)),
-            };
-            if let Some(level) = level {
-                let (t0, t1) = s.estimate.contact_at_level(level, radius);
-                e.contact_time_s = Some(t1 - t0).filter(|d| d.is_finite() && *d > 0.0);
-            }
-            e
-        })
-        .collect();
-    let comparison = bouncelab_compare::compare_problem(&problem, &theta, &extras)?;
+    let comparison = bouncelab_compare::compare_problem(problem, &theta, extras)?;
     let failure = bouncelab_compare::diagnose(&comparison, &bouncelab_compare::DiagnoseOptions::default());
     progress.finish(
         Stage::Compare,
         failure.sentences.first().map_or("no residuals", String::as_str),
     );
-    timings.push((Stage::Compare, t.elapsed().as_secs_f64()));
+    Ok((comparison, failure))
+}
 
-    let t = std::time::Instant::now();
-    let diagnosis = if !options.diagnose {
-        Err("the missing-effect search was not asked for (--no-diagnose)".to_string())
-    } else if fitted.len() < search_options().min_shots {
-        let why = format!(
-            "{} shot(s) fitted; the missing-effect search needs at least {} (held-out errors are compared across shots)",
-            fitted.len(),
-            search_options().min_shots
-        );
-        progress.finish(Stage::Diagnose, &format!("not run: {why}"));
-        Err(why)
-    } else {
-        create_dir(&options.out_dir)?;
-        Ok(diagnose_stage(
-            &spec,
-            &model_text,
-            &fitted,
-            &extras,
-            &options.out_dir,
-            progress,
-        )?)
-    };
-    timings.push((Stage::Diagnose, t.elapsed().as_secs_f64()));
-
-    let t = std::time::Instant::now();
+/// The session's statistics ([`session_stats`]), reported to `progress`.
+fn stats_stage(shots: &[ShotData], progress: &dyn Progress) -> Result<SessionStats, String> {
     progress.start(Stage::Stats, 1);
-    let stats = session_stats(&shots);
+    let stats = session_stats(shots);
     progress.finish(
         Stage::Stats,
         &match &stats {
@@ -422,27 +411,45 @@ pub fn analyze(
             Err(reason) => format!("not computed: {reason}"),
         },
     );
-    timings.push((Stage::Stats, t.elapsed().as_secs_f64()));
+    stats
+}
 
-    let t = std::time::Instant::now();
-    create_dir(&options.out_dir)?;
-    outputs::clear_partials(&options.out_dir);
-    let mut outputs = outputs::write_all(&options.out_dir, &shots, &fit, &spec, &files)?;
-    let tracks: Vec<_> = failed_tracks.iter().map(|(c, t, _)| (c.clone(), t.clone())).collect();
-    outputs::write_failed_trajectories(&options.out_dir, &tracks, &files)?;
-    outputs::remove_stale_trajectories(&options.out_dir, &files)?;
-    outputs.push(outputs::write_comparison(&options.out_dir, &comparison)?);
-    if let Ok(st) = &stats {
-        outputs.push(outputs::write_anova(&options.out_dir, &st.ancova)?);
+/// What [`write_outputs`] writes from.
+struct Written<'a> {
+    shots: &'a [ShotData],
+    fit: &'a FitResult,
+    spec: &'a ModelSpec,
+    files: &'a TrajectoryFiles,
+    failed_tracks: &'a [(String, TrackRecord, String)],
+    comparison: &'a Comparison,
+    stats: &'a Result<SessionStats, String>,
+    diagnosis: &'a Result<Diagnosis, String>,
+    /// The store's id of the model version fitted (the kept diagnosis is filed under it).
+    version: i64,
+}
+
+/// The output files of `docs/outputs.md` but the report; returns those listed as written.
+fn write_outputs(out_dir: &Path, w: &Written<'_>) -> Result<Vec<PathBuf>, AnalyzeError> {
+    create_dir(out_dir)?;
+    outputs::clear_partials(out_dir);
+    let mut written = outputs::write_all(out_dir, w.shots, w.fit, w.spec, w.files)?;
+    let tracks: Vec<_> = w.failed_tracks.iter().map(|(c, t, _)| (c.clone(), t.clone())).collect();
+    outputs::write_failed_trajectories(out_dir, &tracks, w.files)?;
+    outputs::remove_stale_trajectories(out_dir, w.files)?;
+    written.push(outputs::write_comparison(out_dir, w.comparison)?);
+    if let Ok(st) = w.stats {
+        written.push(outputs::write_anova(out_dir, &st.ancova)?);
     }
-    if let Ok(d) = &diagnosis {
-        outputs.push(options.out_dir.join("diagnosis.json"));
+    if let Ok(d) = w.diagnosis {
+        written.push(out_dir.join("diagnosis.json"));
         // Kept per model version, so a later run with another model can show this verdict as the earlier one.
-        outputs::keep_diagnosis(&options.out_dir, version, d)?;
+        outputs::keep_diagnosis(out_dir, w.version, d)?;
     }
-    timings.push((Stage::Report, t.elapsed().as_secs_f64()));
-    let started_report = std::time::Instant::now();
-    let fitted_at = store.latest_fit(measure.session_id)?.map(|f| f.created_at);
+    Ok(written)
+}
+
+/// `report.html` (and the figures' data) from `analysis`, added to its outputs.
+fn write_report(out_dir: &Path, analysis: &mut Analysis, session: &Session) -> Result<(), AnalyzeError> {
     let description = session
         .metadata
         .get("session")
@@ -450,103 +457,9 @@ pub fn analyze(
         .and_then(|d| d.as_str())
         .map(str::to_string);
     let warnings: Vec<String> = session.warnings.iter().map(|w| w.to_string()).collect();
-    let mut analysis = Analysis {
-        fitted_at,
-        session_dir: session_dir.to_path_buf(),
-        shots_listed: session.listed().len(),
-        measure,
-        model_origin: spec.origin.clone(),
-        model: spec.clone(),
-        model_version: version,
-        previous_diagnosis,
-        fit,
-        shots,
-        excluded,
-        before,
-        history,
-        comparison,
-        failure,
-        diagnosis,
-        stats,
-        outputs,
-        timings,
-    };
-    let written = report::write(
-        &options.out_dir,
-        &analysis,
-        &session.clips,
-        description.as_deref(),
-        &warnings,
-    )?;
+    let written = report::write(out_dir, analysis, &session.clips, description.as_deref(), &warnings)?;
     analysis.outputs.extend(written);
-    if let Some((_, t)) = analysis.timings.iter_mut().find(|(s, _)| *s == Stage::Report) {
-        *t += started_report.elapsed().as_secs_f64();
-    }
-    Ok(analysis)
-}
-
-/// The error of the previous model version fitted to the session against this one's, per shot and in total.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct BeforeAfter {
-    /// The earlier model version's name.
-    pub before_model: String,
-    /// The store's id of the earlier model version.
-    pub before_version: i64,
-    /// The earlier model version's `model.toml` text.
-    pub before_toml: String,
-    /// When it was fitted (ISO 8601, UTC).
-    pub before_fitted_at: String,
-    /// Position RMS of all residuals, m: (before, after).
-    pub total_rms_m: (f64, f64),
-    /// Reduced χ²: (before, after).
-    pub reduced_chi2: (f64, f64),
-    /// Per shot present in both fits: (clip, RMS before, RMS after), m.
-    pub shots: Vec<(String, f64, f64)>,
-}
-
-/// The latest fit of this session by another model version than `version`, against `fit`.
-fn before_after(
-    store: &Store,
-    session_id: i64,
-    version: i64,
-    fit: &FitResult,
-) -> Result<Option<BeforeAfter>, AnalyzeError> {
-    let Some(prev) = store
-        .fits(Some(session_id))?
-        .into_iter()
-        .rev()
-        .find(|f| f.record.model_version_id != version)
-    else {
-        return Ok(None);
-    };
-    let Ok(old) = serde_json::from_str::<FitResult>(&prev.record.json) else {
-        return Ok(None);
-    };
-    let prev_version = store
-        .model_versions()?
-        .into_iter()
-        .find(|v| v.id == prev.record.model_version_id);
-    let name = prev_version
-        .as_ref()
-        .map(|v| format!("{} (version {})", v.record.name, v.id))
-        .unwrap_or_else(|| old.model.clone());
-    let shots = fit
-        .shots
-        .iter()
-        .filter_map(|s| {
-            let b = old.shots.iter().find(|o| o.name == s.name)?;
-            Some((s.name.clone(), b.rms_m, s.rms_m))
-        })
-        .collect();
-    Ok(Some(BeforeAfter {
-        before_model: name,
-        before_version: prev.record.model_version_id,
-        before_toml: prev_version.map(|v| v.record.toml).unwrap_or_default(),
-        before_fitted_at: prev.created_at,
-        total_rms_m: (old.rms_m, fit.rms_m),
-        reduced_chi2: (old.reduced_chi2, fit.reduced_chi2),
-        shots,
-    }))
+    Ok(())
 }
 
 /// Shots whose estimate says their numbers are not to be trusted (see `Estimate::flags`: a flight that does not
@@ -559,135 +472,18 @@ pub fn flagged_shots(shots: &[ShotData]) -> Vec<(String, String)> {
         .collect()
 }
 
-/// How far a shot's flight fits may scatter beyond the session's typical shot before its track is suspect.
-pub const SUSPECT_FLIGHT_FACTOR: f64 = 25.0;
-
-/// Shots whose flight phases are not ballistic to within the tracking noise, far beyond the session's other
-/// shots: the worst flight fit's reduced χ² above [`SUSPECT_FLIGHT_FACTOR`] × the session's median and above
-/// 9 (3σ scatter). No contact model can fix a flight phase, so such a track (a seam or a shadow followed for
-/// some frames) would only bend the shared fit; the shot keeps its estimates and is listed with the reason.
-/// A missing flight effect (drag) raises every shot's χ² and so the median with it.
+/// Shots whose flight phases scatter far beyond the session's other shots, with the reason: the fit
+/// crate's rule ([`bouncelab_fit::suspect_flights`]) over each shot's flight fits.
 pub fn suspect_tracks(shots: &[ShotData]) -> Vec<(String, String)> {
-    let worst = |s: &ShotData| s.estimate.chi2_red.iter().cloned().fold(0.0, f64::max);
-    let mut all: Vec<f64> = shots.iter().map(worst).filter(|v| v.is_finite()).collect();
-    if all.len() < 3 {
-        return Vec::new();
-    }
-    all.sort_by(f64::total_cmp);
-    let median = all[all.len() / 2];
-    shots
-        .iter()
-        .filter(|s| {
-            let w = worst(s);
-            !w.is_finite() || (w > 9.0 && w > SUSPECT_FLIGHT_FACTOR * median)
-        })
-        .map(|s| {
-            (
-                s.clip.clone(),
-                format!(
-                    "its flight fits scatter {:.0}× more than the tracker's σ (reduced χ² {:.1}; session median {:.2}): the track is suspect",
-                    worst(s).sqrt(),
-                    worst(s),
-                    median
-                ),
-            )
-        })
+    let flights: Vec<&[f64]> = shots.iter().map(|s| s.estimate.chi2_red.as_slice()).collect();
+    bouncelab_fit::suspect_flights(&flights)
+        .into_iter()
+        .map(|(i, why)| (shots[i].clip.clone(), why))
         .collect()
 }
 
-/// The search's options: the defaults, with each shot's surface level fitted within its line's σ.
-fn search_options() -> SearchOptions {
-    SearchOptions {
-        surface_levels: true,
-        ..SearchOptions::default()
-    }
-}
-
-/// The missing-effect search, or its stored result when neither the shots, their measurements, the model
-/// nor the program changed since it ran (it is the slowest stage after tracking).
-fn diagnose_stage(
-    spec: &ModelSpec,
-    model_text: &str,
-    shots: &[&ShotData],
-    extras: &[ShotExtras],
-    out_dir: &Path,
-    progress: &dyn Progress,
-) -> Result<Diagnosis, AnalyzeError> {
-    let options = search_options();
-    let mut key = Fingerprint::new();
-    key.str(env!("CARGO_PKG_VERSION"))
-        .str(model_text)
-        .str(&format!("{options:?}"));
-    for s in shots {
-        key.str(&s.clip)
-            .str(&serde_json::to_string(&s.measured).unwrap_or_default());
-    }
-    let key = key.finish();
-    let path = out_dir.join("diagnosis.json");
-    let key_path = out_dir.join(".diagnosis-inputs");
-    if std::fs::read_to_string(&key_path).is_ok_and(|k| k.trim() == key)
-        && let Some(d) = std::fs::read_to_string(&path)
-            .ok()
-            .and_then(|t| serde_json::from_str::<Diagnosis>(&t).ok())
-    {
-        progress.finish(
-            Stage::Diagnose,
-            &format!(
-                "unchanged since the last run ({} candidate(s) in diagnosis.json)",
-                d.candidates.len()
-            ),
-        );
-        return Ok(d);
-    }
-    let measured: Vec<_> = shots.iter().map(|s| s.measured.clone()).collect();
-    // The current model plus every library effect it lacks.
-    let total = 1 + bouncelab_model::builtin_effects()
-        .iter()
-        .filter(|e| !e.base && !spec.has_effect(e.name))
-        .count();
-    progress.start(Stage::Diagnose, total as u64);
-    let last = std::sync::atomic::AtomicUsize::new(0);
-    let report = |p: bouncelab_diagnose::Progress| {
-        if let Some(i) = p.iteration {
-            // A solver iteration of the model being fitted.
-            progress.iteration(Stage::Diagnose, i, p.chi2_red.unwrap_or(f64::NAN));
-            return;
-        }
-        let before = last.swap(p.done, std::sync::atomic::Ordering::Relaxed);
-        progress.advance(Stage::Diagnose, p.done.saturating_sub(before) as u64);
-        progress.doing(Stage::Diagnose, &p.what);
-    };
-    let d = find_missing_effect_with(spec, &measured, extras, &options, &report)?;
-    outputs::write_atomic(&path, |w| w.write_all(d.to_json().as_bytes()))?;
-    outputs::write_atomic(&key_path, |w| w.write_all(key.as_bytes()))?;
-    progress.finish(
-        Stage::Diagnose,
-        &format!(
-            "{} candidate effect(s) fitted in {:.1} s",
-            d.candidates.len(),
-            d.seconds
-        ),
-    );
-    Ok(d)
-}
-
-/// The paper's statistics of a session (`docs/stats.md`).
-#[derive(Debug, Clone)]
-pub struct SessionStats {
-    /// The terms fitted, in order (those with a single level are left out).
-    pub terms: Vec<&'static str>,
-    /// ANCOVA of COR (Type I and II), its fit and diagnostics.
-    pub ancova: Ancova,
-    /// Tukey–Kramer comparisons of the surfaces' raw means at α = 0.05, when there are two or more (one-way:
-    /// the impact speed is not accounted for; `inference` holds the comparisons that agree with the ANCOVA).
-    pub tukey: Option<TukeyHsd>,
-    /// The same fit's coefficients with SE, t and p, adjusted means of every factor with Tukey–Kramer and
-    /// Holm comparisons, and its residual tests (α = 0.05), or why they could not be computed.
-    pub inference: Result<AncovaInference, String>,
-}
-
-/// ANCOVA of COR on surface and angle with the incoming normal speed as covariate, and Tukey–Kramer pairwise
-/// comparisons of the surfaces; a factor with one level is left out. `Err` says why nothing could be fitted.
+/// The paper's statistics of the session's shots ([`bouncelab_stats::session_stats`] of their COR,
+/// angle and incoming normal speed); `Err` says why nothing could be fitted.
 pub fn session_stats(shots: &[ShotData]) -> Result<SessionStats, String> {
     let rows: Vec<CorObservation> = shots
         .iter()
@@ -698,77 +494,7 @@ pub fn session_stats(shots: &[ShotData]) -> Result<SessionStats, String> {
             cor: s.estimate.cor.value,
         })
         .collect();
-    let distinct = |f: &dyn Fn(&CorObservation) -> String| {
-        let mut v: Vec<String> = rows.iter().map(f).collect();
-        v.sort();
-        v.dedup();
-        v.len()
-    };
-    let surfaces = distinct(&|r| r.surface.clone());
-    let angles = distinct(&|r| format!("{}", r.angle));
-    let terms: Vec<&'static str> = PAPER_TERMS
-        .into_iter()
-        .filter(|t| match *t {
-            "surface" => surfaces > 1,
-            "angle" => angles > 1,
-            _ => true,
-        })
-        .collect();
-    let data = Dataset::from_cor(&rows).map_err(|e| e.to_string())?;
-    let ancova = ancova(&data, &terms).map_err(|e| format!("{} shot(s): {e}", shots.len()))?;
-    let tukey = if surfaces > 1 {
-        Some(tukey_hsd_factor(&data, "surface", 0.05).map_err(|e| e.to_string())?)
-    } else {
-        None
-    };
-    let inference = ancova_inference(&data, &terms, 0.05).map_err(|e| e.to_string());
-    Ok(SessionStats {
-        terms,
-        ancova,
-        tukey,
-        inference,
-    })
-}
-
-/// The evidence a shot carries besides its frames: drop height, contact time, the camera's roll from the
-/// surface line's tilt, and the spin measured before and after the impact (at the first and last fitted
-/// frames, where the flight arcs hold it constant but for rolling resistance and drag, which act slowly).
-fn shot_extras(s: &ShotData) -> ShotExtras {
-    let frames = &s.measured.frames;
-    let mut spin = Vec::new();
-    if let (Some(m), Some(f)) = (s.estimate.spin_in, frames.first())
-        && m.se > 0.0
-        && m.value.is_finite()
-    {
-        spin.push(SpinFrame {
-            t_s: f.t_s,
-            omega_rad_s: m.value,
-            sigma_rad_s: m.se,
-        });
-    }
-    if let (Some(m), Some(f)) = (s.estimate.spin_out, frames.last())
-        && m.se > 0.0
-        && m.value.is_finite()
-    {
-        spin.push(SpinFrame {
-            t_s: f.t_s,
-            omega_rad_s: m.value,
-            sigma_rad_s: m.se,
-        });
-    }
-    ShotExtras {
-        drop_height_m: Some(s.drop_height_m),
-        contact_time_s: Some(s.estimate.contact_ms.value * 1e-3),
-        camera_roll_deg: s.track.surface_tilt_deg,
-        spin,
-    }
-}
-
-/// The name a model version is stored under: the file's name, or the built-in model's.
-fn model_name(path: Option<&Path>) -> String {
-    path.and_then(|p| p.file_name())
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "built-in paper model".into())
+    bouncelab_stats::session_stats(&rows).map_err(|e| e.to_string())
 }
 
 fn create_dir(dir: &Path) -> Result<(), AnalyzeError> {

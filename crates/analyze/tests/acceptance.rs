@@ -10,7 +10,7 @@
 //! (CI runs it). Each test prints the verdict and the figures recorded in `docs/accuracy.md`, and the rows
 //! of the verdict table (`| preset | verdict | magnitude recovered | interval covers truth | time |`).
 
-use bouncelab_analyze::{Analysis, AnalyzeOptions, Silent, analyze};
+use bouncelab_analyze::{Analysis, AnalyzeOptions, NoProgress, analyze};
 use bouncelab_diagnose::{VerdictKind, add_effect_to_model_toml};
 use bouncelab_frames::ClipOptions;
 use bouncelab_render::{RenderOptions, Scenario, render_with};
@@ -38,7 +38,7 @@ fn run(session: &Path, root: &Path, model: Option<PathBuf>) -> Analysis {
         diagnose: true,
         clip_options: ClipOptions::default(),
     };
-    let a = analyze(session, &options, &Silent).unwrap_or_else(|e| panic!("analysing {}: {e}", session.display()));
+    let a = analyze(session, &options, &NoProgress).unwrap_or_else(|e| panic!("analysing {}: {e}", session.display()));
     assert!(a.measure.failed.is_empty(), "shots failed: {:?}", a.measure.failed);
     a
 }

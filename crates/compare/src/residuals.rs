@@ -1,8 +1,8 @@
 //! Residual series per shot, split by phase and component, with RMS, reduced χ² and output errors.
 
 use crate::CompareError;
-use bouncelab_fit::{MeasuredShot, Problem};
-use bouncelab_model::{Phase, Simulation};
+use bouncelab_fit::{MeasuredOutputs, MeasuredShot, Problem};
+use bouncelab_model::{Impact, Phase, Simulation};
 use serde::{Deserialize, Serialize};
 
 /// Two times closer than this are the same frame, s.
@@ -310,6 +310,48 @@ pub fn compare_shot(
         )));
     }
     let imp = &sim.impact;
+    let (table, residuals) = residual_table(shot, sim, extras)?;
+    let by_phase = stats_of(&table);
+    let (mut sq, mut chi2, mut n, mut n_pos) = (0.0, 0.0, 0usize, 0usize);
+    for s in &by_phase {
+        chi2 += s.chi2;
+        n += s.n;
+        if s.component != Component::Spin {
+            sq += s.rms_m * s.rms_m * s.n as f64;
+            n_pos += s.n;
+        }
+    }
+    let output_errors = shot.measured.map(|m| output_errors(&m, imp));
+    Ok(ShotComparison {
+        shot: shot.name.clone(),
+        surface: shot.surface.clone(),
+        incline_deg: shot.incline_rad.to_degrees(),
+        impact_speed_m_s: imp.state_in.vy.abs(),
+        drop_height_m: extras.drop_height_m,
+        camera_roll_deg: extras.camera_roll_deg,
+        contact_time_error_ms: extras.contact_time_s.map(|tc| (tc - imp.contact_time()) * 1e3),
+        residuals,
+        by_phase,
+        output_errors,
+        rms_m: if n_pos > 0 { (sq / n_pos as f64).sqrt() } else { 0.0 },
+        chi2,
+        n,
+    })
+}
+
+/// Every frame's residual (measured − simulated) with its phase, summed per phase and component into a
+/// table, and the spin residuals at the frames `extras` gives spin at. Fails naming the shot when a frame's
+/// sample is at another time, a spin value is unusable or a spin time is not a frame time.
+fn residual_table(
+    shot: &MeasuredShot,
+    sim: &Simulation,
+    extras: &ShotExtras,
+) -> Result<(Table, Vec<ResidualPoint>), CompareError> {
+    let mismatch = |reason: String| CompareError::Mismatch {
+        shot: shot.name.clone(),
+        reason,
+    };
+    let imp = &sim.impact;
     let mut table = Table::default();
     let mut residuals = Vec::with_capacity(shot.frames.len());
     let mut spin = extras.spin.iter().peekable();
@@ -361,50 +403,27 @@ pub fn compare_shot(
             sp.t_s
         )));
     }
-    let by_phase = stats_of(&table);
-    let (mut sq, mut chi2, mut n, mut n_pos) = (0.0, 0.0, 0usize, 0usize);
-    for s in &by_phase {
-        chi2 += s.chi2;
-        n += s.n;
-        if s.component != Component::Spin {
-            sq += s.rms_m * s.rms_m * s.n as f64;
-            n_pos += s.n;
-        }
+    Ok((table, residuals))
+}
+
+/// The measured outputs `m` against the simulated impact's.
+fn output_errors(m: &MeasuredOutputs, imp: &Impact) -> OutputErrors {
+    let pred = [imp.state_out.vx, imp.state_out.vy];
+    let pct =
+        |k: usize| (m.v_out[k].abs() >= MIN_SPEED_FOR_PCT).then(|| (m.v_out[k] - pred[k]) / m.v_out[k].abs() * 100.0);
+    OutputErrors {
+        v_out_t_pct: pct(0),
+        v_out_n_pct: pct(1),
+        cor_pct: (m.cor - imp.restitution) / m.cor * 100.0,
+        cor_abs: m.cor - imp.restitution,
+        mu_abs: m.mu - imp.effective_friction,
+        cor_measured: m.cor,
+        cor_predicted: imp.restitution,
+        mu_measured: m.mu,
+        mu_predicted: imp.effective_friction,
+        v_out_measured: m.v_out,
+        v_out_predicted: pred,
     }
-    let output_errors = shot.measured.map(|m| {
-        let pred = [imp.state_out.vx, imp.state_out.vy];
-        let pct = |k: usize| {
-            (m.v_out[k].abs() >= MIN_SPEED_FOR_PCT).then(|| (m.v_out[k] - pred[k]) / m.v_out[k].abs() * 100.0)
-        };
-        OutputErrors {
-            v_out_t_pct: pct(0),
-            v_out_n_pct: pct(1),
-            cor_pct: (m.cor - imp.restitution) / m.cor * 100.0,
-            cor_abs: m.cor - imp.restitution,
-            mu_abs: m.mu - imp.effective_friction,
-            cor_measured: m.cor,
-            cor_predicted: imp.restitution,
-            mu_measured: m.mu,
-            mu_predicted: imp.effective_friction,
-            v_out_measured: m.v_out,
-            v_out_predicted: pred,
-        }
-    });
-    Ok(ShotComparison {
-        shot: shot.name.clone(),
-        surface: shot.surface.clone(),
-        incline_deg: shot.incline_rad.to_degrees(),
-        impact_speed_m_s: imp.state_in.vy.abs(),
-        drop_height_m: extras.drop_height_m,
-        camera_roll_deg: extras.camera_roll_deg,
-        contact_time_error_ms: extras.contact_time_s.map(|tc| (tc - imp.contact_time()) * 1e3),
-        residuals,
-        by_phase,
-        output_errors,
-        rms_m: if n_pos > 0 { (sq / n_pos as f64).sqrt() } else { 0.0 },
-        chi2,
-        n,
-    })
 }
 
 /// Compares every shot with its simulation; `extras` is empty (no extras) or one per shot; `n_params` is

@@ -1,7 +1,7 @@
 //! Where the model fails: χ² shares by phase and component, and per-shot errors against the conditions.
 
 use crate::{Comparison, Component, ImpactPhase, ShotComparison};
-use bouncelab_stats::{holm, p_text};
+use bouncelab_stats::{LineFit, fit_line, holm, p_text};
 use serde::{Deserialize, Serialize};
 use statrs::distribution::{ContinuousCDF, FisherSnedecor, StudentsT};
 
@@ -255,39 +255,10 @@ fn signed(v: f64, decimals: usize) -> String {
     s.replacen('-', "−", 1)
 }
 
-struct Line {
-    slope: f64,
-    se: f64,
-    p: f64,
-}
-
-/// Ordinary least squares `y = a + b·x`; `None` when x does not vary or n < 3.
-fn regress(x: &[f64], y: &[f64]) -> Option<Line> {
-    let n = x.len();
-    if n < 3 {
-        return None;
-    }
-    let mx = x.iter().sum::<f64>() / n as f64;
-    let my = y.iter().sum::<f64>() / n as f64;
-    let sxx: f64 = x.iter().map(|v| (v - mx) * (v - mx)).sum();
-    let sxy: f64 = x.iter().zip(y).map(|(a, b)| (a - mx) * (b - my)).sum();
-    let floor = 1e-12 * x.iter().map(|v| v * v).sum::<f64>().max(1e-300);
-    if sxx.is_nan() || sxx <= floor {
-        return None;
-    }
-    let slope = sxy / sxx;
-    let sse: f64 = x.iter().zip(y).map(|(a, b)| (b - my - slope * (a - mx)).powi(2)).sum();
-    let df = (n - 2) as f64;
-    let se = (sse / df / sxx).sqrt();
-    let t = slope / se;
-    let p = if se > 0.0 {
-        StudentsT::new(0.0, 1.0, df)
-            .map(|d| 2.0 * d.sf(t.abs()))
-            .unwrap_or(f64::NAN)
-    } else {
-        0.0
-    };
-    Some(Line { slope, se, p })
+/// The least-squares line `y = a + b·x` (the stats crate's); `None` when x does not vary, n < 3 or a value
+/// is not finite.
+fn regress(x: &[f64], y: &[f64]) -> Option<LineFit> {
+    fit_line(x, y, None).ok()
 }
 
 fn mean_sd(y: &[f64]) -> (f64, f64) {
@@ -301,160 +272,199 @@ fn mean_sd(y: &[f64]) -> (f64, f64) {
     (m, var.sqrt())
 }
 
-fn test(q: Quantity, a: Against, shots: &[ShotComparison], opts: &DiagnoseOptions) -> Option<Trend> {
-    let (subject, unit, dec) = q.words();
-    let (xw, xu) = a.words();
-    let have: Vec<&ShotComparison> = shots.iter().filter(|s| q.of(s).is_some()).collect();
-    let trend = |slope: f64, se: f64, p: f64, f: Option<f64>, n: usize, size: f64, sentence: String| Trend {
-        quantity: q,
-        against: a,
-        slope,
-        slope_se: se,
-        t: slope / se,
-        p,
-        p_holm: p,
-        f,
-        n,
-        significant: false,
-        size,
-        material: size >= q.material(),
-        sentence,
+/// One test of quantity `q` against condition `a` over the shots that have `q`; `None` when the shots
+/// cannot test it (too few, no spread, one surface …).
+fn trend_of(q: Quantity, a: Against, shots: &[ShotComparison], opts: &DiagnoseOptions) -> Option<Trend> {
+    let t = TrendTest {
+        q,
+        a,
+        have: shots.iter().filter(|s| q.of(s).is_some()).collect(),
+        min_shots: opts.min_shots,
     };
     match a {
-        Against::Mean => {
-            if q == Quantity::ResidualRms {
-                return None;
-            }
-            let y: Vec<f64> = have.iter().filter_map(|s| q.of(s)).collect();
-            if y.len() < opts.min_shots {
-                return None;
-            }
-            let (m, sd) = mean_sd(&y);
-            if sd < q.tiny() {
-                return None;
-            }
-            let se = sd / (y.len() as f64).sqrt();
-            let p = StudentsT::new(0.0, 1.0, (y.len() - 1) as f64)
-                .map(|d| 2.0 * d.sf((m / se).abs()))
-                .unwrap_or(f64::NAN);
-            let verb = if m < 0.0 { "over-predicts" } else { "under-predicts" };
-            let sentence = format!(
-                "The model {verb} {subject} by {:.*}{unit} on average ({}, n = {}).",
-                dec,
-                m.abs(),
-                p_text(p),
-                y.len()
-            );
-            Some(trend(m, se, p, None, y.len(), m.abs(), sentence))
+        Against::Mean => t.mean_offset(),
+        Against::Surface => t.between_surfaces(),
+        _ => t.slope(),
+    }
+}
+
+/// A quantity tested against a condition over the shots that have it.
+struct TrendTest<'a> {
+    q: Quantity,
+    a: Against,
+    have: Vec<&'a ShotComparison>,
+    min_shots: usize,
+}
+
+impl TrendTest<'_> {
+    /// The trend's record from its figures (Holm's adjustment and significance come later).
+    #[allow(clippy::too_many_arguments)]
+    fn trend(&self, slope: f64, se: f64, p: f64, f: Option<f64>, n: usize, size: f64, sentence: String) -> Trend {
+        Trend {
+            quantity: self.q,
+            against: self.a,
+            slope,
+            slope_se: se,
+            t: slope / se,
+            p,
+            p_holm: p,
+            f,
+            n,
+            significant: false,
+            size,
+            material: size >= self.q.material(),
+            sentence,
         }
-        Against::Surface => {
-            let mut groups: Vec<(String, Vec<f64>)> = Vec::new();
-            for s in &have {
-                let v = q.of(s).expect("filtered");
-                match groups.iter_mut().find(|(g, _)| *g == s.surface) {
-                    Some((_, vs)) => vs.push(v),
-                    None => groups.push((s.surface.clone(), vec![v])),
-                }
-            }
-            let n: usize = groups.iter().map(|(_, v)| v.len()).sum();
-            let k = groups.len();
-            if k < 2 || n <= k || n < opts.min_shots {
-                return None;
-            }
-            let all: Vec<f64> = groups.iter().flat_map(|(_, v)| v.iter().copied()).collect();
-            let (grand, sd) = mean_sd(&all);
-            if sd < q.tiny() {
-                return None;
-            }
-            let means: Vec<f64> = groups.iter().map(|(_, v)| mean_sd(v).0).collect();
-            let ssb: f64 = groups
-                .iter()
-                .zip(&means)
-                .map(|((_, v), m)| v.len() as f64 * (m - grand).powi(2))
-                .sum();
-            let ssw: f64 = groups
-                .iter()
-                .zip(&means)
-                .map(|((_, v), m)| v.iter().map(|x| (x - m).powi(2)).sum::<f64>())
-                .sum();
-            let (d1, d2) = ((k - 1) as f64, (n - k) as f64);
-            let msw = ssw / d2;
-            let f = (ssb / d1) / msw;
-            let p = if msw > 0.0 {
-                FisherSnedecor::new(d1, d2).map(|d| d.sf(f)).unwrap_or(f64::NAN)
-            } else {
-                0.0
-            };
-            let hi = (0..k).max_by(|&i, &j| means[i].total_cmp(&means[j])).expect("k ≥ 2");
-            let lo = (0..k).min_by(|&i, &j| means[i].total_cmp(&means[j])).expect("k ≥ 2");
-            let slope = means[hi] - means[lo];
-            let se = (msw * (1.0 / groups[hi].1.len() as f64 + 1.0 / groups[lo].1.len() as f64)).sqrt();
-            let what = if q == Quantity::ResidualRms {
-                subject.to_string()
-            } else {
-                format!("{subject} relative to the model (measured − predicted)")
-            };
-            let sentence = format!(
-                "{} differs between surfaces (F = {f:.1}, {}): highest on {} ({}{unit}), lowest on {} ({}{unit}).",
-                capitalise(&what),
-                p_text(p),
-                groups[hi].0,
-                signed(means[hi], dec),
-                groups[lo].0,
-                signed(means[lo], dec)
-            );
-            Some(trend(slope, se, p, Some(f), n, slope.abs(), sentence))
+    }
+
+    /// Does the model miss the quantity on average? A one-sample t test of its mean.
+    fn mean_offset(&self) -> Option<Trend> {
+        let q = self.q;
+        let (subject, unit, dec) = q.words();
+        if q == Quantity::ResidualRms {
+            return None;
         }
-        _ => {
-            let pairs: Vec<(f64, f64, Option<f64>)> = have
-                .iter()
-                .filter_map(|s| Some((a.x(s)?, q.of(s)?, q.predicted(s))))
-                .collect();
-            if pairs.len() < opts.min_shots {
-                return None;
+        let y: Vec<f64> = self.have.iter().filter_map(|s| q.of(s)).collect();
+        if y.len() < self.min_shots {
+            return None;
+        }
+        let (m, sd) = mean_sd(&y);
+        if sd < q.tiny() {
+            return None;
+        }
+        let se = sd / (y.len() as f64).sqrt();
+        let p = StudentsT::new(0.0, 1.0, (y.len() - 1) as f64)
+            .map(|d| 2.0 * d.sf((m / se).abs()))
+            .unwrap_or(f64::NAN);
+        let verb = if m < 0.0 { "over-predicts" } else { "under-predicts" };
+        let sentence = format!(
+            "The model {verb} {subject} by {:.*}{unit} on average ({}, n = {}).",
+            dec,
+            m.abs(),
+            p_text(p),
+            y.len()
+        );
+        Some(self.trend(m, se, p, None, y.len(), m.abs(), sentence))
+    }
+
+    /// Does the quantity differ between surfaces? One-way ANOVA, the slope being the highest surface's
+    /// mean minus the lowest's.
+    fn between_surfaces(&self) -> Option<Trend> {
+        let q = self.q;
+        let (subject, unit, dec) = q.words();
+        let mut groups: Vec<(String, Vec<f64>)> = Vec::new();
+        for s in &self.have {
+            let v = q.of(s).expect("filtered");
+            match groups.iter_mut().find(|(g, _)| *g == s.surface) {
+                Some((_, vs)) => vs.push(v),
+                None => groups.push((s.surface.clone(), vec![v])),
             }
-            let x: Vec<f64> = pairs.iter().map(|p| p.0).collect();
-            let y: Vec<f64> = pairs.iter().map(|p| p.1).collect();
-            if mean_sd(&y).1 < q.tiny() {
-                return None;
-            }
-            let line = regress(&x, &y)?;
-            let dir = if line.slope < 0.0 { "falls" } else { "rises" };
-            let per = format!("{}{unit} per {xu}", signed(line.slope, dec));
-            let mut sentence = if q == Quantity::ResidualRms {
-                format!("{} {dir} with {xw}, {per} ({}).", capitalise(subject), p_text(line.p))
-            } else {
-                format!(
-                    "{} {dir} with {xw} relative to the model, {per} (measured − predicted; {})",
-                    capitalise(subject),
-                    p_text(line.p)
-                )
-            };
-            if q != Quantity::ResidualRms {
-                let pred: Vec<f64> = pairs.iter().filter_map(|p| p.2).collect();
-                if pred.len() == x.len() {
-                    match regress(&x, &pred) {
-                        Some(pl) if pl.slope.abs() >= 0.1 * line.slope.abs() => {
-                            sentence.push_str(&format!("; the model predicts {} per {xu}.", signed(pl.slope, dec)))
-                        }
-                        _ => sentence.push_str("; the model predicts a constant."),
+        }
+        let n: usize = groups.iter().map(|(_, v)| v.len()).sum();
+        let k = groups.len();
+        if k < 2 || n <= k || n < self.min_shots {
+            return None;
+        }
+        let all: Vec<f64> = groups.iter().flat_map(|(_, v)| v.iter().copied()).collect();
+        let (grand, sd) = mean_sd(&all);
+        if sd < q.tiny() {
+            return None;
+        }
+        let means: Vec<f64> = groups.iter().map(|(_, v)| mean_sd(v).0).collect();
+        let ssb: f64 = groups
+            .iter()
+            .zip(&means)
+            .map(|((_, v), m)| v.len() as f64 * (m - grand).powi(2))
+            .sum();
+        let ssw: f64 = groups
+            .iter()
+            .zip(&means)
+            .map(|((_, v), m)| v.iter().map(|x| (x - m).powi(2)).sum::<f64>())
+            .sum();
+        let (d1, d2) = ((k - 1) as f64, (n - k) as f64);
+        let msw = ssw / d2;
+        let f = (ssb / d1) / msw;
+        let p = if msw > 0.0 {
+            FisherSnedecor::new(d1, d2).map(|d| d.sf(f)).unwrap_or(f64::NAN)
+        } else {
+            0.0
+        };
+        let hi = (0..k).max_by(|&i, &j| means[i].total_cmp(&means[j])).expect("k ≥ 2");
+        let lo = (0..k).min_by(|&i, &j| means[i].total_cmp(&means[j])).expect("k ≥ 2");
+        let slope = means[hi] - means[lo];
+        let se = (msw * (1.0 / groups[hi].1.len() as f64 + 1.0 / groups[lo].1.len() as f64)).sqrt();
+        let what = if q == Quantity::ResidualRms {
+            subject.to_string()
+        } else {
+            format!("{subject} relative to the model (measured − predicted)")
+        };
+        let sentence = format!(
+            "{} differs between surfaces (F = {f:.1}, {}): highest on {} ({}{unit}), lowest on {} ({}{unit}).",
+            capitalise(&what),
+            p_text(p),
+            groups[hi].0,
+            signed(means[hi], dec),
+            groups[lo].0,
+            signed(means[lo], dec)
+        );
+        Some(self.trend(slope, se, p, Some(f), n, slope.abs(), sentence))
+    }
+
+    /// Does the quantity move with the condition? The least-squares line's slope, with the model's own
+    /// slope in the sentence.
+    fn slope(&self) -> Option<Trend> {
+        let (q, a) = (self.q, self.a);
+        let (subject, unit, dec) = q.words();
+        let (xw, xu) = a.words();
+        let pairs: Vec<(f64, f64, Option<f64>)> = self
+            .have
+            .iter()
+            .filter_map(|s| Some((a.x(s)?, q.of(s)?, q.predicted(s))))
+            .collect();
+        if pairs.len() < self.min_shots {
+            return None;
+        }
+        let x: Vec<f64> = pairs.iter().map(|p| p.0).collect();
+        let y: Vec<f64> = pairs.iter().map(|p| p.1).collect();
+        if mean_sd(&y).1 < q.tiny() {
+            return None;
+        }
+        let line = regress(&x, &y)?;
+        let dir = if line.slope < 0.0 { "falls" } else { "rises" };
+        let per = format!("{}{unit} per {xu}", signed(line.slope, dec));
+        let mut sentence = if q == Quantity::ResidualRms {
+            format!("{} {dir} with {xw}, {per} ({}).", capitalise(subject), p_text(line.p))
+        } else {
+            format!(
+                "{} {dir} with {xw} relative to the model, {per} (measured − predicted; {})",
+                capitalise(subject),
+                p_text(line.p)
+            )
+        };
+        if q != Quantity::ResidualRms {
+            let pred: Vec<f64> = pairs.iter().filter_map(|p| p.2).collect();
+            if pred.len() == x.len() {
+                match regress(&x, &pred) {
+                    Some(pl) if pl.slope.abs() >= 0.1 * line.slope.abs() => {
+                        sentence.push_str(&format!("; the model predicts {} per {xu}.", signed(pl.slope, dec)))
                     }
-                } else {
-                    sentence.push('.');
+                    _ => sentence.push_str("; the model predicts a constant."),
                 }
+            } else {
+                sentence.push('.');
             }
-            let range =
-                x.iter().cloned().fold(f64::NEG_INFINITY, f64::max) - x.iter().cloned().fold(f64::INFINITY, f64::min);
-            Some(trend(
-                line.slope,
-                line.se,
-                line.p,
-                None,
-                pairs.len(),
-                (line.slope * range).abs(),
-                sentence,
-            ))
         }
+        let range =
+            x.iter().cloned().fold(f64::NEG_INFINITY, f64::max) - x.iter().cloned().fold(f64::INFINITY, f64::min);
+        Some(self.trend(
+            line.slope,
+            line.slope_se,
+            line.p,
+            None,
+            pairs.len(),
+            (line.slope * range).abs(),
+            sentence,
+        ))
     }
 }
 
@@ -489,7 +499,7 @@ pub fn diagnose(comparison: &Comparison, opts: &DiagnoseOptions) -> FailureRepor
     let mut trends: Vec<Trend> = Quantity::ALL
         .iter()
         .flat_map(|q| Against::ALL.iter().map(move |a| (*q, *a)))
-        .filter_map(|(q, a)| test(q, a, &comparison.shots, opts))
+        .filter_map(|(q, a)| trend_of(q, a, &comparison.shots, opts))
         .collect();
     trends.sort_by(|a, b| a.p.total_cmp(&b.p));
     // Holm's step-down adjustment over the whole family.
@@ -620,7 +630,7 @@ mod tests {
         let l = regress(&x, &y).unwrap();
         // Sxx = 10, Sxy = 9.9, slope 0.99, SSE = 0.107, se = sqrt(0.107/3/10).
         assert!((l.slope - 0.99).abs() < 1e-12);
-        assert!((l.se - (0.107f64 / 30.0).sqrt()).abs() < 1e-12);
+        assert!((l.slope_se - (0.107f64 / 30.0).sqrt()).abs() < 1e-12);
         // t = 16.577 with 3 d.o.f.: two-sided p = 4.8e-4.
         assert!((l.p - 4.8e-4).abs() < 0.2e-4, "{}", l.p);
         assert!(regress(&[2.0; 5], &y).is_none());
@@ -634,7 +644,7 @@ mod tests {
         let vals_b = [-0.02, -0.01, -0.03, 0.0, -0.015];
         let mut shots: Vec<ShotComparison> = vals_a.iter().map(|v| shot("clay", 2.0, *v)).collect();
         shots.extend(vals_b.iter().map(|v| shot("tape", 2.0, *v)));
-        let t = test(
+        let t = trend_of(
             Quantity::CorError,
             Against::Surface,
             &shots,

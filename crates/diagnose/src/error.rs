@@ -30,6 +30,15 @@ pub enum DiagnoseError {
         /// The range it must be in.
         reason: String,
     },
+    /// The fit given as the current model's ([`FittedBaseline`](crate::FittedBaseline)) is not of this model
+    /// on these shots.
+    #[error("the fit given for the current model `{model}` does not match the search: {why}")]
+    BaselineMismatch {
+        /// The model file.
+        model: String,
+        /// What differs (parameters, shots, surface levels).
+        why: String,
+    },
     /// The current model could not be fitted to the shots (a bad shot, a simulation failing at the
     /// model's own values, no free parameter, …): there is nothing to compare candidates with.
     #[error("fitting the current model `{model}`: {source}")]

@@ -6,14 +6,13 @@
 //! neither, and the sums and summaries the search compares.
 
 use bouncelab_fit::{
-    FitError, LeastSquares, LevenbergMarquardt, MeasuredShot, NoObserver, Observer, Problem, SolverOutcome,
-    Termination, identified_inverse, profile_surface_level, surface_prior, weighted_residuals,
+    FitError, IterationObserver, LeastSquares, LevenbergMarquardt, MeasuredShot, NoObserver, Problem, SolverOutcome,
+    Termination, covariance, profile_surface_level, surface_prior, weighted_residuals,
 };
 use bouncelab_model::{Model, ModelSpec, SimOptions, Simulation};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use statrs::distribution::{ContinuousCDF, StudentsT};
 use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Shared parameters of a model against shots; residuals `(x_sim − x_m)/σ`, `(y_sim − y_m)/σ` per frame.
@@ -246,7 +245,7 @@ impl Evaluator {
         &self,
         solver: &LevenbergMarquardt,
         p0: &[f64],
-        observer: &mut dyn Observer,
+        observer: &mut dyn IterationObserver,
     ) -> Result<SolverOutcome, FitError> {
         solver.run(self, p0, observer)
     }
@@ -358,7 +357,8 @@ pub struct FittedValue {
     pub surface: Option<String>,
     /// Fitted value, in the parameter's unit (see `bouncelab effects`).
     pub value: f64,
-    /// Standard error, same unit (covariance `(JᵀJ)⁻¹·max(1, χ²_red)` as in the fit crate); `None` when the
+    /// Standard error, same unit (the fit crate's [`covariance`]: `(JᵀJ)⁻¹·max(1, χ²_red)`, each variance
+    /// raised to the cluster-robust one with the shots as clusters when that is larger); `None` when the
     /// parameter is not determined by the shots.
     pub std_error: Option<f64>,
     /// 95 % interval `value ± t·se`; `None` with `std_error`.
@@ -397,22 +397,14 @@ impl FitSummary {
     }
 }
 
-/// The summary of a solver outcome on `ev`.
+/// The summary of a solver outcome on `ev`: standard errors and intervals from the fit crate's
+/// [`covariance`] (the one path the fit's own result takes), χ² the minimised objective.
 pub(crate) fn summarize(ev: &Evaluator, effects: Vec<String>, out: &SolverOutcome, sq_m2: f64) -> FitSummary {
     let n = out.residuals.len();
-    let p = out.params.len() + ev.nuisance_per_shot() * ev.problem.shots().len();
-    let dof = n.saturating_sub(p).max(1);
+    let cov = covariance(&ev.problem, out, INTERVAL_CONFIDENCE);
+    let dof = cov.dof;
     let chi2_red = out.cost / dof as f64;
-    let t = StudentsT::new(0.0, 1.0, dof as f64)
-        .map(|t| t.inverse_cdf(0.975))
-        .unwrap_or(1.96);
-    // A parameter the shots do not determine (μ of a surface with only normal impacts) has no standard
-    // error; the others keep theirs.
-    let cov = out
-        .jacobian
-        .as_ref()
-        .and_then(|j| identified_inverse(j).0)
-        .map(|c| c * chi2_red.max(1.0));
+    let t = cov.t_quantile;
     let parameters = ev
         .problem
         .params()
@@ -420,7 +412,9 @@ pub(crate) fn summarize(ev: &Evaluator, effects: Vec<String>, out: &SolverOutcom
         .enumerate()
         .map(|(j, fp)| {
             let value = out.params[j];
-            let se = cov.as_ref().map(|c| c[(j, j)].sqrt()).filter(|s| s.is_finite());
+            // A parameter the shots do not determine (μ of a surface with only normal impacts) has no
+            // standard error; the others keep theirs.
+            let se = cov.std_error(j);
             FittedValue {
                 name: fp.name.clone(),
                 effect: fp.effect.clone(),
@@ -445,6 +439,9 @@ pub(crate) fn summarize(ev: &Evaluator, effects: Vec<String>, out: &SolverOutcom
         termination: out.termination.clone(),
     }
 }
+
+/// Confidence level of a [`FittedValue`]'s interval.
+const INTERVAL_CONFIDENCE: f64 = 0.95;
 
 #[cfg(test)]
 mod tests {

@@ -78,13 +78,13 @@ pub(crate) fn learn(shots: &[MeasuredShot], sims: &[Simulation], noise_m: f64, c
                 }
             }
         }
-        per_shot.push((s_dof > 0).then(|| crate::search::excess(s_sq / s_dof as f64, noise_m)));
+        per_shot.push((s_dof > 0).then(|| crate::stats::excess(s_sq / s_dof as f64, noise_m)));
         sq += s_sq;
         dof += s_dof;
     }
     // Each component of an arc counted its frames once; a frame has two.
     let frames = frames / 2;
-    let flight_systematic_m = (dof > 0).then(|| crate::search::excess(sq / dof as f64, noise_m));
+    let flight_systematic_m = (dof > 0).then(|| crate::stats::excess(sq / dof as f64, noise_m));
     let structure = flight_systematic_m.unwrap_or(0.0);
     Floor {
         floor_m: structure.hypot(contact_allowance_m),

@@ -21,19 +21,23 @@
 //! explains only part of it, the search goes on from the model with it and may name a second
 //! ([`Diagnosis::then`]).
 //!
-//! [`find_missing_effect`] returns a [`Diagnosis`] (`diagnosis.json`); [`add_effect_to_model_toml`] adds the
+//! [`find_missing_effect`] returns a [`Diagnosis`] (`diagnosis.json`); [`find_missing_effect_from`] starts
+//! from the current model as the caller already fitted and compared it ([`FittedBaseline`]); [`add_effect_to_model_toml`] adds the
 //! named effect to the user's `model.toml`, comments kept. See `docs/diagnosis.md`.
 
 mod candidates;
 mod diagnosis;
 mod error;
 mod evaluate;
+mod evidence;
 mod floor;
 mod model_file;
 mod options;
 mod proposal;
+mod run;
 mod search;
 mod stats;
+mod terms;
 mod verdict;
 
 pub use candidates::CandidateSetup;
@@ -44,6 +48,6 @@ pub use diagnosis::{
 pub use error::DiagnoseError;
 pub use evaluate::{FitSummary, FittedValue};
 pub use model_file::add_effect_to_model_toml;
-pub use options::{Progress, SearchOptions};
+pub use options::{SearchOptions, SearchProgress};
 pub use proposal::{ProposedTerm, TermProposal};
-pub use search::{find_missing_effect, find_missing_effect_with};
+pub use search::{FittedBaseline, find_missing_effect, find_missing_effect_from, find_missing_effect_with};

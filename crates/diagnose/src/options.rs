@@ -178,7 +178,7 @@ impl SearchOptions {
 /// What the search is doing, reported before each fit of a model, after every solver iteration of each fit
 /// to all shots (`iteration`, `chi2_red`), and at the end: a progress bar shows `done / total` and `what`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Progress {
+pub struct SearchProgress {
     /// Models fitted so far (each with its cross-validation).
     pub done: usize,
     /// Models to fit: the current one plus every candidate.

@@ -1,6 +1,7 @@
-//! Small statistics: the white-noise level of residual series, a paired test across shots, folds (Holm's
-//! correction is the stats crate's).
+//! Small statistics: the white-noise level of residual series, the systematic part of a mean square, RMS
+//! over shots, a paired test across shots, folds (Holm's correction is the stats crate's).
 
+use crate::evaluate::ShotSums;
 use statrs::distribution::{ContinuousCDF, StudentsT};
 
 /// Sum of the squared coefficients of the third difference (1, −3, 3, −1).
@@ -33,6 +34,17 @@ pub(crate) fn white_noise(series: &[(Vec<f64>, Vec<f64>)]) -> Option<f64> {
     let mid = d.len() / 2;
     let (_, m, _) = d.select_nth_unstable_by(mid, f64::total_cmp);
     Some(*m / (MEDIAN_ABS_NORMAL * THIRD_DIFF_GAIN.sqrt()))
+}
+
+/// `√max(0, ms − noise²)`: the systematic part of a mean square, m.
+pub(crate) fn excess(ms: f64, noise_m: f64) -> f64 {
+    (ms - noise_m * noise_m).max(0.0).sqrt()
+}
+
+/// RMS over the residuals of the given shots, m (0 when there are none).
+pub(crate) fn rms_of<'a>(sums: impl Iterator<Item = &'a ShotSums>) -> f64 {
+    let (sq, n) = sums.fold((0.0, 0usize), |(a, n), s| (a + s.sq_m2, n + s.n));
+    if n == 0 { 0.0 } else { (sq / n as f64).sqrt() }
 }
 
 /// One-sided paired test that the values `d` (e.g. per-shot log ratios of held-out errors) have a positive

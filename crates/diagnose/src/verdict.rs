@@ -58,118 +58,18 @@ fn num(v: f64) -> String {
 pub(crate) fn decide(cands: &mut Vec<Candidate>, inp: Inputs<'_>) -> (Verdict, Baseline, Signature) {
     let o = inp.options;
     let noise = inp.noise_m;
-    let mut baseline = inp.baseline;
-    let signature = inp.signature;
+    let mut baseline = inp.baseline.clone();
+    let signature = inp.signature.clone();
 
-    // Does the current model misfit?
-    let mut reasons = Vec::new();
-    if baseline.systematic_m > o.tolerance_m {
-        reasons.push(format!(
-            "residual RMS {} against a noise level of {}: a systematic part of {}, above {}",
-            um(baseline.fit.rms_m),
-            um(noise),
-            um(baseline.systematic_m),
-            floor_words(inp.floor)
-        ));
-    }
-    let heldout_systematic = crate::search::excess(baseline.heldout_error_m.powi(2), noise);
-    if baseline.systematic_m <= o.tolerance_m && heldout_systematic > o.tolerance_m {
-        reasons.push(format!(
-            "held-out error {} against a noise level of {}: a systematic part of {}, above {}",
-            um(baseline.heldout_error_m),
-            um(noise),
-            um(heldout_systematic),
-            floor_words(inp.floor)
-        ));
-    }
-    for ph in &signature.phases {
-        if ph.systematic_m > o.phase_tolerance_m {
-            reasons.push(format!(
-                "{} {}: systematic residual {} (RMS {}), above the {} per-phase tolerance",
-                ph.component.name(),
-                ph.phase.words(),
-                um(ph.systematic_m),
-                um(ph.rms_m),
-                um(o.phase_tolerance_m)
-            ));
-        }
-    }
-    if o.use_trends {
-        for t in &signature.trends {
-            if t.quantity != Quantity::ResidualRms {
-                reasons.push(t.sentence.clone());
-            }
-        }
-    }
+    let reasons = misfit_reasons(&baseline, &signature, &inp);
     baseline.misfit = !reasons.is_empty();
     baseline.misfit_reasons = reasons;
 
-    // The checks.
-    let index: Vec<usize> = (0..cands.len()).collect();
     for c in cands.iter_mut() {
         check(c, o, noise);
     }
-
-    // Ranking: explaining candidates by ΔBIC, then the others by held-out error, failed fits last.
-    let mut order = index;
-    let key = |c: &Candidate| -> (u8, f64) {
-        match (&c.evidence, c.explains) {
-            (Some(e), true) => (0, e.delta_bic),
-            (Some(e), false) => (1, e.heldout_error_after),
-            (None, _) => (2, 0.0),
-        }
-    };
-    order.sort_by(|&a, &b| {
-        let (ka, kb) = (key(&cands[a]), key(&cands[b]));
-        ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1)).then(a.cmp(&b))
-    });
-
-    // Ties with the best explaining candidate.
-    let explaining: Vec<usize> = order.iter().copied().filter(|&i| cands[i].explains).collect();
-    let mut named: Vec<usize> = Vec::new();
-    let mut tie_words: Vec<String> = Vec::new();
-    if let Some(&best) = explaining.first() {
-        named.push(best);
-        for &j in &explaining[1..] {
-            let d: Vec<f64> = inp.heldout_chi2[j]
-                .iter()
-                .zip(&inp.heldout_chi2[best])
-                .filter_map(|(a, b)| {
-                    Some((a.as_ref()?.max(f64::MIN_POSITIVE) / b.as_ref()?.max(f64::MIN_POSITIVE)).ln())
-                })
-                .collect();
-            let (_, p) = stats::one_sided_t(&d);
-            // Mean held-out mean square of candidate `k` over the shots both predicted.
-            let ms = |k: usize| -> f64 {
-                let both = inp.heldout_ms[best].iter().zip(&inp.heldout_ms[j]);
-                let (s, n) = inp.heldout_ms[k]
-                    .iter()
-                    .zip(both)
-                    .filter(|(_, (a, b))| a.is_some() && b.is_some())
-                    .filter_map(|(v, _)| *v)
-                    .fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
-                s / n.max(1) as f64
-            };
-            let gap = (ms(j) - ms(best)).max(0.0).sqrt();
-            if p >= o.alpha || gap < o.tolerance_m {
-                named.push(j);
-                tie_words.push(if p >= o.alpha {
-                    format!(
-                        "`{}` predicts held-out shots not significantly worse ({})",
-                        cands[j].effect,
-                        p_text(p)
-                    )
-                } else {
-                    format!(
-                        "`{}` leaves a held-out error only {} above it, within the {} tolerance",
-                        cands[j].effect,
-                        um(gap),
-                        um(o.tolerance_m)
-                    )
-                });
-            }
-        }
-    }
+    let order = ranking(cands);
+    let (named, tie_words) = ties(cands, &order, &inp);
 
     let ranked: Vec<Candidate> = order
         .iter()
@@ -211,6 +111,123 @@ pub(crate) fn decide(cands: &mut Vec<Candidate>, inp: Inputs<'_>) -> (Verdict, B
         },
     };
     (verdict, baseline, signature)
+}
+
+/// Why the current model misfits, one sentence per reason (none when it fits): a systematic residual above
+/// the floor (in the fit, else held out), a phase and component above the per-phase tolerance, and (with
+/// [`SearchOptions::use_trends`]) each significant, material trend of an output error.
+fn misfit_reasons(baseline: &Baseline, signature: &Signature, inp: &Inputs<'_>) -> Vec<String> {
+    let o = inp.options;
+    let noise = inp.noise_m;
+    let mut reasons = Vec::new();
+    if baseline.systematic_m > o.tolerance_m {
+        reasons.push(format!(
+            "residual RMS {} against a noise level of {}: a systematic part of {}, above {}",
+            um(baseline.fit.rms_m),
+            um(noise),
+            um(baseline.systematic_m),
+            floor_words(inp.floor)
+        ));
+    }
+    let heldout_systematic = stats::excess(baseline.heldout_error_m.powi(2), noise);
+    if baseline.systematic_m <= o.tolerance_m && heldout_systematic > o.tolerance_m {
+        reasons.push(format!(
+            "held-out error {} against a noise level of {}: a systematic part of {}, above {}",
+            um(baseline.heldout_error_m),
+            um(noise),
+            um(heldout_systematic),
+            floor_words(inp.floor)
+        ));
+    }
+    for ph in &signature.phases {
+        if ph.systematic_m > o.phase_tolerance_m {
+            reasons.push(format!(
+                "{} {}: systematic residual {} (RMS {}), above the {} per-phase tolerance",
+                ph.component.name(),
+                ph.phase.words(),
+                um(ph.systematic_m),
+                um(ph.rms_m),
+                um(o.phase_tolerance_m)
+            ));
+        }
+    }
+    if o.use_trends {
+        for t in &signature.trends {
+            if t.quantity != Quantity::ResidualRms {
+                reasons.push(t.sentence.clone());
+            }
+        }
+    }
+    reasons
+}
+
+/// The candidates' order (indices): explaining candidates by ΔBIC, then the others by held-out error,
+/// failed fits last; ties keep the order given.
+fn ranking(cands: &[Candidate]) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..cands.len()).collect();
+    let key = |c: &Candidate| -> (u8, f64) {
+        match (&c.evidence, c.explains) {
+            (Some(e), true) => (0, e.delta_bic),
+            (Some(e), false) => (1, e.heldout_error_after),
+            (None, _) => (2, 0.0),
+        }
+    };
+    order.sort_by(|&a, &b| {
+        let (ka, kb) = (key(&cands[a]), key(&cands[b]));
+        ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1)).then(a.cmp(&b))
+    });
+    order
+}
+
+/// The candidates named (indices): the best explaining one and every other explaining one that predicts
+/// held-out shots not significantly worse, or within the tolerance of it; with a sentence per tie.
+fn ties(cands: &[Candidate], order: &[usize], inp: &Inputs<'_>) -> (Vec<usize>, Vec<String>) {
+    let o = inp.options;
+    let explaining: Vec<usize> = order.iter().copied().filter(|&i| cands[i].explains).collect();
+    let mut named: Vec<usize> = Vec::new();
+    let mut tie_words: Vec<String> = Vec::new();
+    let Some(&best) = explaining.first() else {
+        return (named, tie_words);
+    };
+    named.push(best);
+    for &j in &explaining[1..] {
+        let d: Vec<f64> = inp.heldout_chi2[j]
+            .iter()
+            .zip(&inp.heldout_chi2[best])
+            .filter_map(|(a, b)| Some((a.as_ref()?.max(f64::MIN_POSITIVE) / b.as_ref()?.max(f64::MIN_POSITIVE)).ln()))
+            .collect();
+        let (_, p) = stats::one_sided_t(&d);
+        // Mean held-out mean square of candidate `k` over the shots both predicted.
+        let ms = |k: usize| -> f64 {
+            let both = inp.heldout_ms[best].iter().zip(&inp.heldout_ms[j]);
+            let (s, n) = inp.heldout_ms[k]
+                .iter()
+                .zip(both)
+                .filter(|(_, (a, b))| a.is_some() && b.is_some())
+                .filter_map(|(v, _)| *v)
+                .fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+            s / n.max(1) as f64
+        };
+        let gap = (ms(j) - ms(best)).max(0.0).sqrt();
+        if p >= o.alpha || gap < o.tolerance_m {
+            named.push(j);
+            tie_words.push(if p >= o.alpha {
+                format!(
+                    "`{}` predicts held-out shots not significantly worse ({})",
+                    cands[j].effect,
+                    p_text(p)
+                )
+            } else {
+                format!(
+                    "`{}` leaves a held-out error only {} above it, within the {} tolerance",
+                    cands[j].effect,
+                    um(gap),
+                    um(o.tolerance_m)
+                )
+            });
+        }
+    }
+    (named, tie_words)
 }
 
 fn check(c: &mut Candidate, o: &SearchOptions, noise: f64) {
@@ -272,7 +289,7 @@ fn check(c: &mut Candidate, o: &SearchOptions, noise: f64) {
     let removed = (c.heldout_error_before.powi(2) - e.heldout_error_after.powi(2))
         .max(0.0)
         .sqrt();
-    let left = crate::search::excess(e.heldout_error_after.powi(2), noise);
+    let left = stats::excess(e.heldout_error_after.powi(2), noise);
     let complete = left <= o.tolerance_m || e.explained_fraction >= o.explained_fraction;
     c.checks.material = removed >= o.tolerance_m && complete;
     if !c.checks.material {

@@ -16,7 +16,8 @@
 mod common;
 
 use bouncelab_diagnose::{
-    DiagnoseError, Diagnosis, SearchOptions, VerdictKind, add_effect_to_model_toml, find_missing_effect,
+    DiagnoseError, Diagnosis, FittedBaseline, SearchOptions, VerdictKind, add_effect_to_model_toml,
+    find_missing_effect, find_missing_effect_from, find_missing_effect_with,
 };
 use bouncelab_fit::{FitOptions, NoObserver, fit};
 use bouncelab_model::{ModelSpec, PAPER_MODEL_TOML};
@@ -695,4 +696,90 @@ fn sweep_over_seeds() {
     for r in rows {
         eprintln!("{r}");
     }
+}
+
+/// A session whose shots' surface lines are off by up to ±20 µm (each line's σ stated), with the current
+/// model as `analyze` fits it (the surface level free per surface, each shot's level within its σ).
+fn leveled_session(effect: Option<&str>, seed: u64) -> (ModelSpec, Vec<bouncelab_fit::MeasuredShot>) {
+    let tracking = Tracking {
+        surface_level_m: 20e-6,
+        ..Tracking::default()
+    };
+    let mut shots = session(&truth(effect), seed, tracking);
+    for s in &mut shots {
+        s.surface_sigma_m = Some(20e-6);
+    }
+    let mut spec = base_spec();
+    bouncelab_fit::add_surface_level(&mut spec);
+    (spec, shots)
+}
+
+/// The fit crate's fit and its comparison, as `analyze` makes them.
+fn fit_and_compare(
+    spec: &ModelSpec,
+    shots: &[bouncelab_fit::MeasuredShot],
+) -> (
+    bouncelab_fit::FitResult,
+    bouncelab_compare::Comparison,
+    bouncelab_compare::FailureReport,
+) {
+    let options = FitOptions::default();
+    let problem = bouncelab_fit::Problem::new(spec, shots.to_vec(), options.sim)
+        .unwrap()
+        .with_surface_offsets(true);
+    let fit = bouncelab_fit::fit_problem(&problem, &spec.origin, &options, &mut NoObserver).unwrap();
+    let theta: Vec<f64> = fit.parameters.iter().map(|p| p.value).collect();
+    let comparison = bouncelab_compare::compare_problem(&problem, &theta, &[]).unwrap();
+    let failure = bouncelab_compare::diagnose(&comparison, &bouncelab_compare::DiagnoseOptions::default());
+    (fit, comparison, failure)
+}
+
+/// Started from the fit `analyze` already made, the search decides as when it fits the current model
+/// itself: the same verdict, the baseline's parameters within 1e-4 of each other (the two fits reach the
+/// same optimum).
+#[test]
+fn the_search_from_a_given_fit_decides_as_from_its_own() {
+    let (spec, shots) = leveled_session(None, 3);
+    let options = SearchOptions {
+        surface_levels: true,
+        ..SearchOptions::default()
+    };
+    let own = find_missing_effect_with(&spec, &shots, &[], &options, &|_| {}).unwrap();
+    let (fit, comparison, failure) = fit_and_compare(&spec, &shots);
+    let given = FittedBaseline::new(&fit, &comparison, &failure);
+    let from = find_missing_effect_from(&spec, &shots, &[], given, &options, &|_| {}).unwrap();
+    assert_eq!(own.verdict.kind, from.verdict.kind, "{}", from.verdict.sentence);
+    assert_eq!(own.verdict.effects, from.verdict.effects);
+    for (a, b) in own.baseline.fit.parameters.iter().zip(&from.baseline.fit.parameters) {
+        assert_eq!(a.name, b.name);
+        assert!(
+            (a.value - b.value).abs() <= 1e-4 * a.value.abs().max(1e-6),
+            "{}: {} vs {}",
+            a.name,
+            a.value,
+            b.value
+        );
+    }
+}
+
+/// A fit of other shots, or without the surface levels the search fits, is refused naming what differs.
+#[test]
+fn a_fit_that_is_not_of_these_shots_is_refused() {
+    let (spec, shots) = leveled_session(None, 4);
+    let (fit, comparison, failure) = fit_and_compare(&spec, &shots);
+    let given = FittedBaseline::new(&fit, &comparison, &failure);
+    let options = SearchOptions {
+        surface_levels: true,
+        ..SearchOptions::default()
+    };
+    let mut reordered = shots.clone();
+    reordered.swap(0, 1);
+    let err = find_missing_effect_from(&spec, &reordered, &[], given, &options, &|_| {}).unwrap_err();
+    assert!(
+        matches!(err, DiagnoseError::BaselineMismatch { .. }) && err.to_string().contains(&shots[1].name),
+        "{err}"
+    );
+    let without_levels = SearchOptions::default();
+    let err = find_missing_effect_from(&spec, &shots, &[], given, &without_levels, &|_| {}).unwrap_err();
+    assert!(err.to_string().contains("surface level"), "{err}");
 }

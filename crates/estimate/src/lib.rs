@@ -11,6 +11,7 @@
 mod ballistic;
 mod contact;
 mod phase;
+mod refit_level;
 mod roll;
 mod shot;
 mod spin;

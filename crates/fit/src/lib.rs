@@ -6,10 +6,11 @@
 //! match its measured one in the weighted least-squares sense, with standard errors and confidence
 //! intervals. The design follows argmin: a [`Problem`] (implementing [`LeastSquares`]) owns the residuals,
 //! a [`LevenbergMarquardt`] solver written here minimises them (finite-difference Jacobian, parameter
-//! scaling, bounds by projection) and reports every iteration to an [`Observer`], and the run ends with a
+//! scaling, bounds by projection) and reports every iteration to an [`IterationObserver`], and the run ends with a
 //! [`Termination`] reason the report can show. Shots are simulated in parallel with results collected in
 //! shot order, so a fit is deterministic.
 
+mod covariance;
 mod error;
 mod measurement;
 mod params;
@@ -18,23 +19,26 @@ mod problem;
 mod result;
 mod shot;
 mod solver;
-#[doc(hidden)]
+mod surface_level;
+mod suspect;
+/// Synthetic shots for tests (the `testutil` feature, enabled by dependents' dev-dependencies only).
+#[cfg(any(test, feature = "testutil"))]
 pub mod testutil;
 
 pub use bouncelab_model::{ModelSpec, SimOptions, State};
+pub use covariance::{Covariance, covariance, identified_inverse, normal_inverse};
 pub use error::FitError;
 pub use measurement::{observe, observes, true_start};
 pub use params::FreeParam;
 pub use predict::{ForceSample, ImpactPrediction, fitted_model, predict_impact};
 pub use problem::{Problem, profile_surface_level, surface_prior, weighted_residuals};
-pub use result::{
-    FitResult, FittedParam, MAX_RELATIVE_STD_ERROR, ObliqueRow, ShotFit, SurfaceError, identified_inverse,
-    normal_inverse,
-};
+pub use result::{FitResult, FittedParam, MAX_RELATIVE_STD_ERROR, ObliqueRow, ShotFit, SurfaceError};
 pub use shot::{MeasuredFrame, MeasuredOutputs, MeasuredShot, StartState};
 pub use solver::{
-    Iteration, LeastSquares, LevenbergMarquardt, LogObserver, NoObserver, Observer, SolverOutcome, Termination,
+    Iteration, IterationObserver, LeastSquares, LevenbergMarquardt, LogObserver, NoObserver, SolverOutcome, Termination,
 };
+pub use surface_level::{SURFACE_LEVEL_RANGE_M, add_surface_level};
+pub use suspect::{SUSPECT_FLIGHT_CHI2_MIN, SUSPECT_FLIGHT_FACTOR, suspect_flights};
 
 /// Settings of a fit.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -71,7 +75,7 @@ pub fn fit(
     spec: &ModelSpec,
     shots: Vec<MeasuredShot>,
     options: &FitOptions,
-    observer: &mut dyn Observer,
+    observer: &mut dyn IterationObserver,
 ) -> Result<FitResult, FitError> {
     let problem = Problem::new(spec, shots, options.sim)?
         .with_parallel(options.parallel)
@@ -84,7 +88,7 @@ pub fn fit_problem(
     problem: &Problem,
     model: &str,
     options: &FitOptions,
-    observer: &mut dyn Observer,
+    observer: &mut dyn IterationObserver,
 ) -> Result<FitResult, FitError> {
     let out = options.solver.run(problem, &problem.initial(), observer)?;
     result::build(problem, &out, model, options.confidence)

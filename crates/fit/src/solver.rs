@@ -1,5 +1,5 @@
 //! A Levenberg–Marquardt solver for bounded least squares, argmin style: a problem trait, a solver that
-//! reports every iteration to an [`Observer`], and a [`Termination`] reason.
+//! reports every iteration to an [`IterationObserver`], and a [`Termination`] reason.
 
 use crate::FitError;
 use nalgebra::{DMatrix, DVector};
@@ -44,7 +44,7 @@ pub struct Iteration<'a> {
 }
 
 /// Receives every iteration of a solver: a progress bar, a log, a test.
-pub trait Observer {
+pub trait IterationObserver {
     /// Called once per iteration.
     fn observe(&mut self, it: &Iteration<'_>);
 }
@@ -53,12 +53,12 @@ pub trait Observer {
 #[derive(Debug, Clone, Copy, Default)]
 pub struct NoObserver;
 
-impl Observer for NoObserver {
+impl IterationObserver for NoObserver {
     fn observe(&mut self, _it: &Iteration<'_>) {}
 }
 
 /// Any closure taking an [`Iteration`] is an observer.
-impl<F: FnMut(&Iteration<'_>)> Observer for F {
+impl<F: FnMut(&Iteration<'_>)> IterationObserver for F {
     fn observe(&mut self, it: &Iteration<'_>) {
         self(it)
     }
@@ -83,7 +83,7 @@ impl<W: Write> LogObserver<W> {
     }
 }
 
-impl<W: Write> Observer for LogObserver<W> {
+impl<W: Write> IterationObserver for LogObserver<W> {
     fn observe(&mut self, it: &Iteration<'_>) {
         let params = it
             .params
@@ -322,117 +322,151 @@ impl LevenbergMarquardt {
         &self,
         problem: &P,
         p0: &[f64],
-        observer: &mut dyn Observer,
+        observer: &mut dyn IterationObserver,
     ) -> Result<SolverOutcome, FitError> {
         let np = problem.n_params();
         assert_eq!(p0.len(), np, "starting point has the wrong length");
         let mut ev = Eval::new(problem);
-        let project = |u: &mut [f64], lo: &[f64], hi: &[f64]| {
-            for j in 0..u.len() {
-                u[j] = u[j].clamp(lo[j], hi[j]);
-            }
-        };
         let mut u: Vec<f64> = p0.iter().zip(&ev.scale).map(|(p, s)| p / s).collect();
         project(&mut u, &ev.lo, &ev.hi);
-        let mut r = ev.residuals(&u, None)?;
-        let n = r.len();
-        let mut cost = r.norm_squared();
-        let mut lambda = self.lambda_init;
-        let mut nu = 2.0;
+        let r = ev.residuals(&u, None)?;
+        let cost = r.norm_squared();
+        let mut st = LmState {
+            u,
+            r,
+            cost,
+            lambda: self.lambda_init,
+            nu: 2.0,
+        };
         observer.observe(&Iteration {
             iteration: 0,
-            cost,
-            params: &ev.params(&u),
-            lambda,
+            cost: st.cost,
+            params: &ev.params(&st.u),
+            lambda: st.lambda,
         });
         let mut iterations = 0;
-        let termination = 'outer: loop {
+        let termination = loop {
             if iterations >= self.max_iterations {
                 break Termination::MaxIterations;
             }
             iterations += 1;
-            let jac = match ev.jacobian(&u, &r, self.fd_step) {
+            let jac = match ev.jacobian(&st.u, &st.r, self.fd_step) {
                 Ok(j) => j,
                 Err(e) => break failure(&e).ok_or(e)?,
             };
-            let a = jac.transpose() * &jac;
-            let g = jac.transpose() * &r;
-            let diag: Vec<f64> = (0..np).map(|j| a[(j, j)].max(1e-12 * a.diagonal().max())).collect();
-            let mut last_failure = None;
-            loop {
-                if lambda > self.lambda_max {
-                    break 'outer last_failure.unwrap_or(Termination::Stalled);
-                }
-                let mut m = a.clone();
-                for j in 0..np {
-                    m[(j, j)] += lambda * diag[j];
-                }
-                let Some(chol) = m.cholesky() else {
-                    lambda *= nu;
-                    nu *= 2.0;
-                    continue;
-                };
-                let delta = chol.solve(&(-&g));
-                let mut trial: Vec<f64> = u.iter().zip(delta.iter()).map(|(u, d)| u + d).collect();
-                project(&mut trial, &ev.lo, &ev.hi);
-                let step = DVector::from_iterator(np, trial.iter().zip(&u).map(|(t, u)| t - u));
-                let predicted = -(2.0 * g.dot(&step) + (&a * &step).dot(&step));
-                let unorm = DVector::from_column_slice(&u).norm();
-                let tiny_step = step.norm() <= self.xtol * (unorm + self.xtol);
-                let r_new = match ev.residuals(&trial, Some(n)) {
-                    Ok(r) => Some(r),
-                    Err(e) => {
-                        last_failure = Some(failure(&e).ok_or(e)?);
-                        None
-                    }
-                };
-                let new_cost = r_new.as_ref().map(|r| r.norm_squared()).unwrap_or(f64::INFINITY);
-                if new_cost < cost && predicted > 0.0 {
-                    let rho = (cost - new_cost) / predicted;
-                    lambda *= (1.0 - (2.0 * rho - 1.0).powi(3)).max(1.0 / 3.0);
-                    nu = 2.0;
-                    let change = cost - new_cost;
-                    u = trial;
-                    r = r_new.expect("a lower cost has residuals");
-                    cost = new_cost;
-                    observer.observe(&Iteration {
-                        iteration: iterations,
-                        cost,
-                        params: &ev.params(&u),
-                        lambda,
-                    });
-                    if change <= self.ftol * cost {
-                        break 'outer Termination::ConvergedCost;
-                    }
-                    if tiny_step {
-                        break 'outer Termination::ConvergedStep;
-                    }
-                    continue 'outer;
-                }
-                if tiny_step && r_new.is_some() {
-                    // The step is below the tolerance and does not help: we are at the minimum.
-                    observer.observe(&Iteration {
-                        iteration: iterations,
-                        cost,
-                        params: &ev.params(&u),
-                        lambda,
-                    });
-                    break 'outer Termination::ConvergedStep;
-                }
-                lambda *= nu;
-                nu *= 2.0;
+            if let Some(t) = self.damped_step(&mut ev, &mut st, &jac, iterations, observer)? {
+                break t;
             }
         };
-        let jacobian = ev.jacobian_unscaled(&u, &r, self.fd_step).ok();
+        let jacobian = ev.jacobian_unscaled(&st.u, &st.r, self.fd_step).ok();
         Ok(SolverOutcome {
-            params: ev.params(&u),
-            residuals: r.as_slice().to_vec(),
-            cost,
+            params: ev.params(&st.u),
+            residuals: st.r.as_slice().to_vec(),
+            cost: st.cost,
             jacobian,
             iterations,
             evaluations: ev.count,
             termination,
         })
+    }
+
+    /// One iteration's step from `st` with the Jacobian `jac` (of the scaled parameters): the damping is
+    /// raised until a step lowers the cost (accepted, the damping lowered by the gain ratio) or the step is
+    /// below the tolerance. `None` when a step was taken and the search goes on, else why it stops.
+    fn damped_step<P: LeastSquares>(
+        &self,
+        ev: &mut Eval<'_, P>,
+        st: &mut LmState,
+        jac: &DMatrix<f64>,
+        iteration: usize,
+        observer: &mut dyn IterationObserver,
+    ) -> Result<Option<Termination>, FitError> {
+        let np = st.u.len();
+        let n = st.r.len();
+        let a = jac.transpose() * jac;
+        let g = jac.transpose() * &st.r;
+        let diag: Vec<f64> = (0..np).map(|j| a[(j, j)].max(1e-12 * a.diagonal().max())).collect();
+        let mut last_failure = None;
+        loop {
+            if st.lambda > self.lambda_max {
+                return Ok(Some(last_failure.unwrap_or(Termination::Stalled)));
+            }
+            let mut m = a.clone();
+            for j in 0..np {
+                m[(j, j)] += st.lambda * diag[j];
+            }
+            let Some(chol) = m.cholesky() else {
+                st.lambda *= st.nu;
+                st.nu *= 2.0;
+                continue;
+            };
+            let delta = chol.solve(&(-&g));
+            let mut trial: Vec<f64> = st.u.iter().zip(delta.iter()).map(|(u, d)| u + d).collect();
+            project(&mut trial, &ev.lo, &ev.hi);
+            let step = DVector::from_iterator(np, trial.iter().zip(&st.u).map(|(t, u)| t - u));
+            let predicted = -(2.0 * g.dot(&step) + (&a * &step).dot(&step));
+            let unorm = DVector::from_column_slice(&st.u).norm();
+            let tiny_step = step.norm() <= self.xtol * (unorm + self.xtol);
+            let r_new = match ev.residuals(&trial, Some(n)) {
+                Ok(r) => Some(r),
+                Err(e) => {
+                    last_failure = Some(failure(&e).ok_or(e)?);
+                    None
+                }
+            };
+            let new_cost = r_new.as_ref().map(|r| r.norm_squared()).unwrap_or(f64::INFINITY);
+            if new_cost < st.cost && predicted > 0.0 {
+                let rho = (st.cost - new_cost) / predicted;
+                st.lambda *= (1.0 - (2.0 * rho - 1.0).powi(3)).max(1.0 / 3.0);
+                st.nu = 2.0;
+                let change = st.cost - new_cost;
+                st.u = trial;
+                st.r = r_new.expect("a lower cost has residuals");
+                st.cost = new_cost;
+                observer.observe(&Iteration {
+                    iteration,
+                    cost: st.cost,
+                    params: &ev.params(&st.u),
+                    lambda: st.lambda,
+                });
+                if change <= self.ftol * st.cost {
+                    return Ok(Some(Termination::ConvergedCost));
+                }
+                if tiny_step {
+                    return Ok(Some(Termination::ConvergedStep));
+                }
+                return Ok(None);
+            }
+            if tiny_step && r_new.is_some() {
+                // The step is below the tolerance and does not help: we are at the minimum.
+                observer.observe(&Iteration {
+                    iteration,
+                    cost: st.cost,
+                    params: &ev.params(&st.u),
+                    lambda: st.lambda,
+                });
+                return Ok(Some(Termination::ConvergedStep));
+            }
+            st.lambda *= st.nu;
+            st.nu *= 2.0;
+        }
+    }
+}
+
+/// Where the solver stands: the scaled parameters, their residuals and cost, and the damping λ with its
+/// growth factor ν.
+struct LmState {
+    u: Vec<f64>,
+    r: DVector<f64>,
+    cost: f64,
+    lambda: f64,
+    nu: f64,
+}
+
+/// Clamps each scaled parameter into its bounds.
+fn project(u: &mut [f64], lo: &[f64], hi: &[f64]) {
+    for j in 0..u.len() {
+        u[j] = u[j].clamp(lo[j], hi[j]);
     }
 }
 

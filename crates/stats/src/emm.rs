@@ -173,6 +173,27 @@ fn estimates(ols: &Ols, data: &Dataset, factor: &str, alpha: f64) -> Result<Marg
         })
         .collect();
 
+    let pairs = pairwise(ols, &rows, levels, df, alpha);
+    let (covariates_at, averaged_over) = grid_of(ols, factor);
+    Ok(MarginalMeans {
+        factor: factor.to_string(),
+        alpha,
+        df: ols.df,
+        mse: ols.sigma2(),
+        t_crit,
+        q_crit: f64::NAN,
+        covariates_at,
+        averaged_over,
+        means,
+        pairs,
+    })
+}
+
+/// Every pair of levels (i < j, in level order): the difference of their adjusted means (rows `rows` of
+/// the grid), its t test on `df` degrees of freedom, and Holm's adjustment over the pairs at `alpha`; the
+/// Tukey figures are left NaN.
+fn pairwise(ols: &Ols, rows: &[DVector<f64>], levels: &[String], df: f64, alpha: f64) -> Vec<MarginalComparison> {
+    let k = levels.len();
     let mut pairs = Vec::with_capacity(k * (k - 1) / 2);
     for i in 0..k {
         for j in i + 1..k {
@@ -201,7 +222,12 @@ fn estimates(ols: &Ols, data: &Dataset, factor: &str, alpha: f64) -> Result<Marg
         pair.p_holm = adj;
         pair.reject_holm = adj <= alpha;
     }
+    pairs
+}
 
+/// Where the adjusted means of `factor` are taken: each covariate at its mean, and the other factors
+/// averaged over.
+fn grid_of(ols: &Ols, factor: &str) -> (Vec<GridValue>, Vec<String>) {
     let mut covariates_at = Vec::new();
     let mut averaged_over = Vec::new();
     for c in &ols.cols {
@@ -214,18 +240,7 @@ fn estimates(ols: &Ols, data: &Dataset, factor: &str, alpha: f64) -> Result<Marg
             _ => {}
         }
     }
-    Ok(MarginalMeans {
-        factor: factor.to_string(),
-        alpha,
-        df: ols.df,
-        mse: ols.sigma2(),
-        t_crit,
-        q_crit: f64::NAN,
-        covariates_at,
-        averaged_over,
-        means,
-        pairs,
-    })
+    (covariates_at, averaged_over)
 }
 
 pub(crate) fn means_of(ols: &Ols, data: &Dataset, factor: &str, alpha: f64) -> Result<MarginalMeans, StatsError> {

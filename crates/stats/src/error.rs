@@ -108,6 +108,14 @@ pub enum StatsError {
         /// The cell's text.
         value: String,
     },
+    /// A session's ANCOVA could not be fitted (the shots are counted in the message).
+    #[error("{shots} shot(s): {error}")]
+    Session {
+        /// Shots in the session.
+        shots: usize,
+        /// Why the fit failed.
+        error: Box<StatsError>,
+    },
     /// Reading or writing CSV failed.
     #[error("CSV: {0}")]
     Csv(#[from] csv::Error),

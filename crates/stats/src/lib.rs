@@ -22,6 +22,7 @@ mod line;
 mod linear;
 mod quad;
 mod residual_tests;
+mod session;
 mod srange;
 mod text;
 mod tukey;
@@ -41,6 +42,7 @@ pub use residual_tests::{
     CovariateCurvature, FTest, NormalityTest, ResidualTests, TestOutcome, normality_test, quadratic_test, reset_test,
     residual_tests,
 };
+pub use session::{SESSION_ALPHA, SessionStats, session_stats, session_terms};
 pub use srange::StudentizedRange;
 pub use text::p_text;
 pub use tukey::{

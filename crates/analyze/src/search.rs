@@ -1,0 +1,115 @@
+//! The missing-effect search as a stage: run, or read back from the output folder when nothing it depends
+//! on changed (it is the slowest stage after tracking).
+
+use crate::{AnalyzeError, AnalyzeOptions, Progress, ShotData, Stage, outputs};
+use bouncelab_compare::ShotExtras;
+use bouncelab_diagnose::{Diagnosis, FittedBaseline, SearchOptions, SearchProgress, find_missing_effect_from};
+use bouncelab_model::ModelSpec;
+use bouncelab_store::Fingerprint;
+use std::path::Path;
+
+/// The search's options: the defaults, with each shot's surface level fitted within its line's σ.
+fn search_options() -> SearchOptions {
+    SearchOptions {
+        surface_levels: true,
+        ..SearchOptions::default()
+    }
+}
+
+/// The missing-effect search from the current model as the fit stage fitted and compared it (`baseline`),
+/// or its stored result when neither the shots, their measurements, the model nor the program changed
+/// since it ran; `Ok(Err(why))` when it was not asked for or there are too few shots.
+pub(crate) fn search_stage(
+    spec: &ModelSpec,
+    model_text: &str,
+    shots: &[&ShotData],
+    extras: &[ShotExtras],
+    baseline: FittedBaseline<'_>,
+    analyze: &AnalyzeOptions,
+    progress: &dyn Progress,
+) -> Result<Result<Diagnosis, String>, AnalyzeError> {
+    let options = search_options();
+    if !analyze.diagnose {
+        return Ok(Err(
+            "the missing-effect search was not asked for (--no-diagnose)".to_string()
+        ));
+    }
+    if shots.len() < options.min_shots {
+        let why = format!(
+            "{} shot(s) fitted; the missing-effect search needs at least {} (held-out errors are compared across shots)",
+            shots.len(),
+            options.min_shots
+        );
+        progress.finish(Stage::Diagnose, &format!("not run: {why}"));
+        return Ok(Err(why));
+    }
+    let out_dir = analyze.out_dir.as_path();
+    crate::create_dir(out_dir)?;
+    let key = inputs_key(model_text, &options, shots);
+    let path = out_dir.join("diagnosis.json");
+    let key_path = out_dir.join(".diagnosis-inputs");
+    if let Some(d) = cached(&path, &key_path, &key) {
+        progress.finish(
+            Stage::Diagnose,
+            &format!(
+                "unchanged since the last run ({} candidate(s) in diagnosis.json)",
+                d.candidates.len()
+            ),
+        );
+        return Ok(Ok(d));
+    }
+    let measured: Vec<_> = shots.iter().map(|s| s.measured.clone()).collect();
+    // The current model plus every library effect it lacks.
+    let total = 1 + bouncelab_model::builtin_effects()
+        .iter()
+        .filter(|e| !e.base && !spec.has_effect(e.name))
+        .count();
+    progress.start(Stage::Diagnose, total as u64);
+    let last = std::sync::atomic::AtomicUsize::new(0);
+    let report = |p: SearchProgress| {
+        if let Some(i) = p.iteration {
+            // A solver iteration of the model being fitted.
+            progress.iteration(Stage::Diagnose, i, p.chi2_red.unwrap_or(f64::NAN));
+            return;
+        }
+        let before = last.swap(p.done, std::sync::atomic::Ordering::Relaxed);
+        progress.advance(Stage::Diagnose, p.done.saturating_sub(before) as u64);
+        progress.doing(Stage::Diagnose, &p.what);
+    };
+    let d = find_missing_effect_from(spec, &measured, extras, baseline, &options, &report)?;
+    outputs::write_atomic(&path, |w| w.write_all(d.to_json().as_bytes()))?;
+    outputs::write_atomic(&key_path, |w| w.write_all(key.as_bytes()))?;
+    progress.finish(
+        Stage::Diagnose,
+        &format!(
+            "{} candidate effect(s) fitted in {:.1} s",
+            d.candidates.len(),
+            d.seconds
+        ),
+    );
+    Ok(Ok(d))
+}
+
+/// The key of what the search depends on: the program's version, the model, the options and every shot's
+/// measurement.
+fn inputs_key(model_text: &str, options: &SearchOptions, shots: &[&ShotData]) -> String {
+    let mut key = Fingerprint::new();
+    key.str(env!("CARGO_PKG_VERSION"))
+        .str(model_text)
+        .str(&format!("{options:?}"));
+    for s in shots {
+        key.str(&s.clip)
+            .str(&serde_json::to_string(&s.measured).unwrap_or_default());
+    }
+    key.finish()
+}
+
+/// The diagnosis in `path`, when `key_path` holds `key` (the inputs it was made from).
+fn cached(path: &Path, key_path: &Path, key: &str) -> Option<Diagnosis> {
+    if !std::fs::read_to_string(key_path).is_ok_and(|k| k.trim() == key) {
+        return None;
+    }
+    std::fs::read_to_string(path)
+        .ok()
+        .and_then(|t| serde_json::from_str::<Diagnosis>(&t).ok())
+}
