@@ -16,29 +16,8 @@ pub const TAPE1: (f64, f64) = (30_800.0, 15.0);
 /// Tape 2.
 pub const TAPE2: (f64, f64) = (31_825.0, 15.0);
 
-/// A small deterministic generator (SplitMix64) with Box–Muller normals.
-pub struct Rng(u64);
-
-impl Rng {
-    /// A generator from `seed`.
-    pub fn new(seed: u64) -> Rng {
-        Rng(seed)
-    }
-    /// Uniform in (0, 1).
-    pub fn uniform(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        ((z >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
-    /// Standard normal.
-    pub fn normal(&mut self) -> f64 {
-        let (u1, u2) = (self.uniform(), self.uniform());
-        (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
-    }
-}
+/// The workspace's one seeded generator (SplitMix64 with Box–Muller normals).
+pub use bouncelab_testkit::Rng;
 
 /// `model` dropped from `height_m` (m) onto a surface inclined by `incline_deg`, sampled at [`FPS`] from
 /// 10 ms before touch to 10 ms after separation, with a random sub-frame phase.
