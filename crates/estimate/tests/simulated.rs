@@ -8,20 +8,7 @@ const SCALE: f64 = 4e-4; // m/px
 const SURFACE_Y: f64 = 420.0; // px
 const NOISE_PX: f64 = 0.05;
 
-struct Rng(u64);
-impl Rng {
-    fn gauss(&mut self) -> f64 {
-        let mut u = || {
-            self.0 = self
-                .0
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((self.0 >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-        };
-        let (a, b) = (u(), u());
-        (-2.0 * a.ln()).sqrt() * (std::f64::consts::TAU * b).cos()
-    }
-}
+use bouncelab_testkit::Rng;
 
 /// A shot from 15 ms before touch to `after` s after it, as a tracker would report it.
 fn shot(model: &Model, incline_deg: f64, drop_m: f64, after: f64, seed: u64) -> (Track, Impact) {
@@ -43,7 +30,7 @@ fn shot(model: &Model, incline_deg: f64, drop_m: f64, after: f64, seed: u64) -> 
         .map(|i| i as f64 * 1e-4)
         .collect();
     let sim = simulate(model, beta, 0.0, start, &times, &SimOptions::default()).unwrap();
-    let mut rng = Rng(seed.wrapping_mul(0x9E3779B97F4A7C15) ^ 0xD1B54A32D192ED03);
+    let mut rng = Rng::new(seed.wrapping_mul(0x9E3779B97F4A7C15) ^ 0xD1B54A32D192ED03);
     let fixes = sim
         .samples
         .iter()
@@ -51,8 +38,8 @@ fn shot(model: &Model, incline_deg: f64, drop_m: f64, after: f64, seed: u64) -> 
         .map(|(i, s)| BallFix {
             frame: i,
             t_s: s.t,
-            x_px: 150.0 + s.state.x / SCALE + NOISE_PX * rng.gauss(),
-            y_px: SURFACE_Y - s.state.y / SCALE + NOISE_PX * rng.gauss(),
+            x_px: 150.0 + s.state.x / SCALE + NOISE_PX * rng.normal(),
+            y_px: SURFACE_Y - s.state.y / SCALE + NOISE_PX * rng.normal(),
             r_px: r / SCALE,
             sigma_px: NOISE_PX,
             sigma_r_px: 0.02,
