@@ -43,7 +43,20 @@ impl Default for Scene {
     }
 }
 
-use bouncelab_testkit::Rng;
+struct Rng(u64);
+impl Rng {
+    fn uniform(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((self.0 >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    }
+    fn gauss(&mut self) -> f64 {
+        let (u, v) = (self.uniform(), self.uniform());
+        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+    }
+}
 
 /// Fraction of pixel (x, y) covered by the disc, by 8×8 supersampling near the edge.
 fn coverage(x: usize, y: usize, cx: f64, cy: f64, r: f64) -> f64 {
@@ -72,12 +85,12 @@ fn coverage(x: usize, y: usize, cx: f64, cy: f64, r: f64) -> f64 {
 /// Renders `scene` as 8-bit pixels, row-major.
 pub fn render(scene: &Scene) -> Vec<u8> {
     let (w, h) = scene.size;
-    let mut rng = Rng::new(scene.seed.wrapping_add(0x5851F42D4C957F2D));
-    let tex: Vec<f64> = (0..w * h).map(|_| rng.normal()).collect();
+    let mut rng = Rng(scene.seed.wrapping_add(0x5851F42D4C957F2D));
+    let tex: Vec<f64> = (0..w * h).map(|_| rng.gauss()).collect();
     let (cx, cy, r) = scene.ball;
     let xc = (w as f64 - 1.0) / 2.0;
     // The ragged edge: a few incommensurate waves, scaled to reach ±roughness.
-    let mut phases = Rng::new(scene.seed ^ 0x9E37_79B9_7F4A_7C15);
+    let mut phases = Rng(scene.seed ^ 0x9E37_79B9_7F4A_7C15);
     let waves: Vec<(f64, f64)> = [2.3, 4.1, 7.9, 15.7]
         .iter()
         .map(|&l| (l, phases.uniform() * std::f64::consts::TAU))
@@ -111,7 +124,7 @@ pub fn render(scene: &Scene) -> Vec<u8> {
                     v = v * (1.0 - cov) + band * cov;
                 }
             }
-            v += scene.noise * rng.normal();
+            v += scene.noise * rng.gauss();
             out[y * w + x] = v.round().clamp(0.0, 255.0) as u8;
         }
     }
