@@ -9,14 +9,19 @@
 use crate::common::*;
 use std::path::Path;
 
-/// `unshare` arguments that give this process a private mount namespace where it may mount a tmpfs.
+/// `unshare` arguments that give this process a private mount namespace where it may mount a tmpfs
+/// (probed once: a trial mount in a temporary folder, removed again).
 fn namespace() -> Option<&'static [&'static str]> {
-    [&["-m"][..], &["-r", "-m"][..]].into_iter().find(|args| {
-        std::process::Command::new("unshare")
-            .args(*args)
-            .args(["sh", "-c", "d=$(mktemp -d) && mount -t tmpfs -o size=64k tmpfs \"$d\""])
-            .output()
-            .is_ok_and(|o| o.status.success())
+    static FOUND: std::sync::OnceLock<Option<&'static [&'static str]>> = std::sync::OnceLock::new();
+    *FOUND.get_or_init(|| {
+        let probe = "d=$(mktemp -d) || exit 1; mount -t tmpfs -o size=64k tmpfs \"$d\"; r=$?; umount \"$d\" 2>/dev/null; rmdir \"$d\"; exit $r";
+        [&["-m"][..], &["-r", "-m"][..]].into_iter().find(|args| {
+            std::process::Command::new("unshare")
+                .args(*args)
+                .args(["sh", "-c", probe])
+                .output()
+                .is_ok_and(|o| o.status.success())
+        })
     })
 }
 
