@@ -6,7 +6,9 @@
 //! cast no votes, then measured on the frame itself. A circle counts as the ball when it moved between two
 //! frames ten apart, is found again half-way between where its path puts it, and is not one of the circles
 //! that stayed put. When the difference holds no such circle (a ball too large or slow for the median to
-//! forget it), the frames themselves are searched the same way.
+//! forget it), the frames themselves are searched the same way. Clean circles centred beyond the frame's
+//! edges (a ball mostly out of view) are looked for after clean ones inside it and before doubtful ones, so
+//! that a seam's lobe on the visible cap of a ball whose centre is out of view is not taken for the ball.
 
 use crate::ball_search::{BALL_CANDIDATES, MIN_BALL_RADIUS_PX, hint_window, radius_window};
 use crate::clip::{ClipTracking, TrackError, on_plane, with_plane};
@@ -78,11 +80,18 @@ pub(crate) fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32, noise: f32) -
         found: HashMap::new(),
         still: Vec::new(),
     };
-    // Clean circles before doubtful ones; then an octave of radii at a time, largest first, so the ball's rim
-    // comes before the smaller circles drawn on it (the seam's lobes, which move with it); then the strongest
+    // Clean circles centred in the frame, then clean circles centred beyond its edges (a ball mostly out of
+    // view: a third of a rim lines up by chance more easily than a whole one, so only clean ones count, and
+    // before doubtful circles in the frame, which on such a ball are the seam's lobes on its visible cap),
+    // then doubtful circles in the frame. In each, an octave of radii at a time, largest first, so the ball's
+    // rim comes before the smaller circles drawn on it (the lobes, which move with it); then the strongest
     // voters before all significant ones (cheaper, and what a clear ball needs), moving votes before the
     // frame's; then pairs of frames through the first half of the clip.
-    for threshold in [CLEAN_QUALITY, CANDIDATE_QUALITY] {
+    for (threshold, beyond_edge) in [
+        (CLEAN_QUALITY, false),
+        (CLEAN_QUALITY, true),
+        (CANDIDATE_QUALITY, false),
+    ] {
         for (band, &radii) in bands.iter().enumerate() {
             for voters in [Voters::Strongest, Voters::AboveNoise] {
                 for votes in [Votes::Moving, Votes::Frame] {
@@ -93,6 +102,7 @@ pub(crate) fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32, noise: f32) -
                         threshold,
                         band,
                         radii,
+                        beyond_edge,
                         votes,
                         voters,
                     };
@@ -106,12 +116,14 @@ pub(crate) fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32, noise: f32) -
     Err(nothing_moved(clip, search.still, min_radius, max_radius))
 }
 
-/// One pass of the search: the least quality of a sighting, the radius band (its index and range, px), where
+/// One pass of the search: the least quality of a sighting, the radius band (its index and range, px), whether
+/// centres inside the frame or beyond its edges are looked for (see [`CircleDetection::beyond_edge`]), where
 /// the votes come from and which edges vote.
 struct Pass {
     threshold: f64,
     band: usize,
     radii: (f64, f64),
+    beyond_edge: bool,
     votes: Votes,
     voters: Voters,
 }
@@ -127,7 +139,7 @@ struct PairSearch<'a> {
     noise: f32,
     frames: FrameCache<'a>,
     background: Option<Vec<f32>>,
-    found: HashMap<(usize, usize, Votes, Voters), Vec<Seen>>,
+    found: HashMap<(usize, usize, bool, Votes, Voters), Vec<Seen>>,
     /// The clearest circles that did not move, for the error: (x, y, r, quality).
     still: Vec<(f64, f64, f64, f64)>,
 }
@@ -135,7 +147,7 @@ struct PairSearch<'a> {
 impl PairSearch<'_> {
     /// The circles seen in file `k` in this pass (detected once, then remembered).
     fn circles(&mut self, k: usize, pass: &Pass) -> Result<Vec<Seen>, TrackError> {
-        let key = (k, pass.band, pass.votes, pass.voters);
+        let key = (k, pass.band, pass.beyond_edge, pass.votes, pass.voters);
         if let Some(c) = self.found.get(&key) {
             return Ok(c.clone());
         }
@@ -144,6 +156,7 @@ impl PairSearch<'_> {
             max_radius: pass.radii.1,
             max_candidates: BALL_CANDIDATES,
             noise_sigma: (pass.voters == Voters::AboveNoise).then_some(self.noise as f64),
+            beyond_edge: pass.beyond_edge,
             ..CircleDetection::default()
         };
         let c = self
@@ -169,7 +182,11 @@ impl PairSearch<'_> {
             let b_all: Vec<Seen> = self.circles(k + gap, pass)?.into_iter().filter(loose).collect();
             let (a_loose, _) = split_static(&a_all, &b_all);
             let (b_loose, _) = split_static(&b_all, &a_all);
-            if pass.threshold == CLEAN_QUALITY && pass.votes == Votes::Frame && pass.voters == Voters::Strongest {
+            if pass.threshold == CLEAN_QUALITY
+                && !pass.beyond_edge
+                && pass.votes == Votes::Frame
+                && pass.voters == Voters::Strongest
+            {
                 for c in a_static.iter().map(|s| &s.circle) {
                     if !self.still.iter().any(|s| (s.0 - c.x).hypot(s.1 - c.y) < 0.5 * c.r) {
                         self.still.push((c.x, c.y, c.r, c.support));

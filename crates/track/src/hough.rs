@@ -25,6 +25,11 @@ pub struct CircleDetection {
     /// cluttered frame (rulers, seams, a hand) is outshone by the clutter's edges but stands well out of the
     /// noise; the price is many more votes on textured frames.
     pub noise_sigma: Option<f64>,
+    /// Look only for circles centred beyond the frame's edges (default `false`: only centres inside it): a
+    /// ball mostly out of view, whose centre is above the top edge while its lower rim is in the frame. Such
+    /// a centre lies at most half a radius beyond an edge and needs a third of its rim inside, enough arc
+    /// for a circle fit; the accumulator grows by that half radius on every side.
+    pub beyond_edge: bool,
 }
 
 impl Default for CircleDetection {
@@ -35,6 +40,7 @@ impl Default for CircleDetection {
             edge_fraction: 0.06,
             max_candidates: 8,
             noise_sigma: None,
+            beyond_edge: false,
         }
     }
 }
@@ -128,7 +134,7 @@ pub fn detect_circles<P: Pixel>(img: &Plane<P>, opts: &CircleDetection) -> Vec<C
             scales.push((f, g, edges));
         }
         let (_, g, edges) = scales.iter().find(|s| s.0 == f).expect("just added");
-        for c in detect_band(g, edges, f, lo, hi, opts.max_candidates) {
+        for c in detect_band(g, edges, f, (lo, hi), opts.max_candidates, opts.beyond_edge) {
             let same = |o: &Circle| (o.x - c.x).hypot(o.y - c.y) < 0.1 * c.r && (o.r - c.r).abs() < 0.1 * c.r;
             match out.iter_mut().find(|o| same(o)) {
                 Some(o) if o.support < c.support => *o = c,
@@ -172,21 +178,29 @@ fn detect_band(
     g: &Gradients,
     edges: &[usize],
     f: usize,
-    min_radius: f64,
-    max_radius: f64,
+    (min_radius, max_radius): (f64, f64),
     max_candidates: usize,
+    beyond_edge: bool,
 ) -> Vec<Circle> {
     if edges.is_empty() {
         return Vec::new();
     }
-    let (w, h) = (g.w, g.h);
     let (rmin, rmax) = (min_radius / f as f64, max_radius / f as f64);
+    // The accumulator covers the frame and, for centres beyond its edges, a margin of half the largest radius
+    // (plus the box filter's and the peak finder's cells) on every side.
+    let margin = if beyond_edge {
+        (0.5 * rmax).ceil() as usize + 2
+    } else {
+        0
+    };
+    let (w, h) = (g.w + 2 * margin, g.h + 2 * margin);
+    let m = margin as f64;
     // Vote along both directions of the gradient (the ball may be brighter or darker than what is behind).
     let mut acc = vec![0.0f32; w * h];
     for &i in edges {
-        let (x, y) = ((i % w) as f64, (i / w) as f64);
-        let m = g.mag[i] as f64;
-        let (ux, uy) = (g.gx[i] as f64 / m, g.gy[i] as f64 / m);
+        let (x, y) = ((i % g.w) as f64 + m, (i / g.w) as f64 + m);
+        let mag = g.mag[i] as f64;
+        let (ux, uy) = (g.gx[i] as f64 / mag, g.gy[i] as f64 / mag);
         for sign in [-1.0, 1.0] {
             let mut r = rmin;
             while r <= rmax {
@@ -203,6 +217,8 @@ fn detect_band(
     let peaks = local_maxima(&acc, w, h, (rmin * 0.25).max(2.0) as usize, max_candidates * 8);
     let mut out: Vec<Circle> = peaks
         .into_iter()
+        .map(|(cx, cy)| (cx - m, cy - m))
+        .filter(|&(cx, cy)| centre_in_frame(g, cx, cy) != beyond_edge)
         .filter_map(|(cx, cy)| radius_at(g, edges, cx, cy, rmin, rmax))
         .map(|(cx, cy, r, support)| Circle {
             x: (cx + 0.5) * f as f64 - 0.5,
@@ -214,6 +230,11 @@ fn detect_band(
     out.sort_by(|a, b| b.support.total_cmp(&a.support));
     out.truncate(max_candidates);
     out
+}
+
+/// Whether (cx, cy), in the gradient field's cells, lies on a pixel of the frame.
+fn centre_in_frame(g: &Gradients, cx: f64, cy: f64) -> bool {
+    (-0.5..=g.w as f64 - 0.5).contains(&cx) && (-0.5..=g.h as f64 - 0.5).contains(&cy)
 }
 
 /// Indices of the gradient magnitudes above the strongest `fraction`'s threshold, or above `floor` when given,
@@ -362,7 +383,8 @@ fn radius_at(g: &Gradients, edges: &[usize], cx: f64, cy: f64, rmin: f64, rmax: 
             })
             .count()
     };
-    if inside < steps / 4 {
+    // A centre beyond the frame's edge needs a third of its rim in view (an arc of 120°) for a fit to place it.
+    if inside < steps / 4 || (!centre_in_frame(g, cx, cy) && inside < steps / 3) {
         return None;
     }
     let expected = std::f64::consts::TAU * r * inside as f64 / steps as f64;
@@ -403,6 +425,63 @@ mod tests {
                 // Each band reaches 10 % into the one above it.
                 prop_assert!(pair[1].1 > pair[0].0);
                 prop_assert!(pair[1].0 < pair[0].0);
+            }
+        }
+    }
+
+    /// A 200×100 frame of gray 60 with a disc of gray 180 (edge antialiased over a pixel) at (`cx`, `cy`).
+    fn disc(cx: f64, cy: f64, r: f64) -> Vec<u8> {
+        let (w, h) = (200, 100);
+        let mut px = vec![60u8; w * h];
+        for y in 0..h {
+            for x in 0..w {
+                let d = (x as f64 - cx).hypot(y as f64 - cy) - r;
+                px[y * w + x] = (60.0 + 120.0 * (0.5 - d).clamp(0.0, 1.0)).round() as u8;
+            }
+        }
+        px
+    }
+
+    fn detection(beyond_edge: bool) -> CircleDetection {
+        CircleDetection {
+            min_radius: 30.0,
+            max_radius: 60.0,
+            beyond_edge,
+            ..CircleDetection::default()
+        }
+    }
+
+    #[test]
+    fn a_disc_centred_above_the_frame_is_found_only_beyond_the_edge() {
+        // Centre 15 px above the top edge: 146° of the rim in view.
+        let px = disc(90.3, -15.0, 45.0);
+        let img = Plane::new(&px, 200, 100);
+        let beyond = detect_circles(&img, &detection(true));
+        let best = beyond.first().expect("found");
+        assert!(
+            (best.x - 90.3).abs() < 2.0 && (best.y + 15.0).abs() < 2.0 && (best.r - 45.0).abs() < 2.0,
+            "{best:?}"
+        );
+        let inside = detect_circles(&img, &detection(false));
+        assert!(inside.iter().all(|c| c.y >= 0.0), "{inside:?}");
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(24))]
+        /// The two searches split the candidates by where their centres lie.
+        #[test]
+        fn centres_lie_where_the_search_looks(cx in -20.0f64..220.0, cy in -20.0f64..120.0, r in 32.0f64..55.0) {
+            let px = disc(cx, cy, r);
+            let img = Plane::new(&px, 200, 100);
+            let within = |c: &Circle| c.x >= -0.5 && c.y >= -0.5 && c.x <= 199.5 && c.y <= 99.5;
+            for c in detect_circles(&img, &detection(false)) {
+                prop_assert!(within(&c), "{:?}", c);
+            }
+            for c in detect_circles(&img, &detection(true)) {
+                prop_assert!(!within(&c), "{:?}", c);
+                // A centre beyond the edge lies within half a radius of it.
+                let beyond = (-c.x).max(c.x - 199.0).max(-c.y).max(c.y - 99.0);
+                prop_assert!(beyond <= 0.5 * c.r + 4.0, "{:?}", c);
             }
         }
     }

@@ -615,7 +615,10 @@ pub fn refined_candidates<P: Pixel>(
 
 /// [`refined_candidates`] from vote peaks found elsewhere (e.g. on the part of the frame that moves): each
 /// peak refined on `img` (followed with a quarter of the rays, grown out to a containing rim, measured with
-/// every ray), duplicates merged, nested and seam-like circles dropped. Best first.
+/// every ray), duplicates merged, nested and seam-like circles dropped. Best first. With
+/// [`CircleDetection::beyond_edge`](crate::CircleDetection::beyond_edge) a circle is judged by its
+/// [`Refined::visible_quality`] (the rays that leave the frame are not counted against it), else by its
+/// [`Refined::quality`].
 pub fn refine_candidates<P: Pixel>(
     img: &Plane<P>,
     peaks: Vec<crate::Circle>,
@@ -636,6 +639,14 @@ pub fn refine_candidates<P: Pixel>(
         half_width: 0.5 * wide.half_width,
         ..search.clone()
     };
+    // A circle centred beyond the frame's edge is judged on the rim the frame can show.
+    let quality = |f: &Refined| {
+        if detection.beyond_edge {
+            f.visible_quality()
+        } else {
+            f.quality()
+        }
+    };
     let mut out: Vec<(crate::Circle, Refined)> = Vec::new();
     for c in peaks {
         // A vote peak next to a circle already refined would converge onto it again.
@@ -648,14 +659,14 @@ pub fn refine_candidates<P: Pixel>(
         let Some(f) = refine_circle(img, c.x, c.y, c.r, &screen, surface) else {
             continue;
         };
-        if f.quality() < 0.5 * min_quality {
+        if quality(&f) < 0.5 * min_quality {
             continue;
         }
         let f = grow_outward(img, f, &screen, surface, detection.max_radius);
         let Some(f) = refine_circle(img, f.fit.x, f.fit.y, f.fit.r, &settled, surface) else {
             continue;
         };
-        let (q, fit) = (f.quality(), f.fit);
+        let (q, fit) = (quality(&f), f.fit);
         if q < min_quality || fit.r < detection.min_radius * 0.95 || fit.r > detection.max_radius * 1.05 {
             continue;
         }
