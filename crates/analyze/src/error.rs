@@ -67,14 +67,4 @@ pub enum AnalyzeError {
         /// The clip.
         clip: String,
     },
-    /// A stored trajectory row this build cannot read (a status it does not know).
-    #[error("shot {clip}, frame {frame}: the stored trajectory row cannot be read: {why}")]
-    BadTrajectoryRow {
-        /// The clip.
-        clip: String,
-        /// The row's frame index.
-        frame: u64,
-        /// Why.
-        why: String,
-    },
 }

@@ -323,7 +323,7 @@ fn track_record(
         warnings: track.warnings.clone(),
         seconds,
         camera: None,
-        rows: rows.iter().map(crate::shots::trajectory_record).collect(),
+        rows,
     }
 }
 

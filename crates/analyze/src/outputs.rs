@@ -5,7 +5,7 @@ use crate::{AnalyzeError, ShotData};
 use bouncelab_fit::FitResult;
 use bouncelab_report as r;
 use bouncelab_store::ESTIMATE_QUANTITIES as Q;
-use bouncelab_track::{TRAJECTORY_COLUMNS, TrajectoryRow};
+use bouncelab_track::{TRAJECTORY_COLUMNS, TrajectoryCell, TrajectoryRow};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -223,7 +223,7 @@ fn estimate_cells(s: &ShotData, ball_mass_kg: f64, gravity: f64, files: &Traject
 
 /// `trajectories/<clip>.csv`: the `docs/outputs.md` columns of every frame.
 fn write_trajectory(out: &mut dyn Write, s: &ShotData) -> Result<(), csv::Error> {
-    write_track_rows(out, &s.rows)
+    write_track_rows(out, &s.track.rows)
 }
 
 /// Writes `trajectories/<clip>.csv` for tracks whose shots could not be estimated (what was measured of them
@@ -240,9 +240,8 @@ pub(crate) fn write_failed_trajectories(
     })?;
     let mut written = Vec::new();
     for (clip, track) in tracks {
-        let rows = crate::shots::trajectory_rows(clip, &track.rows)?;
         let path = traj.join(file_for(files, clip));
-        write_atomic(&path, |w| write_track_rows(w, &rows).map_err(csv_io))?;
+        write_atomic(&path, |w| write_track_rows(w, &track.rows).map_err(csv_io))?;
         written.push(path);
     }
     Ok(written)
@@ -268,18 +267,11 @@ fn write_track_rows(out: &mut dyn Write, rows: &[TrajectoryRow]) -> Result<(), c
     let mut w = csv::Writer::from_writer(out);
     w.write_record(TRAJECTORY_COLUMNS)?;
     for r in rows {
-        w.write_record([
-            r.frame.to_string(),
-            num(r.t_s),
-            num(r.x_px),
-            num(r.y_px),
-            num(r.r_px),
-            num(r.sigma_px),
-            num(r.quality),
-            r.status.name().to_string(),
-            num(r.x_m),
-            num(r.y_m),
-        ])?;
+        w.write_record(r.cells().map(|cell| match cell {
+            TrajectoryCell::Frame(f) => f.to_string(),
+            TrajectoryCell::Number(x) => num(x),
+            TrajectoryCell::Status(s) => s.name().to_string(),
+        }))?;
     }
     w.flush()?;
     Ok(())
@@ -654,6 +646,43 @@ pub(crate) fn write_anova(dir: &Path, a: &bouncelab_stats::Ancova) -> Result<Pat
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `trajectories/<clip>.csv` spells numbers with `Display` and a value not measured as an empty cell.
+    #[test]
+    fn a_trajectory_file_writes_every_column_and_leaves_unmeasured_cells_empty() {
+        use bouncelab_track::{BallFix, Status};
+        let fix = |frame, x_px: f64, status| BallFix {
+            frame,
+            t_s: frame as f64 * 1e-4,
+            x_px,
+            y_px: 200.25,
+            r_px: 40.5,
+            sigma_px: 0.03,
+            sigma_r_px: 0.04,
+            quality: if x_px.is_nan() { 0.0 } else { 0.97 },
+            status,
+        };
+        let rows = [
+            TrajectoryRow {
+                fix: fix(7, 101.125, Status::Occluded),
+                x_m: -0.0125,
+                y_m: 0.5,
+            },
+            TrajectoryRow {
+                fix: fix(8, f64::NAN, Status::Absent),
+                x_m: f64::NAN,
+                y_m: f64::NAN,
+            },
+        ];
+        let mut out = Vec::new();
+        write_track_rows(&mut out, &rows).unwrap();
+        assert_eq!(
+            String::from_utf8(out).unwrap(),
+            "frame,t_s,x_px,y_px,r_px,sigma_px,quality,status,x_m,y_m\n\
+             7,0.0007,101.125,200.25,40.5,0.03,0.97,occluded,-0.0125,0.5\n\
+             8,0.0008,,200.25,40.5,0.03,0,absent,,\n"
+        );
+    }
 
     /// Every CSV's header, one file a line: the contract users read (refresh with BOUNCELAB_BLESS=1).
     #[test]

@@ -1061,14 +1061,15 @@ fn key_frame_strip(entry: &bouncelab_frames::ClipEntry, shot: &ShotData) -> Resu
     use bouncelab_overlay as o;
     let clip = entry.open().map_err(|e| e.to_string())?;
     let marks: Vec<o::BallMark> = shot
+        .track
         .rows
         .iter()
-        .map(|row| o::BallMark {
-            frame: row.frame as u64,
-            x_px: row.x_px,
-            y_px: row.y_px,
-            r_px: row.r_px,
-            status: row.status,
+        .map(|&bouncelab_track::TrajectoryRow { fix: f, .. }| o::BallMark {
+            frame: f.frame as u64,
+            x_px: f.x_px,
+            y_px: f.y_px,
+            r_px: f.r_px,
+            status: f.status,
             phase: o::Phase::Unknown,
         })
         .collect();

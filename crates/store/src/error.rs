@@ -54,6 +54,22 @@ pub enum StoreError {
         /// What is wrong.
         message: String,
     },
+    /// A stored trajectory row has a status this build does not know (written by a newer or edited store):
+    /// refused, never skipped.
+    #[error("{}: table `trajectory`, shot {clip} (id {shot_id}), frame {frame}: {source}", .path.display())]
+    UnknownStatus {
+        /// The database file.
+        path: PathBuf,
+        /// The shot's clip name.
+        clip: String,
+        /// The shot's id.
+        shot_id: i64,
+        /// The row's frame index.
+        frame: i64,
+        /// The name found.
+        #[source]
+        source: bouncelab_track::UnknownStatus,
+    },
     /// A row referred to by id does not exist.
     #[error("{}: table `{table}`: no row with id {id}", .path.display())]
     NotFound {

@@ -5,8 +5,9 @@
 //! transaction, and a caller groups the writes that belong together (a shot, its track and its estimate) in
 //! one [`Store::transaction`], so a run killed at any instant leaves each shot either complete or absent, and
 //! re-running resumes. Incremental analysis rests on each shot's fingerprint ([`fingerprint_clip_dir`]):
-//! [`Tx::upsert_shot`] says whether a shot must be tracked again. The crate takes plain records defined here
-//! and depends on no other bouncelab crate; every table exports to CSV. See `docs/store.md`.
+//! [`Tx::upsert_shot`] says whether a shot must be tracked again. The crate takes plain records defined here,
+//! and the tracker's own trajectory row (`bouncelab_track::TrajectoryRow`, status stored by its name); every
+//! table exports to CSV. See `docs/store.md`.
 
 mod error;
 mod export;
@@ -19,7 +20,7 @@ pub use error::{Result, StoreError};
 pub use fingerprint::{ClipFingerprint, Fingerprint, fingerprint_clip_dir};
 pub use records::{
     CameraRecord, EstimateRecord, EstimateRow, FitRecord, FitRow, ModelHistoryRow, ModelVersionRecord, ModelVersionRow,
-    SessionRecord, SessionRow, ShotRecord, ShotRow, ShotStatus, ShotUpsert, TrackRecord, TrajectoryRecord, ValueSe,
+    SessionRecord, SessionRow, ShotRecord, ShotRow, ShotStatus, ShotUpsert, TrackRecord, ValueSe,
 };
 pub use schema::{ESTIMATE_QUANTITIES, MIGRATIONS, Migration, Table, latest_version};
 pub use store::{Store, StoreLock, Tx};

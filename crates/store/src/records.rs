@@ -1,12 +1,14 @@
 //! Plain records: what callers write (`*Record`) and what queries return (`*Row`).
 //!
 //! The caller converts from the pipeline's types (`frames::Session`, `track::Track`, `estimate::Estimate`,
-//! `fit::FitResult`), so this crate depends on none of them. Numbers that are NaN are stored as SQL `NULL`
-//! and read back as NaN.
+//! `fit::FitResult`) except the trajectory, whose row is the tracker's own [`TrajectoryRow`] (the store comes
+//! after the tracker in the pipeline). Numbers that are NaN are stored as SQL `NULL` and read back as NaN;
+//! −0 is read back as 0 (SQLite keeps an integral real as an integer).
 
 use std::collections::BTreeMap;
 use std::fmt;
 
+use bouncelab_track::TrajectoryRow;
 use serde::{Deserialize, Serialize};
 
 /// A session folder as loaded.
@@ -148,8 +150,9 @@ pub struct TrackRecord {
     pub warnings: Vec<String>,
     /// Wall time spent tracking, seconds.
     pub seconds: f64,
-    /// Per-frame trajectory (`docs/outputs.md` columns); frames unique.
-    pub rows: Vec<TrajectoryRecord>,
+    /// Per-frame trajectory (`docs/outputs.md` columns); frames unique. Read back, each fix's `sigma_r_px`
+    /// (not a column) is NaN.
+    pub rows: Vec<TrajectoryRow>,
     /// What the camera file's header says (model, rate, exposure, bit depth, trigger), when the clip is a
     /// camera file; `None` for a folder of images or a track stored before it was kept.
     #[serde(default)]
@@ -171,31 +174,6 @@ pub struct CameraRecord {
     pub bit_depth: Option<u8>,
     /// Position in the file (0-based) of the trigger frame; may lie outside the stored frames.
     pub trigger_frame: Option<i64>,
-}
-
-/// One frame of a trajectory (`docs/outputs.md` `trajectories/<clip>.csv`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct TrajectoryRecord {
-    /// Frame index (0-based, dropped frames counted).
-    pub frame: u64,
-    /// Time, s.
-    pub t_s: f64,
-    /// Centre x, px.
-    pub x_px: f64,
-    /// Centre y, px.
-    pub y_px: f64,
-    /// Radius, px.
-    pub r_px: f64,
-    /// Standard error of each centre coordinate, px.
-    pub sigma_px: f64,
-    /// Quality 0–1.
-    pub quality: f64,
-    /// Status name.
-    pub status: String,
-    /// Along the surface, down-slope, m.
-    pub x_m: f64,
-    /// Above the surface line, m.
-    pub y_m: f64,
 }
 
 /// A value with its standard error.

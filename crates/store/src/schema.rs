@@ -3,6 +3,8 @@
 use std::fmt;
 use std::str::FromStr;
 
+use bouncelab_track::TRAJECTORY_COLUMNS;
+
 use crate::error::StoreError;
 
 /// SQL for the current time as ISO 8601 UTC with milliseconds (`2026-04-14T09:30:00.123Z`).
@@ -202,6 +204,19 @@ const ESTIMATES_COLUMNS: [&str; 24] = {
     out
 };
 
+/// The `trajectory` table's columns in export order: its shot, then the trajectory row's
+/// ([`bouncelab_track::TRAJECTORY_COLUMNS`]), so the table, `trajectories/<clip>.csv` and `bouncelab track`
+/// share one list.
+const TRAJECTORY_TABLE_COLUMNS: [&str; 11] = {
+    let mut out = ["shot_id"; 11];
+    let mut i = 0;
+    while i < TRAJECTORY_COLUMNS.len() {
+        out[1 + i] = TRAJECTORY_COLUMNS[i];
+        i += 1;
+    }
+    out
+};
+
 /// The newest schema version this build knows.
 pub fn latest_version() -> i64 {
     MIGRATIONS.last().map_or(0, |m| m.version)
@@ -296,9 +311,7 @@ impl Table {
                 "created_at",
                 "camera",
             ],
-            Table::Trajectory => &[
-                "shot_id", "frame", "t_s", "x_px", "y_px", "r_px", "sigma_px", "quality", "status", "x_m", "y_m",
-            ],
+            Table::Trajectory => &TRAJECTORY_TABLE_COLUMNS,
             Table::Estimates => &ESTIMATES_COLUMNS,
             Table::ModelVersions => &["id", "name", "toml", "parent_id", "created_at"],
             Table::Fits => &[

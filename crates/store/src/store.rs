@@ -3,6 +3,8 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
+use bouncelab_track::{Status, TRAJECTORY_COLUMNS, TrajectoryCell, TrajectoryRow};
+use rusqlite::types::Value;
 use rusqlite::{Connection, OptionalExtension, Row, TransactionBehavior, params};
 
 use crate::error::{Result, StoreError};
@@ -647,32 +649,37 @@ impl Tx<'_> {
                 ],
             )
             .map_err(sql(self.path, "tracks"))?;
+        self.put_trajectory(shot_id, &r.rows)?;
+        self.set_status(shot_id, ShotStatus::Tracked, None)
+    }
+
+    /// The rows under their [`TRAJECTORY_COLUMNS`]: the frame an integer, numbers reals (NaN as NULL), the
+    /// status by its name.
+    fn put_trajectory(&self, shot_id: i64, rows: &[TrajectoryRow]) -> Result<()> {
         let err = || sql(self.path, "trajectory");
+        let placeholders: Vec<String> = (2..TRAJECTORY_COLUMNS.len() + 2).map(|i| format!("?{i}")).collect();
         let mut stmt = self
             .tx
-            .prepare_cached(
-                "INSERT INTO trajectory (shot_id, frame, t_s, x_px, y_px, r_px, sigma_px, quality, status, x_m, y_m)
-                 VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11)",
-            )
+            .prepare_cached(&format!(
+                "INSERT INTO trajectory (shot_id, {}) VALUES (?1, {})",
+                TRAJECTORY_COLUMNS.join(", "),
+                placeholders.join(", ")
+            ))
             .map_err(err())?;
-        for row in &r.rows {
-            let frame = to_i64(self.path, "trajectory", "frame", row.frame)?;
-            stmt.execute(params![
-                shot_id,
-                frame,
-                nn(row.t_s),
-                nn(row.x_px),
-                nn(row.y_px),
-                nn(row.r_px),
-                nn(row.sigma_px),
-                nn(row.quality),
-                row.status,
-                nn(row.x_m),
-                nn(row.y_m)
-            ])
-            .map_err(err())?;
+        let mut values: Vec<Value> = Vec::with_capacity(TRAJECTORY_COLUMNS.len() + 1);
+        for row in rows {
+            values.clear();
+            values.push(Value::Integer(shot_id));
+            for cell in row.cells() {
+                values.push(match cell {
+                    TrajectoryCell::Frame(f) => Value::Integer(to_i64(self.path, "trajectory", "frame", f as u64)?),
+                    TrajectoryCell::Number(x) => nn(x).map_or(Value::Null, Value::Real),
+                    TrajectoryCell::Status(s) => Value::Text(s.name().to_string()),
+                });
+            }
+            stmt.execute(rusqlite::params_from_iter(&values)).map_err(err())?;
         }
-        self.set_status(shot_id, ShotStatus::Tracked, None)
+        Ok(())
     }
 
     /// Replaces a shot's estimate and sets its status to `estimated`.
@@ -894,32 +901,67 @@ fn q_track(conn: &Connection, path: &Path, shot_id: i64) -> Result<Option<TrackR
     };
     track.warnings = json_field(path, "tracks", "warnings", &warnings)?;
     track.camera = camera.map(|c| json_field(path, "tracks", "camera", &c)).transpose()?;
+    track.rows = q_trajectory(conn, path, shot_id)?;
+    Ok(Some(track))
+}
+
+/// A shot's trajectory in frame order, read under [`TRAJECTORY_COLUMNS`] (the inverse of
+/// `Tx::put_trajectory`); a status this build does not know is an error naming the shot and the frame.
+fn q_trajectory(conn: &Connection, path: &Path, shot_id: i64) -> Result<Vec<TrajectoryRow>> {
     let err = || sql(path, "trajectory");
     let mut stmt = conn
-        .prepare(
-            "SELECT frame, t_s, x_px, y_px, r_px, sigma_px, quality, status, x_m, y_m FROM trajectory
-             WHERE shot_id = ?1 ORDER BY frame",
-        )
+        .prepare(&format!(
+            // The frame first once more, to name the row in an error.
+            "SELECT frame, {} FROM trajectory WHERE shot_id = ?1 ORDER BY frame",
+            TRAJECTORY_COLUMNS.join(", ")
+        ))
         .map_err(err())?;
-    track.rows = stmt
+    let raw: Vec<(i64, Vec<Value>)> = stmt
         .query_map([shot_id], |r| {
-            Ok(TrajectoryRecord {
-                frame: r.get::<_, i64>(0)? as u64,
-                t_s: get_f64(r, 1)?,
-                x_px: get_f64(r, 2)?,
-                y_px: get_f64(r, 3)?,
-                r_px: get_f64(r, 4)?,
-                sigma_px: get_f64(r, 5)?,
-                quality: get_f64(r, 6)?,
-                status: r.get(7)?,
-                x_m: get_f64(r, 8)?,
-                y_m: get_f64(r, 9)?,
-            })
+            let cells = (1..=TRAJECTORY_COLUMNS.len()).map(|i| r.get(i));
+            Ok((r.get(0)?, cells.collect::<rusqlite::Result<_>>()?))
         })
         .map_err(err())?
         .collect::<rusqlite::Result<_>>()
         .map_err(err())?;
-    Ok(Some(track))
+    raw.into_iter()
+        .map(|(frame, values)| {
+            let bad = |message: String| StoreError::Field {
+                path: path.to_path_buf(),
+                table: "trajectory",
+                field: "frame",
+                message: format!("shot {shot_id}, frame {frame}: {message}"),
+            };
+            let mut cells = [TrajectoryCell::Number(f64::NAN); 10];
+            for (cell, value) in cells.iter_mut().zip(values) {
+                *cell = match value {
+                    Value::Null => TrajectoryCell::Number(f64::NAN),
+                    Value::Real(x) => TrajectoryCell::Number(x),
+                    Value::Integer(i) => {
+                        TrajectoryCell::Frame(usize::try_from(i).map_err(|_| bad(format!("{i} is not a frame index")))?)
+                    }
+                    Value::Text(name) => TrajectoryCell::Status(Status::from_name(&name).map_err(|source| {
+                        StoreError::UnknownStatus {
+                            path: path.to_path_buf(),
+                            clip: shot_clip(conn, shot_id),
+                            shot_id,
+                            frame,
+                            source,
+                        }
+                    })?),
+                    Value::Blob(_) => return Err(bad("a blob where a trajectory value belongs".into())),
+                };
+            }
+            TrajectoryRow::from_cells(cells)
+                .ok_or_else(|| bad(format!("{cells:?} are not the trajectory columns' kinds")))
+        })
+        .collect()
+}
+
+/// The clip name of a shot, for an error message (`?` if it cannot be read).
+fn shot_clip(conn: &Connection, shot_id: i64) -> String {
+    conn.query_row("SELECT clip FROM shots WHERE id = ?1", [shot_id], |r| r.get(0))
+        .unwrap_or_else(|_| "?".to_string())
 }
 
 /// Estimates joined with shots where `column = id` (`e.shot_id` or `s.session_id`).

@@ -192,7 +192,7 @@ fn a_failed_transaction_leaves_nothing() {
             let id = tx.upsert_shot(sid, &shot("c", "h"))?.id;
             tx.put_track(id, &track(3))?;
             let mut bad = track(3);
-            bad.rows[2].frame = 1; // duplicate frame
+            bad.rows[2].fix.frame = 1; // duplicate frame
             tx.put_track(id, &bad)
         })
         .unwrap_err();

@@ -164,18 +164,7 @@ impl Track {
                     Some(fr) if f.status.measured() => fr.to_local(f.x_px, f.y_px),
                     _ => (f64::NAN, f64::NAN),
                 };
-                TrajectoryRow {
-                    frame: f.frame,
-                    t_s: f.t_s,
-                    x_px: f.x_px,
-                    y_px: f.y_px,
-                    r_px: f.r_px,
-                    sigma_px: f.sigma_px,
-                    quality: f.quality,
-                    status: f.status,
-                    x_m,
-                    y_m,
-                }
+                TrajectoryRow { fix: *f, x_m, y_m }
             })
             .collect()
     }

@@ -37,7 +37,7 @@ pub use refine::{
 pub use surface::{LineCue, SurfaceLine, SurfaceLines, find_surface_line, find_surface_lines};
 pub use texture::{horizontal_gradient_energy, texture_line, texture_lines};
 pub use tracker::{BallFix, Status, TrackOptions, Tracker, UnknownStatus};
-pub use trajectory::{TRAJECTORY_COLUMNS, TrajectoryRow};
+pub use trajectory::{TRAJECTORY_COLUMNS, TrajectoryCell, TrajectoryRow};
 
 /// Synthetic frames for tests, benches and examples (here and in dependents' dev-dependencies, through the
 /// `testutil` feature); not part of the library proper.

@@ -1,5 +1,8 @@
 //! Small synthetic frames for tests: a shaded disc with sub-pixel centre over a gradient backdrop, an
-//! optional textured surface band that hides the disc below its top edge, distractor discs and noise.
+//! optional textured surface band that hides the disc below its top edge, distractor discs and noise, drawn
+//! with the workspace's one seeded generator (`bouncelab_testkit::Rng`).
+
+use bouncelab_testkit::Rng;
 
 /// What to draw.
 #[derive(Debug, Clone)]
@@ -43,18 +46,20 @@ impl Default for Scene {
     }
 }
 
-struct Rng(u64);
-impl Rng {
-    fn uniform(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((self.0 >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
-    fn gauss(&mut self) -> f64 {
-        let (u, v) = (self.uniform(), self.uniform());
-        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+/// The OpenCV reference's test frame: 512×512, a bright ball over a dark gradient, a textured band below
+/// (its top at y = 430, slope 0.02), a dark screw head at the top right, noise σ = 5.
+pub fn opencv_scene(ball: (f64, f64, f64), seed: u64) -> Scene {
+    Scene {
+        size: (512, 512),
+        ball,
+        ball_level: 210.0,
+        backdrop: (60.0, 100.0),
+        surface: Some((430.0, 0.02)),
+        band: (120.0, 50.0),
+        distractors: vec![(450.0, 80.0, 9.0, 40.0)],
+        noise: 5.0,
+        seed,
+        roughness: 0.0,
     }
 }
 
@@ -85,12 +90,12 @@ fn coverage(x: usize, y: usize, cx: f64, cy: f64, r: f64) -> f64 {
 /// Renders `scene` as 8-bit pixels, row-major.
 pub fn render(scene: &Scene) -> Vec<u8> {
     let (w, h) = scene.size;
-    let mut rng = Rng(scene.seed.wrapping_add(0x5851F42D4C957F2D));
-    let tex: Vec<f64> = (0..w * h).map(|_| rng.gauss()).collect();
+    let mut rng = Rng::new(scene.seed.wrapping_add(0x5851F42D4C957F2D));
+    let tex: Vec<f64> = (0..w * h).map(|_| rng.normal()).collect();
     let (cx, cy, r) = scene.ball;
     let xc = (w as f64 - 1.0) / 2.0;
     // The ragged edge: a few incommensurate waves, scaled to reach ±roughness.
-    let mut phases = Rng(scene.seed ^ 0x9E37_79B9_7F4A_7C15);
+    let mut phases = Rng::new(scene.seed ^ 0x9E37_79B9_7F4A_7C15);
     let waves: Vec<(f64, f64)> = [2.3, 4.1, 7.9, 15.7]
         .iter()
         .map(|&l| (l, phases.uniform() * std::f64::consts::TAU))
@@ -124,7 +129,7 @@ pub fn render(scene: &Scene) -> Vec<u8> {
                     v = v * (1.0 - cov) + band * cov;
                 }
             }
-            v += scene.noise * rng.gauss();
+            v += scene.noise * rng.normal();
             out[y * w + x] = v.round().clamp(0.0, 255.0) as u8;
         }
     }

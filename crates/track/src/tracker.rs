@@ -88,7 +88,7 @@ pub struct UnknownStatus {
     pub name: String,
 }
 
-/// The ball in one frame (NaN coordinates when not measured).
+/// The ball in one frame (NaN coordinates when not measured): the pixel part of a [`crate::TrajectoryRow`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct BallFix {
     /// Frame index (position in the clip, dropped frames counted).
@@ -103,7 +103,8 @@ pub struct BallFix {
     pub r_px: f64,
     /// Standard error of each centre coordinate, px.
     pub sigma_px: f64,
-    /// Standard error of the radius, px.
+    /// Standard error of the radius, px. Not a trajectory column ([`crate::TRAJECTORY_COLUMNS`]): NaN in a
+    /// row read back from a file or the store.
     pub sigma_r_px: f64,
     /// 0–1 quality score (fraction of the rim used × contrast factor).
     pub quality: f64,

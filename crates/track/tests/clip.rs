@@ -62,7 +62,7 @@ fn the_moving_circle_is_the_ball_and_the_scale_follows_from_its_radius() {
         "{lowest:?}"
     );
     assert!(rows[0].x_m < 0.0 && rows[39].x_m > 0.0 && rows[0].y_m > lowest.y_m);
-    assert!((rows[0].t_s - 0.0).abs() < 1e-15 && (rows[1].t_s - 1e-4).abs() < 1e-12);
+    assert!((rows[0].fix.t_s - 0.0).abs() < 1e-15 && (rows[1].fix.t_s - 1e-4).abs() < 1e-12);
 }
 
 #[test]

@@ -1,5 +1,5 @@
-//! OpenCV's HoughCircles behind our detector interface (feature `opencv`): both methods find the ball in a
-//! noisy textured frame, an empty frame gives no circle, bad options are errors, and a clip tracks.
+//! OpenCV's HoughCircles behind our detector interface (feature `opencv`): both methods find the ball in
+//! noisy textured frames within the spread measured for them, an empty frame gives no circle, bad options are errors, and a clip tracks.
 #![cfg(feature = "opencv")]
 
 use bouncelab_frames::Clip;
@@ -12,20 +12,7 @@ use bouncelab_track::{CircleDetection, ClipTracking, Plane, TrackError};
 
 const METHODS: [OpencvMethod; 2] = [OpencvMethod::Gradient, OpencvMethod::GradientAlt];
 
-fn scene(ball: (f64, f64, f64), seed: u64) -> Scene {
-    Scene {
-        size: (512, 512),
-        ball,
-        ball_level: 210.0,
-        backdrop: (60.0, 100.0),
-        surface: Some((430.0, 0.02)),
-        band: (120.0, 50.0),
-        distractors: vec![(450.0, 80.0, 9.0, 40.0)],
-        noise: 5.0,
-        seed,
-        roughness: 0.0,
-    }
-}
+use bouncelab_track::testutil::opencv_scene as scene;
 
 fn range(r: f64) -> CircleDetection {
     CircleDetection {
@@ -35,24 +22,41 @@ fn range(r: f64) -> CircleDetection {
     }
 }
 
+/// OpenCV's Hough is a reference, not our tracker: its centres sit on a half-pixel grid and its radii on a
+/// 0.1 px one, so a frame can land ~2 px off (one of these balls, 72.5 px, is found 2.14 px away in over
+/// 5 % of noise draws by HOUGH_GRADIENT_ALT). The limits come from its spread on these very frames over 200
+/// noise seeds, drawn with this generator and with another one (`examples/opencv_spread.rs`,
+/// `docs/accuracy.md`): the largest centre error of 1,200 frames per method was 2.36 px, the largest radius
+/// error 2.2 px, and the centre RMS over the three balls × 4 seeds at most 1.45 px in 100 blocks of seeds.
+/// A wrapper bug (axes swapped, a scale or offset lost, the wrong circle kept) is far outside these.
 #[test]
-fn both_methods_find_the_ball_within_one_and_a_half_pixels() {
-    for (k, ball) in [(201.3, 240.6, 60.0), (260.8, 300.2, 72.5), (300.4, 190.9, 84.0)]
-        .into_iter()
-        .enumerate()
-    {
-        let px = render(&scene(ball, k as u64));
-        let plane = Plane::new(&px, 512, 512);
-        for method in METHODS {
-            let found = detect_circles_opencv(&plane, &range(ball.2), method).unwrap();
-            let best = found
-                .first()
-                .unwrap_or_else(|| panic!("{method:?}: nothing at {ball:?}"));
-            let d = (best.x - ball.0).hypot(best.y - ball.1);
-            assert!(d < 1.5, "{method:?}: {best:?} vs {ball:?}");
-            assert!((best.r - ball.2).abs() < 1.5, "{method:?}: {best:?} vs {ball:?}");
-            assert!(best.support > 0.0 && best.support <= 1.0, "{best:?}");
+fn both_methods_find_the_ball_within_the_spread_of_opencvs_hough() {
+    const MAX_CENTRE_PX: f64 = 2.5;
+    const MAX_RADIUS_PX: f64 = 2.5;
+    const MAX_CENTRE_RMS_PX: f64 = 1.6;
+    const SEEDS: u64 = 4;
+    for method in METHODS {
+        let mut sq = Vec::new();
+        for ball in [(201.3, 240.6, 60.0), (260.8, 300.2, 72.5), (300.4, 190.9, 84.0)] {
+            for seed in 0..SEEDS {
+                let px = render(&scene(ball, seed));
+                let plane = Plane::new(&px, 512, 512);
+                let found = detect_circles_opencv(&plane, &range(ball.2), method).unwrap();
+                let best = found
+                    .first()
+                    .unwrap_or_else(|| panic!("{method:?}: nothing at {ball:?}, seed {seed}"));
+                let d = (best.x - ball.0).hypot(best.y - ball.1);
+                assert!(d < MAX_CENTRE_PX, "{method:?} seed {seed}: {best:?} vs {ball:?}");
+                assert!(
+                    (best.r - ball.2).abs() < MAX_RADIUS_PX,
+                    "{method:?} seed {seed}: {best:?} vs {ball:?}"
+                );
+                assert!(best.support > 0.0 && best.support <= 1.0, "{best:?}");
+                sq.push(d * d);
+            }
         }
+        let rms = (sq.iter().sum::<f64>() / sq.len() as f64).sqrt();
+        assert!(rms < MAX_CENTRE_RMS_PX, "{method:?}: centre RMS {rms:.3} px");
     }
 }
 

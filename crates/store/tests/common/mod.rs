@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 use bouncelab_store::*;
+pub use bouncelab_track::{BallFix, Status, TrajectoryRow};
 
 pub fn session(path: &str) -> SessionRecord {
     SessionRecord {
@@ -43,15 +44,18 @@ pub fn track(frames: u64) -> TrackRecord {
             trigger_frame: Some(-52),
         }),
         rows: (0..frames)
-            .map(|i| TrajectoryRecord {
-                frame: i,
-                t_s: i as f64 * 1e-4,
-                x_px: 100.0 + i as f64,
-                y_px: 200.0 - 0.5 * i as f64,
-                r_px: 134.0,
-                sigma_px: 0.05,
-                quality: 0.9,
-                status: "ok".into(),
+            .map(|i| TrajectoryRow {
+                fix: BallFix {
+                    frame: i as usize,
+                    t_s: i as f64 * 1e-4,
+                    x_px: 100.0 + i as f64,
+                    y_px: 200.0 - 0.5 * i as f64,
+                    r_px: 134.0,
+                    sigma_px: 0.05,
+                    sigma_r_px: 0.07,
+                    quality: 0.9,
+                    status: Status::Ok,
+                },
                 x_m: 0.001 * i as f64,
                 y_m: 0.03,
             })
