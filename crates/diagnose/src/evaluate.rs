@@ -404,7 +404,6 @@ pub(crate) fn summarize(ev: &Evaluator, effects: Vec<String>, out: &SolverOutcom
     let cov = covariance(&ev.problem, out, INTERVAL_CONFIDENCE);
     let dof = cov.dof;
     let chi2_red = out.cost / dof as f64;
-    let t = cov.t_quantile;
     let parameters = ev
         .problem
         .params()
@@ -414,16 +413,15 @@ pub(crate) fn summarize(ev: &Evaluator, effects: Vec<String>, out: &SolverOutcom
             let value = out.params[j];
             // A parameter the shots do not determine (μ of a surface with only normal impacts) has no
             // standard error; the others keep theirs.
-            let se = cov.std_error(j);
             FittedValue {
                 name: fp.name.clone(),
                 effect: fp.effect.clone(),
                 param: fp.param.clone(),
                 surface: fp.surface.clone(),
                 value,
-                std_error: se,
-                interval: se.map(|s| [value - t * s, value + t * s]),
-                at_bound: value <= fp.min || value >= fp.max,
+                std_error: cov.std_error(j),
+                interval: cov.interval(j, value),
+                at_bound: fp.at_bound(value),
             }
         })
         .collect();

@@ -30,6 +30,12 @@ impl Covariance {
     pub fn std_error(&self, j: usize) -> Option<f64> {
         self.matrix.as_ref().map(|c| c[(j, j)].sqrt()).filter(|s| s.is_finite())
     }
+
+    /// The interval `value ± t·se` of parameter `j` at `value`; `None` when it is not determined.
+    pub fn interval(&self, j: usize, value: f64) -> Option<[f64; 2]> {
+        self.std_error(j)
+            .map(|s| [value - self.t_quantile * s, value + self.t_quantile * s])
+    }
 }
 
 /// The covariance of `out`'s parameters on `problem` (`out` from minimising `problem`'s residuals, or residuals

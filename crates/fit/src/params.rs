@@ -30,6 +30,13 @@ pub struct FreeParam {
     pub scale: f64,
 }
 
+impl FreeParam {
+    /// Whether `value` lies on a bound (an interval there means little).
+    pub fn at_bound(&self, value: f64) -> bool {
+        value <= self.min || value >= self.max
+    }
+}
+
 /// A per-surface model and which entries of the parameter vector go into it.
 #[derive(Debug, Clone)]
 pub(crate) struct SurfaceModel {

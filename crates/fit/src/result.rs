@@ -213,7 +213,6 @@ pub(crate) fn build(
 /// starting at ≥ 0) whose standard error exceeds [`MAX_RELATIVE_STD_ERROR`] of its value is marked not
 /// identified.
 fn fitted_params(problem: &Problem, out: &SolverOutcome, cov: &Covariance) -> Vec<FittedParam> {
-    let t_quantile = cov.t_quantile;
     let mut not_identified = cov.not_identified.clone();
     problem
         .params()
@@ -239,9 +238,9 @@ fn fitted_params(problem: &Problem, out: &SolverOutcome, cov: &Covariance) -> Ve
                 initial: fp.initial,
                 value,
                 std_error: se,
-                interval: se.map(|s| [value - t_quantile * s, value + t_quantile * s]),
+                interval: cov.interval(j, value),
                 bounds: [fp.min, fp.max],
-                at_bound: value <= fp.min || value >= fp.max,
+                at_bound: fp.at_bound(value),
                 not_identified: not_identified[j].take().map(|w| name_partners(&w, problem)),
             }
         })
