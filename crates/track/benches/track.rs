@@ -2,12 +2,14 @@
 //!
 //! Run: `cargo bench -p bouncelab-track --bench track`
 //! 100 synthetic 512×512 8-bit frames of a ball (radius 84 px) falling onto a textured surface band, decoded
-//! in memory beforehand. "track_frame_steady": following the ball once found (prediction, one edge pass
-//! along 128 rays, the robust fit). "cold_start_first_frame": the first frame of a clip without a track
-//! (surface line, Hough, refined candidates). "detect_full_frame": the Hough transform alone.
+//! in memory beforehand. "track_frame_steady": following the ball once found and the surface line known
+//! (prediction, one edge pass along 128 rays, the robust fit), frames 2–99. "cold_start_first_frame": the
+//! first frame of a clip without a track (Hough, refined candidates). "surface_line": the surface line
+//! search, which runs on the second frame (once the ball is known) and until a line is found.
+//! "detect_full_frame": the Hough transform alone.
 
 use bouncelab_track::testutil::{Scene, render};
-use bouncelab_track::{CircleDetection, Plane, TrackOptions, Tracker, detect_circles};
+use bouncelab_track::{CircleDetection, Plane, TrackOptions, Tracker, detect_circles, find_surface_lines};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
 
@@ -36,15 +38,18 @@ fn bench(c: &mut Criterion) {
         radius_px: Some((70.0, 100.0)),
         ..TrackOptions::default()
     };
-    // A tracker that has already found the ball and the surface on the first frame.
+    // A tracker that has found the ball on the first frame and the surface line on the second (the line is
+    // looked for once the ball is known).
     let mut warm = Tracker::new(opts.clone());
-    warm.observe(0, 0.0, &Plane::new(&frames[0], 512, 512));
+    let first = warm.observe(0, 0.0, &Plane::new(&frames[0], 512, 512));
+    warm.observe(1, 1e-4, &Plane::new(&frames[1], 512, 512));
+    assert!(warm.surface().is_some(), "the bench's surface line is found on the second frame");
     let mut g = c.benchmark_group("track");
-    g.throughput(Throughput::Elements((frames.len() - 1) as u64));
+    g.throughput(Throughput::Elements((frames.len() - 2) as u64));
     g.bench_function("track_frame_steady", |b| {
         b.iter(|| {
             let mut t = warm.clone();
-            for (i, f) in frames.iter().enumerate().skip(1) {
+            for (i, f) in frames.iter().enumerate().skip(2) {
                 black_box(t.observe(i, i as f64 * 1e-4, &Plane::new(f, 512, 512)));
             }
         })
@@ -52,6 +57,10 @@ fn bench(c: &mut Criterion) {
     g.throughput(Throughput::Elements(1));
     g.bench_function("cold_start_first_frame", |b| {
         b.iter(|| black_box(Tracker::new(opts.clone()).observe(0, 0.0, &Plane::new(&frames[0], 512, 512))))
+    });
+    let ball = Some((first.x_px, first.y_px, first.r_px));
+    g.bench_function("surface_line", |b| {
+        b.iter(|| black_box(find_surface_lines(&Plane::new(&frames[1], 512, 512), ball)))
     });
     let det = CircleDetection {
         min_radius: 70.0,
