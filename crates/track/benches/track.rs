@@ -43,7 +43,10 @@ fn bench(c: &mut Criterion) {
     let mut warm = Tracker::new(opts.clone());
     let first = warm.observe(0, 0.0, &Plane::new(&frames[0], 512, 512));
     warm.observe(1, 1e-4, &Plane::new(&frames[1], 512, 512));
-    assert!(warm.surface().is_some(), "the bench's surface line is found on the second frame");
+    assert!(
+        warm.surface().is_some(),
+        "the bench's surface line is found on the second frame"
+    );
     let mut g = c.benchmark_group("track");
     g.throughput(Throughput::Elements((frames.len() - 2) as u64));
     g.bench_function("track_frame_steady", |b| {
