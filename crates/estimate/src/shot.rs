@@ -116,8 +116,9 @@ pub struct Estimate {
     /// rolled camera's tilt is taken out) and its normal.
     #[serde(default)]
     pub frame: Option<SurfaceFrame>,
-    /// The surface's tilt in the image, degrees counter-clockwise as seen, with its standard error, when a line
-    /// was found (a camera rolled by φ shows the surface tilted by −φ for down-slope +x).
+    /// The surface's tilt in the image, degrees counter-clockwise as seen, with its standard error, when the
+    /// frame follows a line found in the image (a camera rolled by φ shows the surface tilted by −φ for
+    /// down-slope +x); none when the line found was rejected, whose tilt is no measurement.
     #[serde(default)]
     pub surface_tilt_deg: Option<Measured>,
     /// Where the ball's own trajectory puts the contact level, px above the contact line used (≈ 0 when the
@@ -306,8 +307,7 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
         surface_sigma_m: level.sigma_scatter,
         contact_line: Some(line),
         frame: Some(frame),
-        surface_tilt_deg: track
-            .surface
+        surface_tilt_deg: Some(line)
             .filter(|l| matches!(l.cue, LineCue::Brightness | LineCue::Texture))
             .map(|l| Measured::new(l.tilt_deg(), l.sigma_tilt_deg)),
         trajectory_level_px: choice.trajectory_level_px,
@@ -664,7 +664,28 @@ fn contact_line(
         });
     }
     match (found, &view.trajectory) {
-        (Some(line), Ok(tc)) => Ok(view.found_or_trajectory(line, tc, &track.surface_alternatives, no_impact)),
+        (Some(line), Ok(tc)) => {
+            let choice = view.found_or_trajectory(line, tc, &track.surface_alternatives, no_impact);
+            if choice.line.cue != LineCue::Trajectory {
+                return Ok(choice);
+            }
+            // A line that is not where the ball lands is no evidence of the surface's direction either: the
+            // level is taken along the image's axes, as when no line is found.
+            let across = TrajectoryView::along(image_axis(measured), track, measured, radius_px, a_px);
+            Ok(match &across.trajectory {
+                Ok(tc) => ContactChoice {
+                    line: across.level_line(tc),
+                    trajectory_level_px: Some(Measured::new(0.0, tc.level_se_px)),
+                    notes: [
+                        choice.notes,
+                        vec!["the rejected line's tilt is not used: image axes are taken as the surface's".into()],
+                    ]
+                    .concat(),
+                    ..choice
+                },
+                Err(_) => choice,
+            })
+        }
         (Some(line), Err(_)) => Ok(ContactChoice {
             line,
             trajectory_level_px: None,
@@ -701,9 +722,18 @@ struct TrajectoryView {
 
 impl TrajectoryView {
     fn new(track: &Track, measured: &[&bouncelab_track::BallFix], radius_px: f64, a_px: f64) -> Self {
-        let axis = track
-            .surface
-            .unwrap_or_else(|| SurfaceLine::given((track_width(measured) - 1.0) / 2.0, 0.0, 0.0));
+        let axis = track.surface.unwrap_or_else(|| image_axis(measured));
+        Self::along(axis, track, measured, radius_px, a_px)
+    }
+
+    /// The trajectory seen along `axis`.
+    fn along(
+        axis: SurfaceLine,
+        track: &Track,
+        measured: &[&bouncelab_track::BallFix],
+        radius_px: f64,
+        a_px: f64,
+    ) -> Self {
         let heights: Vec<HeightPoint> = measured
             .iter()
             .map(|f| HeightPoint {
@@ -823,6 +853,12 @@ impl TrajectoryView {
             no_impact,
         }
     }
+}
+
+/// The image's own axes as a line (through the middle column the fixes suggest): the surface's direction
+/// when nothing in the image shows it.
+fn image_axis(measured: &[&bouncelab_track::BallFix]) -> SurfaceLine {
+    SurfaceLine::given((track_width(measured) - 1.0) / 2.0, 0.0, 0.0)
 }
 
 /// The image width the fixes suggest (for a reference column when no line is known), px.

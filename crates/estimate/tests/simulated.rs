@@ -282,6 +282,31 @@ fn a_line_the_ball_does_not_land_on_gives_way_to_the_trajectory() {
     );
 }
 
+/// A line the ball does not land on is no evidence of the surface's direction either: a spurious line
+/// tilted by 10° leaves the frame on the image's axes, so COR and μ are those of the level surface.
+#[test]
+fn a_rejected_line_lends_the_frame_no_tilt() {
+    let model = Model::paper(25_650.0, 14.0, 0.5);
+    let (mut track, truth) = shot(&model, 7.5, 0.4, 0.02, 9);
+    let line = track.surface.as_mut().unwrap();
+    line.y0 -= 40.0;
+    line.slope = -(10f64.to_radians().tan());
+    let e = estimate(&track, &conditions(7.5)).unwrap();
+    let used = e.contact_line.unwrap();
+    assert_eq!(used.cue, LineCue::Trajectory);
+    assert_eq!(used.slope, 0.0, "{used:?}");
+    assert!((SURFACE_Y - used.y0).abs() < 1.5, "{used:?}");
+    assert!(e.surface_tilt_deg.is_none(), "{:?}", e.surface_tilt_deg);
+    assert!((e.cor.value - truth.restitution).abs() < 0.003, "e {}", e.cor.value);
+    assert!(
+        (e.mu.value - truth.effective_friction).abs() < 0.01,
+        "μ {} vs {}",
+        e.mu.value,
+        truth.effective_friction
+    );
+    assert!(e.notes.iter().any(|n| n.contains("tilt is not used")), "{:?}", e.notes);
+}
+
 /// A clip that holds no impact says so, with the speed the ball has at its end.
 #[test]
 fn a_fall_without_an_impact_is_no_impact_with_its_speed() {

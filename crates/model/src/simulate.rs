@@ -167,6 +167,10 @@ struct Mode {
     patch: bool,
     /// u_t at which the patch's spring is relaxed while it holds: its displacement is `u_t − offset`.
     patch_offset: f64,
+    /// True while a compliant patch slides on its limit because holding it failed at the instant it
+    /// began (the held force exceeds the limit by rounding where both vanish, as at separation): its
+    /// stop event then counts only a real crossing, not its value at the start.
+    riding_limit: bool,
 }
 
 /// Quantities the events are made of.
@@ -628,6 +632,7 @@ impl<'a> Run<'a> {
             force_max: 0.0,
             patch: self.dynamics.patch,
             patch_offset: 0.0,
+            riding_limit: false,
         };
         self.recorder.record_until(t0, &mode, |_| y0, |_, _| 0.0);
         let (mut t, mut y) = (t0, y0);
@@ -755,6 +760,7 @@ impl<'a> Run<'a> {
                 return Ok((t, y));
             }
             // A stick/slip event ended the segment.
+            mode.riding_limit = false;
             let kind = match mode.friction {
                 Friction::Slip(_) if mode.patch => {
                     // The patch stops sliding: it holds from the displacement it had, so the force is
@@ -774,16 +780,23 @@ impl<'a> Run<'a> {
             };
             // Switches piling up on one instant mean the law cannot decide there (a tangency of the force
             // with its limit, within rounding): say so rather than spin through the step budget.
-            match slip_events.last() {
-                Some(last) if t - last.t <= 1e-12 * t.abs().max(1e-3) => same_instant += 1,
-                _ => same_instant = 0,
-            }
+            let at_once = slip_events
+                .last()
+                .is_some_and(|last| t - last.t <= 1e-12 * t.abs().max(1e-3));
+            same_instant = if at_once { same_instant + 1 } else { 0 };
             if same_instant >= MAX_SWITCHES_AT_ONE_INSTANT {
                 return Err(ModelError::Chatter {
                     t_s: t,
                     phase: phase.name(),
                     switches: same_instant + 1,
                 });
+            }
+            if at_once && mode.patch && kind == SlipEventKind::StartsSliding {
+                // The patch could not hold for any time: it never stopped sliding, and rides its limit
+                // (the force stays continuous and within it) until its stop is really due.
+                slip_events.pop();
+                mode.riding_limit = true;
+                continue;
             }
             slip_events.push(SlipEvent { t, kind });
         }
@@ -831,7 +844,7 @@ impl<'a> Run<'a> {
         };
         let (mut f, aux) = dynamics.eval(t, &y, &m);
         let mut g = event_values(events, &y, &aux, &m, r);
-        if m.patch {
+        if m.patch && !m.riding_limit {
             patch_switch_just_positive(&mut g, events);
         }
         let scale = dynamics.model.ball.radius_m.max(1e-3) / y[3].hypot(y[4]).max(0.1);

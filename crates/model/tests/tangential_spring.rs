@@ -237,3 +237,24 @@ proptest! {
         prop_assert!(ev.iter().all(|e| e.kind != SlipEventKind::Reverses));
     }
 }
+
+/// Found by the property test below: the patch stops sliding femtoseconds before separation, where the
+/// load is 5e-11 N and the held force exceeds the vanishing limit by rounding. It must slide on to the
+/// separation instead of switching back and forth at one instant.
+#[test]
+fn a_patch_that_cannot_hold_just_before_separation_slides_on() {
+    let model = spring_model(25_650.0, 14.0, 0.5632068499968248, 10f64.powf(-5.397057476623496), 0.0);
+    let start = State {
+        y: R + 0.005,
+        ..at_touch(3.962350706702278, 56.021732296253994, -14.104730365752038)
+    };
+    let sim = simulate(&model, 0.3437721133115088, 0.0, start, &[], &SimOptions::default()).unwrap();
+    let ev = &sim.impact.slip_events;
+    assert_eq!(ev.len(), 5, "{ev:?}");
+    assert!(
+        ev.windows(2).all(|w| w[0].kind != w[1].kind && w[1].t - w[0].t > 1e-4),
+        "{ev:?}"
+    );
+    assert_eq!(ev.last().map(|e| e.kind), Some(SlipEventKind::StartsSliding));
+    assert!(!sim.impact.rolling_at_separation);
+}
