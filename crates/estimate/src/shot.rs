@@ -148,6 +148,19 @@ pub struct GravityCheck {
     pub inconclusive: bool,
 }
 
+impl GravityCheck {
+    /// The angle from gravity's expected direction to the measured acceleration's, rad, with its standard
+    /// error: how far the frame's axes are turned from the surface's, as the free fall alone tells it.
+    pub fn frame_offset_rad(&self) -> Measured {
+        let [at, an] = self.measured;
+        let [et, en] = self.expected;
+        let value = at.value.atan2(-an.value) - et.atan2(-en);
+        let norm2 = at.value * at.value + an.value * an.value;
+        let se = (an.value * at.se).hypot(at.value * an.se) / norm2;
+        Measured::new(value, if se.is_finite() { se } else { f64::INFINITY })
+    }
+}
+
 impl Estimate {
     /// Contact start and end, s, had the surface been `level_m` above the surface line found in the image (the
     /// flight arcs crossing `radius_m + level_m`): how a fitted surface level carries over to the contact
@@ -253,7 +266,14 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
     let fin = fit(&incoming, "incoming")?;
     let fout = fit(&outgoing, "outgoing")?;
     let radius = c.ball_diameter_m / 2.0;
-    let level = LevelErrors::of(&line, &scale, radius);
+    let gravity = gravity_check(&incoming, &outgoing, a, c.gravity);
+    let mut notes = choice.notes;
+    let mut level = LevelErrors::of(&line, &scale, radius);
+    if line.cue == LineCue::Trajectory
+        && let Some(g) = &gravity
+    {
+        level.sigma_theta = unmeasured_tilt(g, &mut notes);
+    }
     // The level's error is common to both crossings, so it is carried as a derivative and propagated
     // coherently into the contact time, COR and μ, not added to each crossing separately.
     let touch = crossing(&fin, radius, points[first].t);
@@ -268,7 +288,6 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
         (touch.t.se.powi(2) + sep.t.se.powi(2) + ((sep.dt_dlevel - touch.dt_dlevel) * level.sigma).powi(2)).sqrt();
     let contact = &points[first..=last];
     let (t_max, delta_max) = deepest(contact, radius, level.sigma, level.rel_scale);
-    let mut notes = choice.notes;
     let mut flags = impossible(
         vin[1].value,
         vout[1].value,
@@ -278,7 +297,6 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
         t_sep.value,
     );
     flags.extend(saturation_flag(track));
-    let gravity = gravity_check(&incoming, &outgoing, a, c.gravity);
     if let Some(g) = &gravity {
         note_gravity(g, c.incline_deg, &mut flags, &mut notes);
     }
@@ -528,6 +546,29 @@ fn note_gravity(g: &GravityCheck, incline_deg: f64, flags: &mut Vec<String>, not
             g.measured[1].value, g.measured[1].se
         ));
     }
+}
+
+/// How level a camera set up by eye is, degrees: the tilt's standard error assumed for a frame on the image's
+/// axes when the flights cannot bound it more tightly (`--line Y,TILT` replaces the assumption).
+pub const LEVEL_BY_EYE_DEG: f64 = 2.0;
+
+/// The standard error of a frame whose tilt nothing in the image measured (the image's own axes), rad. The
+/// flights' fall direction is the only evidence of it: the frame is known to within the angle between that
+/// direction and gravity's on the incline, with that angle's own error. Short flights bound it loosely (3–60°
+/// on the looks sweep), so the camera is taken as level by eye ([`LEVEL_BY_EYE_DEG`]) unless the fall shows
+/// a clear turn, which then sets the error and gets a note.
+fn unmeasured_tilt(g: &GravityCheck, notes: &mut Vec<String>) -> f64 {
+    let off = g.frame_offset_rad();
+    let bound = off.value.hypot(off.se);
+    if off.value.abs() > 3.0 * off.se {
+        notes.push(format!(
+            "the flights fall {:.1} ± {:.1}° away from gravity's direction in the image's axes: the camera looks rolled; give the contact line with its tilt (--line Y,TILT) to take the roll out",
+            off.value.abs().to_degrees(),
+            off.se.to_degrees()
+        ));
+        return bound;
+    }
+    bound.min(LEVEL_BY_EYE_DEG.to_radians())
 }
 
 /// A note for each flight scattering well beyond the tracker's σ (reduced χ² above 4), whose errors the fit

@@ -307,6 +307,39 @@ fn a_rejected_line_lends_the_frame_no_tilt() {
     assert!(e.notes.iter().any(|n| n.contains("tilt is not used")), "{:?}", e.notes);
 }
 
+/// A camera rolled by 2° with no line to show it: the frame stays on the image's axes, so a normal impact
+/// gains an apparent μ of about tan 2°. Its standard error must say so (the flights' fall is the only
+/// evidence of the tilt) instead of claiming a few thousandths.
+#[test]
+fn an_unmeasured_tilt_is_in_the_errors() {
+    let model = Model::paper(25_650.0, 14.0, 0.5);
+    let roll = 2f64.to_radians();
+    let (mut covered, mut seen) = (0, 0);
+    for seed in 0..6 {
+        let (mut track, truth) = shot(&model, 0.0, 0.4, 0.02, 70 + seed);
+        track.surface = None;
+        let (cx, cy) = (255.5, SURFACE_Y);
+        for f in &mut track.fixes {
+            let (dx, dy) = (f.x_px - cx, f.y_px - cy);
+            f.x_px = cx + dx * roll.cos() - dy * roll.sin();
+            f.y_px = cy + dx * roll.sin() + dy * roll.cos();
+        }
+        let e = estimate(&track, &conditions(0.0)).unwrap();
+        assert_eq!(e.contact_line.unwrap().cue, LineCue::Trajectory);
+        let err = e.mu.value - truth.effective_friction;
+        assert!(err.abs() > 0.02, "the roll shows in μ: {err}");
+        seen += 1;
+        if err.abs() <= 2.0 * e.mu.se {
+            covered += 1;
+        }
+        assert!(e.mu.se < 0.5, "μ ± {}", e.mu.se);
+    }
+    assert!(
+        covered >= 5,
+        "μ's 2σ interval covers the truth on {covered} of {seen} shots"
+    );
+}
+
 /// A clip that holds no impact says so, with the speed the ball has at its end.
 #[test]
 fn a_fall_without_an_impact_is_no_impact_with_its_speed() {
