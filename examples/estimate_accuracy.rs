@@ -56,6 +56,7 @@ fn main() {
             incline_deg: entry.angle_deg,
             gravity: 9.81,
             ball_diameter_m: session.ball.diameter_m,
+            surface_tilt_deg: None,
         };
         let est = match estimate_with_frames(&track, &clip, &c) {
             Ok(e) => e,

@@ -70,6 +70,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         incline_deg: angle,
         gravity: a.gravity,
         ball_diameter_m: diameter,
+        surface_tilt_deg: clip.settings().surface_tilt_deg,
     };
     let e = estimate_with_frames(&track, &clip, &c).with_context(|| format!("estimating {}", a.clip_dir.display()))?;
     if a.json {

@@ -23,6 +23,10 @@ fn parse_diameter(text: &str) -> Result<f64, String> {
     number_in(text, DIAMETER_RANGE_M, " m")
 }
 
+fn parse_tilt(text: &str) -> Result<f64, String> {
+    number_in(text, (-MAX_LINE_TILT_DEG, MAX_LINE_TILT_DEG), " degrees")
+}
+
 fn parse_scale(text: &str) -> Result<f64, String> {
     number_in(text, SCALE_RANGE_M_PER_PX, " m/px")
 }
@@ -64,6 +68,11 @@ pub struct Overrides {
     /// (counter-clockwise in the image) [default: found in the image, else from the ball's trajectory].
     #[arg(long, value_parser = parse_line, value_name = "Y[,TILT]", allow_negative_numbers = true)]
     pub line: Option<ContactLine>,
+    /// The surface's tilt in the image, degrees counter-clockwise as seen, for shots whose level no line
+    /// shows (a known camera roll) [default: session.toml / clip.toml `[surface] tilt_deg`, else the image's
+    /// axes, taken as level to within 2°].
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_tilt, value_name = "DEGREES")]
+    pub tilt: Option<f64>,
     /// Largest frame accepted, in pixels, checked from each file's header before decoding (a corrupt or
     /// hostile header is refused) [default: 67108864 = 8192×8192].
     #[arg(long, value_name = "PIXELS", value_parser = clap::value_parser!(u64).range(1..))]
@@ -79,6 +88,7 @@ impl Overrides {
         o.overrides.scale_m_per_px = self.scale;
         o.overrides.roi = self.roi;
         o.overrides.contact_line = self.line;
+        o.overrides.surface_tilt_deg = self.tilt;
         if let Some(max) = self.max_frame_pixels {
             o.max_frame_pixels = max;
         }

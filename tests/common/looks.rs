@@ -153,6 +153,7 @@ fn evaluate_clip(
         incline_deg: entry.angle_deg,
         gravity: 9.81,
         ball_diameter_m: session.ball.diameter_m,
+        surface_tilt_deg: None,
     };
     match estimate_with_frames(&track, &clip, &conditions) {
         Ok(e) => {

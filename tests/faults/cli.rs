@@ -41,7 +41,12 @@ fn nonsense_estimate_arguments_are_refused_naming_the_flag() {
         );
         assert!(ran.stdout.is_empty(), "{flag} {value}: nothing printed: {}", ran.stdout);
     }
-    for (flag, value) in [("--line", "nan"), ("--line", "10,90")] {
+    for (flag, value) in [
+        ("--line", "nan"),
+        ("--line", "10,90"),
+        ("--tilt", "60"),
+        ("--tilt", "nan"),
+    ] {
         expect(bouncelab().arg("track").arg(&clip).arg(flag).arg(value), 2, &[flag]);
     }
     // overlay checks its own two flags when it runs (exit 1, like its other input errors).

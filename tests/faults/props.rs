@@ -85,6 +85,7 @@ fn settings_text() -> impl Strategy<Value = String> {
         "downslope",
         "line_y_px",
         "line_tilt_deg",
+        "tilt_deg",
     ]);
     let table = prop::sample::select(vec!["[ball]", "[camera]", "[surface]", "[session]", "[ball", "x"]);
     let value = prop::sample::select(vec![

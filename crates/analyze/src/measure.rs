@@ -68,13 +68,14 @@ pub(crate) fn session_key(session: &Session) -> String {
 
 /// Raised whenever the tracker or the estimator changes what they record for a shot, so that shots
 /// measured by an earlier build are measured again (2: estimates carry the surface line's σ; 3: the contact
-/// line's source, the local frame along the measured tilt, the gravity check).
-const MEASUREMENT_REVISION: u32 = 3;
+/// line's source, the local frame along the measured tilt, the gravity check; 4: a rejected line lends no
+/// tilt, an unmeasured tilt is in the errors, the surface's tilt setting).
+const MEASUREMENT_REVISION: u32 = 4;
 
 /// Everything besides the frame files that changes a shot's track or estimate.
 fn settings_text(entry: &ClipEntry, gravity: f64) -> String {
     format!(
-        "bouncelab {} rev {MEASUREMENT_REVISION} | fps {} ({:?}) | downslope {:?} | diameter {} | scale {:?} | roi {:?} | line {:?} | angle {} | gravity {} | tracker {:?}",
+        "bouncelab {} rev {MEASUREMENT_REVISION} | fps {} ({:?}) | downslope {:?} | diameter {} | scale {:?} | roi {:?} | line {:?} | tilt {:?} | angle {} | gravity {} | tracker {:?}",
         env!("CARGO_PKG_VERSION"),
         entry.fps,
         entry.fps_source,
@@ -83,6 +84,7 @@ fn settings_text(entry: &ClipEntry, gravity: f64) -> String {
         entry.settings.scale_m_per_px,
         entry.settings.roi,
         entry.settings.contact_line,
+        entry.settings.surface_tilt_deg,
         entry.angle_deg,
         gravity,
         bouncelab_track::TrackOptions::default(),
@@ -271,6 +273,7 @@ fn measure_clip(entry: &ClipEntry, gravity: f64) -> Measured {
         incline_deg: entry.angle_deg,
         gravity,
         ball_diameter_m: settings.ball_diameter_m,
+        surface_tilt_deg: settings.surface_tilt_deg,
     };
     let estimate = estimate_with_frames(&track, &clip, &conditions);
     // The trajectory in the estimate's local frame (on the contact line it chose, along its tilt), else in

@@ -422,6 +422,29 @@ fn generated_by() -> String {
     format!("bouncelab {}", env!("CARGO_PKG_VERSION"))
 }
 
+/// When some shots were measured along the image's axes (no line of their own, no tilt given) while the
+/// lines found on the others show the surface tilted: which shots, and the setting that would take the tilt
+/// into their frames.
+fn unseen_tilt_note<'a>(
+    lines: impl Iterator<Item = (&'a str, Option<bouncelab_track::SurfaceLine>)>,
+    tilt: bouncelab_estimate::Measured,
+) -> Option<String> {
+    let unseen: Vec<&str> = lines
+        .filter(|(_, l)| l.is_some_and(|l| l.cue == bouncelab_track::LineCue::Trajectory && l.slope == 0.0))
+        .map(|(clip, _)| clip)
+        .collect();
+    (!unseen.is_empty() && tilt.value.abs() > 2.0 * tilt.se).then(|| {
+        format!(
+            "{} shot(s) ({}) had no surface line of their own and are measured along the image's axes, while the lines found on the others lie tilted by {:.2} ± {:.2}°: if the camera did not move between shots, set `[surface] tilt_deg = {:.2}` in session.toml (docs/session.md) to measure them along the surface",
+            unseen.len(),
+            unseen.join(", "),
+            tilt.value,
+            tilt.se,
+            tilt.value
+        )
+    })
+}
+
 /// Everything `report.html` shows about `a`.
 pub(crate) fn build(a: &Analysis, p: &Predictions, description: Option<&str>, warnings: &[String]) -> r::Report {
     let surfaces = surfaces_of(&a.shots);
@@ -438,6 +461,8 @@ pub(crate) fn build(a: &Analysis, p: &Predictions, description: Option<&str>, wa
             t.se,
             tilts.len()
         ));
+        let lines = a.shots.iter().map(|s| (s.clip.as_str(), s.estimate.contact_line));
+        notes.extend(unseen_tilt_note(lines, t));
     }
     r::Report {
         title: title(&a.session_dir),
@@ -1106,7 +1131,33 @@ fn key_frame_strip(entry: &bouncelab_frames::ClipEntry, shot: &ShotData) -> Resu
 mod tests {
     use super::*;
     use bouncelab_fit::MeasuredFrame;
+    use bouncelab_track::{LineCue, SurfaceLine};
     use serde::Serialize;
+
+    #[test]
+    fn shots_on_the_image_axes_are_named_when_the_lines_found_show_a_tilt() {
+        let found = SurfaceLine {
+            cue: LineCue::Brightness,
+            ..SurfaceLine::given(255.5, 400.0, -1.5)
+        };
+        let axes = SurfaceLine {
+            cue: LineCue::Trajectory,
+            ..SurfaceLine::given(255.5, 400.0, 0.0)
+        };
+        let told = SurfaceLine {
+            cue: LineCue::Trajectory,
+            ..SurfaceLine::given(255.5, 400.0, -1.5)
+        };
+        let shots = [("a", Some(found)), ("b", Some(axes)), ("c", Some(told)), ("d", None)];
+        let tilt = bouncelab_estimate::Measured { value: -1.5, se: 0.01 };
+        let note = unseen_tilt_note(shots.into_iter(), tilt).expect("a note");
+        assert!(note.starts_with("1 shot(s) (b)"), "{note}");
+        assert!(note.contains("tilt_deg = -1.50"), "{note}");
+        // A tilt the lines do not show clearly, or no shot on the image's axes: nothing to say.
+        let faint = bouncelab_estimate::Measured { value: -0.01, se: 0.01 };
+        assert!(unseen_tilt_note(shots.into_iter(), faint).is_none());
+        assert!(unseen_tilt_note(shots[..1].iter().copied(), tilt).is_none());
+    }
 
     /// Every key of `mirror` (a report type, serialised) carries the producer's value under the same key,
     /// or under the key `renamed` pairs it with; `derived` keys are filled from elsewhere. Catches a mapper

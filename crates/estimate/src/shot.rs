@@ -15,6 +15,9 @@ pub struct Conditions {
     pub gravity: f64,
     /// Ball diameter, m.
     pub ball_diameter_m: f64,
+    /// The surface's tilt in the image, degrees counter-clockwise as seen, where no line shows it (a known
+    /// camera roll, `[surface] tilt_deg`); `None`: the image's axes, taken as level to [`LEVEL_BY_EYE_DEG`].
+    pub surface_tilt_deg: Option<f64>,
 }
 
 impl Conditions {
@@ -39,6 +42,15 @@ impl Conditions {
                 "must be a positive number of metres",
             );
         }
+        if let Some(t) = self.surface_tilt_deg
+            && !(t.abs() < 45.0)
+        {
+            return bad(
+                "surface tilt",
+                t,
+                "a tilt in the image lies strictly between −45 and 45 degrees",
+            );
+        }
         Ok(())
     }
 }
@@ -49,6 +61,7 @@ impl Default for Conditions {
             incline_deg: 0.0,
             gravity: 9.81,
             ball_diameter_m: 0.067,
+            surface_tilt_deg: None,
         }
     }
 }
@@ -252,7 +265,13 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
     let s = scale.m_per_px;
     let measured = fitted_fixes(track)?;
     let beta = c.incline_deg.to_radians();
-    let choice = contact_line(track, &measured, scale.radius_px, -c.gravity * beta.cos() / s)?;
+    let choice = contact_line(
+        track,
+        &measured,
+        scale.radius_px,
+        -c.gravity * beta.cos() / s,
+        c.surface_tilt_deg,
+    )?;
     let line = choice.line;
     let (frame, points) = local_points(track, &measured, &line, &scale);
     let (first, last) = contact_run(&points, choice.no_impact)?;
@@ -270,6 +289,7 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
     let mut notes = choice.notes;
     let mut level = LevelErrors::of(&line, &scale, radius);
     if line.cue == LineCue::Trajectory
+        && c.surface_tilt_deg.is_none()
         && let Some(g) = &gravity
     {
         level.sigma_theta = unmeasured_tilt(g, &mut notes);
@@ -549,7 +569,7 @@ fn note_gravity(g: &GravityCheck, incline_deg: f64, flags: &mut Vec<String>, not
 }
 
 /// How level a camera set up by eye is, degrees: the tilt's standard error assumed for a frame on the image's
-/// axes when the flights cannot bound it more tightly (`--line Y,TILT` replaces the assumption).
+/// axes when the flights cannot bound it more tightly (`[surface] tilt_deg` or `--tilt` replaces the assumption).
 pub const LEVEL_BY_EYE_DEG: f64 = 2.0;
 
 /// The standard error of a frame whose tilt nothing in the image measured (the image's own axes), rad. The
@@ -562,7 +582,7 @@ fn unmeasured_tilt(g: &GravityCheck, notes: &mut Vec<String>) -> f64 {
     let bound = off.value.hypot(off.se);
     if off.value.abs() > 3.0 * off.se {
         notes.push(format!(
-            "the flights fall {:.1} ± {:.1}° away from gravity's direction in the image's axes: the camera looks rolled; give the contact line with its tilt (--line Y,TILT) to take the roll out",
+            "the flights fall {:.1} ± {:.1}° away from gravity's direction in the image's axes: the camera looks rolled; give the surface's tilt ([surface] tilt_deg or --tilt) to take the roll out",
             off.value.abs().to_degrees(),
             off.se.to_degrees()
         ));
@@ -670,10 +690,16 @@ fn contact_line(
     measured: &[&bouncelab_track::BallFix],
     radius_px: f64,
     a_px: f64,
+    surface_tilt_deg: Option<f64>,
 ) -> Result<ContactChoice, EstimateError> {
     let given = track.surface.filter(|l| l.cue == LineCue::Given);
     let found = track.surface.filter(|l| l.cue != LineCue::Given);
-    let view = TrajectoryView::new(track, measured, radius_px, a_px);
+    let unseen = image_axis(measured, surface_tilt_deg);
+    let unseen_text = match surface_tilt_deg {
+        Some(t) => format!("the surface's tilt given ({t}°) is taken"),
+        None => "the camera's roll is not measured, image axes are taken as the surface's".to_string(),
+    };
+    let view = TrajectoryView::along(track.surface.unwrap_or(unseen), track, measured, radius_px, a_px);
     let no_impact = match &view.trajectory {
         Err(EstimateError::NoImpact {
             frames,
@@ -711,15 +737,15 @@ fn contact_line(
                 return Ok(choice);
             }
             // A line that is not where the ball lands is no evidence of the surface's direction either: the
-            // level is taken along the image's axes, as when no line is found.
-            let across = TrajectoryView::along(image_axis(measured), track, measured, radius_px, a_px);
+            // level is taken as when no line is found.
+            let across = TrajectoryView::along(unseen, track, measured, radius_px, a_px);
             Ok(match &across.trajectory {
                 Ok(tc) => ContactChoice {
                     line: across.level_line(tc),
                     trajectory_level_px: Some(Measured::new(0.0, tc.level_se_px)),
                     notes: [
                         choice.notes,
-                        vec!["the rejected line's tilt is not used: image axes are taken as the surface's".into()],
+                        vec![format!("the rejected line's tilt is not used: {unseen_text}")],
                     ]
                     .concat(),
                     ..choice
@@ -735,7 +761,7 @@ fn contact_line(
         }),
         (None, Ok(tc)) => {
             notes.push(format!(
-                "no surface line found: the contact level comes from the ball's trajectory (± {:.2} px); the camera's roll is not measured, image axes are taken as the surface's",
+                "no surface line found: the contact level comes from the ball's trajectory (± {:.2} px); {unseen_text}",
                 tc.level_se_px
             ));
             notes.extend(tc.notes.iter().cloned());
@@ -762,11 +788,6 @@ struct TrajectoryView {
 }
 
 impl TrajectoryView {
-    fn new(track: &Track, measured: &[&bouncelab_track::BallFix], radius_px: f64, a_px: f64) -> Self {
-        let axis = track.surface.unwrap_or_else(|| image_axis(measured));
-        Self::along(axis, track, measured, radius_px, a_px)
-    }
-
     /// The trajectory seen along `axis`.
     fn along(
         axis: SurfaceLine,
@@ -896,10 +917,10 @@ impl TrajectoryView {
     }
 }
 
-/// The image's own axes as a line (through the middle column the fixes suggest): the surface's direction
-/// when nothing in the image shows it.
-fn image_axis(measured: &[&bouncelab_track::BallFix]) -> SurfaceLine {
-    SurfaceLine::given((track_width(measured) - 1.0) / 2.0, 0.0, 0.0)
+/// The surface's direction when nothing in the image shows it: a line through the middle column the fixes
+/// suggest, at the tilt given, else along the image's own axes.
+fn image_axis(measured: &[&bouncelab_track::BallFix], tilt_deg: Option<f64>) -> SurfaceLine {
+    SurfaceLine::given((track_width(measured) - 1.0) / 2.0, 0.0, tilt_deg.unwrap_or(0.0))
 }
 
 /// The image width the fixes suggest (for a reference column when no line is known), px.

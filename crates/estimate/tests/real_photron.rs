@@ -42,6 +42,7 @@ fn a_real_free_fall_is_tracked_in_every_frame_and_has_no_impact() {
         incline_deg: 0.0,
         gravity: 9.81,
         ball_diameter_m: 0.0025,
+        surface_tilt_deg: None,
     };
     match estimate_with_frames(&track, &clip, &conditions) {
         Err(EstimateError::NoImpact {
@@ -82,6 +83,7 @@ fn conditions_no_impact_can_have_are_refused_by_name() {
         (
             Conditions {
                 ball_diameter_m: 1e300 * 1e300,
+                surface_tilt_deg: None,
                 ..ok
             },
             "ball diameter",

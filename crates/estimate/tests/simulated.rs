@@ -83,6 +83,7 @@ fn conditions(incline_deg: f64) -> Conditions {
         incline_deg,
         gravity: 9.81,
         ball_diameter_m: 2.0 * Ball::TENNIS.radius_m,
+        surface_tilt_deg: None,
     }
 }
 
@@ -309,7 +310,7 @@ fn a_rejected_line_lends_the_frame_no_tilt() {
 
 /// A camera rolled by 2° with no line to show it: the frame stays on the image's axes, so a normal impact
 /// gains an apparent μ of about tan 2°. Its standard error must say so (the flights' fall is the only
-/// evidence of the tilt) instead of claiming a few thousandths.
+/// evidence of the tilt) instead of claiming a few thousandths; told the tilt, the frame takes it.
 #[test]
 fn an_unmeasured_tilt_is_in_the_errors() {
     let model = Model::paper(25_650.0, 14.0, 0.5);
@@ -333,6 +334,19 @@ fn an_unmeasured_tilt_is_in_the_errors() {
             covered += 1;
         }
         assert!(e.mu.se < 0.5, "μ ± {}", e.mu.se);
+        // Told the surface's tilt (the roll turns the surface by −2° as seen), the frame takes it.
+        let told = Conditions {
+            surface_tilt_deg: Some(-2.0),
+            ..conditions(0.0)
+        };
+        let e = estimate(&track, &told).unwrap();
+        assert!(
+            (e.mu.value - truth.effective_friction).abs() < 0.005 && e.mu.se < 0.005,
+            "μ {:?} vs {}",
+            e.mu,
+            truth.effective_friction
+        );
+        assert!(e.notes.iter().any(|n| n.contains("tilt given (-2°)")), "{:?}", e.notes);
     }
     assert!(
         covered >= 5,

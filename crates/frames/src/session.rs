@@ -123,7 +123,7 @@ impl Session {
     /// Loads a session folder (`docs/session.md`).
     ///
     /// `session.toml` needs `[ball] diameter_m` and `mass_kg` (positive numbers); `[camera] fps`,
-    /// `downslope`, `scale_m_per_px`, `roi` and `[surface] line_y_px`, `line_tilt_deg` are optional;
+    /// `downslope`, `scale_m_per_px`, `roi` and `[surface] line_y_px`, `line_tilt_deg`, `tilt_deg` are optional;
     /// anything else is kept in [`Session::metadata`]. `clips.csv` needs the columns
     /// `clip, surface, angle_deg, drop_height_m` in any order; cells are trimmed; other columns are kept per
     /// row. Lines starting with `#` are comments. Rows whose `surface`, `angle_deg` or `drop_height_m` cell

@@ -177,6 +177,8 @@ pub struct SettingOverrides {
     pub roi: Option<Roi>,
     /// Contact line, in pixels and degrees.
     pub contact_line: Option<ContactLine>,
+    /// The surface's tilt in the image where no line shows it, in degrees.
+    pub surface_tilt_deg: Option<f64>,
 }
 
 /// A clip's resolved geometry settings, each with where it came from (`docs/session.md`).
@@ -203,6 +205,11 @@ pub struct ClipSettings {
     pub contact_line: Option<ContactLine>,
     /// Where the contact line came from, when given.
     pub contact_line_source: Option<SettingSource>,
+    /// The surface's tilt in the image, degrees counter-clockwise as seen (`[surface] tilt_deg`), for the
+    /// shots whose level no line shows (the trajectory's); `None`: the image's axes, taken as level by eye.
+    pub surface_tilt_deg: Option<f64>,
+    /// Where that tilt came from, when given.
+    pub surface_tilt_source: Option<SettingSource>,
 }
 
 impl Default for ClipSettings {
@@ -216,6 +223,8 @@ impl Default for ClipSettings {
             roi_source: None,
             contact_line: None,
             contact_line_source: None,
+            surface_tilt_deg: None,
+            surface_tilt_source: None,
         }
     }
 }
@@ -260,6 +269,7 @@ pub(crate) struct CameraKeys {
     pub diameter_m: Option<f64>,
     pub roi: Option<Roi>,
     pub contact_line: Option<ContactLine>,
+    pub surface_tilt_deg: Option<f64>,
 }
 
 /// Reads and parses a TOML file into a table.
@@ -422,6 +432,16 @@ pub(crate) fn camera_keys(path: &Path, doc: &toml::Table) -> Result<CameraKeys> 
         )?);
     }
     if let Some(surface) = table(path, doc, "surface")? {
+        if let Some(v) = surface.get("tilt_deg") {
+            let field = "[surface] tilt_deg";
+            keys.surface_tilt_deg = Some(check_range(
+                number(path, field, v)?,
+                (-MAX_LINE_TILT_DEG, MAX_LINE_TILT_DEG),
+                "degrees",
+                path,
+                field,
+            )?);
+        }
         let y = surface
             .get("line_y_px")
             .map(|v| number(path, "[surface] line_y_px", v))
@@ -436,7 +456,7 @@ pub(crate) fn camera_keys(path: &Path, doc: &toml::Table) -> Result<CameraKeys> 
                 return Err(FramesError::BadValue {
                     path: path.into(),
                     field: "[surface] line_tilt_deg".into(),
-                    problem: "given without [surface] line_y_px (the line's y at the image's centre column)".into(),
+                    problem: "given without [surface] line_y_px (the line's y at the image's centre column); for a tilt alone, with the level left to the image or the trajectory, use [surface] tilt_deg".into(),
                 });
             }
             (Some(y), tilt) => {
@@ -550,6 +570,7 @@ pub(crate) fn choose_settings(
     let diameter = pick(overrides.ball_diameter_m, own, session, |k| k.diameter_m);
     let roi = pick(overrides.roi, own, session, |k| k.roi);
     let line = pick(overrides.contact_line, own, session, |k| k.contact_line);
+    let tilt = pick(overrides.surface_tilt_deg, own, session, |k| k.surface_tilt_deg);
     let (ball_diameter_m, ball_diameter_source) = diameter.unwrap_or_else(|| {
         warnings.push(Warning::DefaultDiameter {
             clip: clip.into(),
@@ -566,6 +587,7 @@ pub(crate) fn choose_settings(
     let (scale_m_per_px, scale_source) = split(scale);
     let (roi, roi_source) = split(roi);
     let (contact_line, contact_line_source) = split(line);
+    let (surface_tilt_deg, surface_tilt_source) = split(tilt);
     ClipSettings {
         scale_m_per_px,
         scale_source,
@@ -575,6 +597,8 @@ pub(crate) fn choose_settings(
         roi_source,
         contact_line,
         contact_line_source,
+        surface_tilt_deg,
+        surface_tilt_source,
     }
 }
 
@@ -596,6 +620,9 @@ pub(crate) fn check_overrides(o: &SettingOverrides) -> Result<()> {
             cl,
             "--line-tilt",
         )?;
+    }
+    if let Some(t) = o.surface_tilt_deg {
+        check_range(t, (-MAX_LINE_TILT_DEG, MAX_LINE_TILT_DEG), "degrees", cl, "--tilt")?;
     }
     if let Some(r) = o.roi
         && (r.width == 0 || r.height == 0)

@@ -221,7 +221,7 @@ fn an_impossible_angle_or_height_in_clips_csv_is_named() {
 mod common;
 
 use bouncelab_frames::init::{InitOptions, scan};
-use bouncelab_frames::{ContactLine, Roi, SettingSource};
+use bouncelab_frames::{ClipOptions, ContactLine, Roi, SettingSource};
 use common::camera::{Cine, CinePacking, Mraw, TiffCompression, moving_disc, write_tiff_stack};
 
 const BALL: &str = "[ball]\ndiameter_m = 0.067\nmass_kg = 0.0567\n";
@@ -313,7 +313,8 @@ fn settings_keys_resolve_clip_over_session_with_their_sources() {
             tilt_deg: 0.0
         })
     );
-    assert_eq!(b.contact_line_source, Some(clip_src));
+    assert_eq!(b.contact_line_source, Some(clip_src.clone()));
+    assert_eq!((a.surface_tilt_deg, b.surface_tilt_deg), (None, None));
     let clip = s.clips[1].open().unwrap();
     assert_eq!(clip.settings().ball_diameter_m, 0.04);
 
@@ -327,6 +328,45 @@ fn settings_keys_resolve_clip_over_session_with_their_sources() {
     let err = s.clips[1].open().unwrap_err();
     assert!(matches!(err, FramesError::LineOutsideImage { .. }), "{err:?}");
     assert_names(&err, &["shot_02", "y = 24", "0 ≤ y ≤ 23"]);
+}
+
+/// The surface's tilt alone (a known camera roll for shots whose level no line shows): clip over session,
+/// the command line over both, each with its source.
+#[test]
+fn the_surface_tilt_resolves_clip_over_session_and_the_command_line_over_both() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    write_session(
+        d,
+        &format!("{BALL}[surface]\ntilt_deg = -1.5\n"),
+        CSV,
+        &["shot_01", "shot_02"],
+    );
+    std::fs::write(d.join("shot_02/clip.toml"), "[surface]\ntilt_deg = 0.75\n").unwrap();
+    let s = Session::load(d).unwrap();
+    let (a, b) = (&s.clips[0].settings, &s.clips[1].settings);
+    assert_eq!(
+        (a.surface_tilt_deg, &a.surface_tilt_source),
+        (Some(-1.5), &Some(SettingSource::SessionToml(d.join("session.toml"))))
+    );
+    assert_eq!(
+        (b.surface_tilt_deg, &b.surface_tilt_source),
+        (Some(0.75), &Some(SettingSource::ClipToml(d.join("shot_02/clip.toml"))))
+    );
+    // The tilt alone leaves the line to the image: no contact line is given.
+    assert_eq!((a.contact_line, b.contact_line), (None, None));
+    let mut opts = ClipOptions::default();
+    opts.overrides.surface_tilt_deg = Some(2.0);
+    let s = Session::load_with(d, &opts).unwrap();
+    for c in &s.clips {
+        assert_eq!(
+            (c.settings.surface_tilt_deg, &c.settings.surface_tilt_source),
+            (Some(2.0), &Some(SettingSource::CommandLine))
+        );
+    }
+    opts.overrides.surface_tilt_deg = Some(60.0);
+    let err = Session::load_with(d, &opts).unwrap_err();
+    assert_names(&err, &["--tilt", "4.5e1"]);
 }
 
 #[test]
@@ -345,6 +385,12 @@ fn settings_values_out_of_range_name_the_file_key_and_range() {
         ),
         ("[surface]\nline_tilt_deg = 2\n", "[surface] line_tilt_deg", "without"),
         ("[surface]\nline_y_px = -3\n", "[surface] line_y_px", "≥ 0"),
+        ("[surface]\ntilt_deg = -50\n", "[surface] tilt_deg", "4.5e1"),
+        (
+            "[surface]\ntilt_deg = \"level\"\n",
+            "[surface] tilt_deg",
+            "not a number",
+        ),
         (
             "[surface]\nline_y_px = \"top\"\n",
             "[surface] line_y_px",
