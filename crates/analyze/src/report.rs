@@ -435,7 +435,7 @@ fn unseen_tilt_note<'a>(
         .collect();
     (!unseen.is_empty() && tilt.value.abs() > 2.0 * tilt.se).then(|| {
         format!(
-            "{} shot(s) ({}) had no surface line of their own and are measured along the image's axes, while the lines found on the others lie tilted by {:.2} ± {:.2}°: if the camera did not move between shots, set `[surface] tilt_deg = {:.2}` in session.toml (docs/session.md) to measure them along the surface",
+            "{} shot(s) ({}) had no surface line of their own and are measured along the image's axes, while the lines found on the others lie tilted by {:.3} ± {:.3}°: if the camera did not move between shots, set `[surface] tilt_deg = {:.2}` in session.toml (docs/session.md) to measure them along the surface",
             unseen.len(),
             unseen.join(", "),
             tilt.value,
