@@ -43,7 +43,7 @@ impl Conditions {
             );
         }
         if let Some(t) = self.surface_tilt_deg
-            && !(t.abs() < 45.0)
+            && (t.is_nan() || t.abs() >= 45.0)
         {
             return bad(
                 "surface tilt",
