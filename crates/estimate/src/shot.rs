@@ -43,13 +43,9 @@ impl Conditions {
             );
         }
         if let Some(t) = self.surface_tilt_deg
-            && (t.is_nan() || t.abs() >= 45.0)
+            && (t.is_nan() || t.abs() > 45.0)
         {
-            return bad(
-                "surface tilt",
-                t,
-                "a tilt in the image lies strictly between −45 and 45 degrees",
-            );
+            return bad("surface tilt", t, "a tilt in the image lies between −45 and 45 degrees");
         }
         Ok(())
     }
