@@ -570,7 +570,7 @@ pub const LEVEL_BY_EYE_DEG: f64 = 2.0;
 
 /// The standard error of a frame whose tilt nothing in the image measured (the image's own axes), rad. The
 /// flights' fall direction is the only evidence of it: the frame is known to within the angle between that
-/// direction and gravity's on the incline, with that angle's own error. Short flights bound it loosely (3–60°
+/// direction and gravity's on the incline, with that angle's own error. Short flights bound it loosely (3–64°
 /// on the looks sweep), so the camera is taken as level by eye ([`LEVEL_BY_EYE_DEG`]) unless the fall shows
 /// a clear turn, which then sets the error and gets a note.
 fn unmeasured_tilt(g: &GravityCheck, notes: &mut Vec<String>) -> f64 {

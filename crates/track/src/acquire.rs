@@ -5,8 +5,8 @@
 //! circles are voted for on that difference, so clay grains, rulers, screws, fixtures and a second ball at rest
 //! cast no votes, then measured on the frame itself. A circle counts as the ball when it moved between two
 //! frames 1 ms apart (ten at 10,000 fps, see `SIGHTING_GAP_S`), is found again half-way between where its
-//! path puts it, and is not one of the circles that stayed put. When the difference holds no such circle (a ball too large or slow for the median to
-//! forget it), the frames themselves are searched the same way. Clean circles centred beyond the frame's
+//! path puts it, and is not one of the circles that stayed put. When the difference holds no such circle (a
+//! ball too large or slow for the median to forget it), the frames themselves are searched the same way. Clean circles centred beyond the frame's
 //! edges (a ball mostly out of view) are looked for after clean ones inside it and before doubtful ones, so
 //! that a seam's lobe on the visible cap of a ball whose centre is out of view is not taken for the ball.
 
