@@ -17,6 +17,10 @@ use bouncelab_render::{RenderOptions, Scenario, render_with};
 use bouncelab_store::ClipFingerprint;
 use std::path::{Path, PathBuf};
 
+#[path = "../../../tests/common/verdicts.rs"]
+mod verdicts;
+use verdicts::{fit_of, magnitude, measured_roll, print_candidates, scenario_truth};
+
 /// Renders `scenario` into `root/render` and returns the session folder.
 fn render(scenario: &Scenario, root: &Path) -> PathBuf {
     let out = render_with(
@@ -95,7 +99,7 @@ fn hidden_in(effect: &str, scenario: &Scenario) -> (f64, Option<[f64; 2]>, f64) 
         .unwrap_or_default();
     let c = d.candidate(effect).expect("the hidden effect was tried");
     let e = c.evidence.as_ref().expect("its fit ran");
-    let m = magnitude(scenario, effect, &e.fit.parameters);
+    let m = magnitude(scenario, effect, &e.fit.parameters).expect("the effect's parameter fitted");
     eprintln!(
         "{effect}: systematic part removed {:.1} %",
         e.explained_fraction * 100.0
@@ -158,67 +162,6 @@ fn hidden_in(effect: &str, scenario: &Scenario) -> (f64, Option<[f64; 2]>, f64) 
     (m.value, m.interval, m.truth)
 }
 
-/// Prints every search's candidates (this one's, then the search that went on from it): the evidence a
-/// failure is read from.
-fn print_candidates(d: &bouncelab_diagnose::Diagnosis) {
-    let mut level = Some(d);
-    let mut depth = 0;
-    while let Some(d) = level {
-        eprintln!(
-            "  search {}: {} (current model {:?}; systematic {:.1} µm, floor {:.1} µm, noise {:.1} µm, {:.1} s)",
-            depth + 1,
-            d.verdict.kind.name(),
-            d.baseline.fit.effects,
-            d.baseline.systematic_m * 1e6,
-            d.floor.floor_m * 1e6,
-            d.noise.noise_m * 1e6,
-            d.seconds
-        );
-        for ph in d.signature.phases.iter().take(3) {
-            eprintln!(
-                "    residual: {} {}: systematic {:.1} µm, {:.0} % of χ²",
-                ph.component.name(),
-                ph.phase.words(),
-                ph.systematic_m * 1e6,
-                ph.chi2_share * 100.0
-            );
-        }
-        for c in d.candidates.iter().take(5) {
-            match &c.evidence {
-                Some(e) => eprintln!(
-                    "    {}. {} = {:.4e}: held-out {:.1} → {:.1} µm, {:.0} % removed, ΔBIC {:.0}, explains {} (part {}); {}",
-                    c.rank,
-                    c.effect,
-                    e.param_value,
-                    c.heldout_error_before * 1e6,
-                    e.heldout_error_after * 1e6,
-                    e.explained_fraction * 100.0,
-                    e.delta_bic,
-                    c.explains,
-                    c.partly_explains,
-                    c.reasons.join("; ")
-                ),
-                None => eprintln!("    {}. {}: {}", c.rank, c.effect, c.reasons.join("; ")),
-            }
-        }
-        level = d.then.as_deref();
-        depth += 1;
-    }
-}
-
-/// The hidden value of `effect`'s parameter `param` in the scenario's model (its `[extra_effects]` table).
-fn scenario_truth(scenario: &Scenario, effect: &str, param: &str) -> f64 {
-    let spec = scenario
-        .model_spec(&[effect.to_string()])
-        .expect("the scenario's model");
-    spec.settings(None)
-        .expect("the scenario's model has values")
-        .iter()
-        .find(|(r, _)| r.effect == effect && r.param == param)
-        .map(|(_, s)| s.value)
-        .unwrap_or(f64::NAN)
-}
-
 #[test]
 #[ignore]
 fn hidden_hertz_is_named() {
@@ -275,23 +218,9 @@ fn hidden_camera_roll_is_measured_and_taken_out() {
     let dir = tempfile::tempdir().unwrap();
     let session = render(&scenario, dir.path());
     let a = run(&session, dir.path(), None);
-    let tilts: Vec<(f64, f64)> = a
-        .shots
-        .iter()
-        .filter_map(|s| s.estimate.surface_tilt_deg.map(|m| (m.value, m.se)))
-        .collect();
-    assert_eq!(tilts.len(), a.shots.len(), "every shot's line seen: {tilts:?}");
-    let n = tilts.len() as f64;
-    let mean = tilts.iter().map(|t| t.0).sum::<f64>() / n;
-    // The mean's error: the larger of the stated errors' and the scatter's.
-    let stated = (tilts.iter().map(|t| t.1 * t.1).sum::<f64>()).sqrt() / n;
-    let scatter = (tilts.iter().map(|t| (t.0 - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt() / n.sqrt();
-    let se = stated.max(scatter);
-    let measured_roll = -mean;
-    eprintln!(
-        "camera_roll: measured roll {measured_roll:.4}° ± {se:.4}° (stated {stated:.4}, scatter {scatter:.4}) over {} shots, hidden {roll}°",
-        tilts.len()
-    );
+    let (measured_roll, se, lines) = measured_roll(&a).expect("the lines measured a tilt");
+    assert_eq!(lines, a.shots.len(), "every shot's line seen");
+    eprintln!("camera_roll: measured roll {measured_roll:.4}° ± {se:.4}° over {lines} shots, hidden {roll}°");
     assert!(
         (measured_roll - roll).abs() <= 3.0 * se,
         "measured roll {measured_roll} ± {se} vs hidden {roll}"
@@ -422,16 +351,9 @@ fn pair(a: &str, b: &str) {
     want.sort();
     assert_eq!(named, want, "{}", d.verdict.sentence);
     // The last search's named candidate carries every parameter, both effects' refitted together.
-    let last = d.then.as_deref().unwrap_or(d);
-    let c = last
-        .candidate(last.verdict.effect.as_deref().expect("a named effect"))
-        .unwrap();
-    let fit = &c.evidence.as_ref().expect("its fit").fit;
-    for p in &fit.parameters {
-        eprintln!("  {} = {:.6e} {:?}", p.name, p.value, p.interval);
-    }
     for effect in [a, b] {
-        let m = magnitude(&scenario, effect, &fit.parameters);
+        let fitted = fit_of(d, effect).unwrap_or_else(|| panic!("{effect} not fitted"));
+        let m = magnitude(&scenario, effect, fitted).unwrap_or_else(|| panic!("{effect} not fitted: {fitted:?}"));
         eprintln!(
             "| pair-{a}+{b} | {} | {} = {:.4e} ({:+.1} % of {:e}) | {} | {:.1} s |",
             d.verdict.kind.name(),
@@ -443,74 +365,6 @@ fn pair(a: &str, b: &str) {
             d.seconds
         );
         assert!(m.error().abs() <= 0.1, "{} = {} vs {}", m.label, m.value, m.truth);
-    }
-}
-
-/// An effect's magnitude as fitted, against the scenario's truth.
-struct Magnitude {
-    label: String,
-    value: f64,
-    truth: f64,
-    interval: Option<[f64; 2]>,
-}
-
-impl Magnitude {
-    fn error(&self) -> f64 {
-        (self.value - self.truth) / self.truth
-    }
-
-    fn covers_text(&self) -> &'static str {
-        match self.interval {
-            Some([lo, hi]) if lo <= self.truth && self.truth <= hi => "yes",
-            Some(_) => "no",
-            None => "no interval",
-        }
-    }
-}
-
-/// `effect`'s magnitude in `fitted` (a search's fit): its first parameter, except for Hunt–Crossley, whose
-/// magnitude is the damping force per unit speed λ·δⁿ at δ = 2 mm (so a search that frees n is judged by
-/// the force, not by a λ that trades with n along a valley).
-fn magnitude(scenario: &Scenario, effect: &str, fitted: &[bouncelab_diagnose::FittedValue]) -> Magnitude {
-    let find = |param: &str| {
-        fitted
-            .iter()
-            .find(|p| p.effect == effect && p.param == param)
-            .unwrap_or_else(|| panic!("{effect}.{param} not fitted: {fitted:?}"))
-    };
-    let info = bouncelab_model::builtin(effect).unwrap();
-    let param = info.params[0].name;
-    let p = find(param);
-    let truth = scenario_truth(scenario, effect, param);
-    if effect != "hunt_crossley" {
-        return Magnitude {
-            label: format!("{effect}.{param}"),
-            value: p.value,
-            truth,
-            interval: p.interval,
-        };
-    }
-    // n is held at its default (the linear spring's exponent) unless the search freed it; held, λ's
-    // interval gives the force's.
-    let n_free = fitted.iter().find(|p| p.effect == effect && p.param == "n");
-    let n_fit = n_free
-        .map(|p| p.value)
-        .unwrap_or_else(|| info.params[1].default.expect("n has a default"));
-    let n_true = scenario_truth(scenario, effect, "n");
-    let force = |lambda: f64, n: f64| lambda * 0.002f64.powf(n);
-    eprintln!(
-        "hunt_crossley: λ = {:.4e}, n = {n_fit:.3} (truth λ = {truth}, n = {n_true})",
-        p.value
-    );
-    Magnitude {
-        label: "hunt_crossley λ·δⁿ at δ = 2 mm (N·s/m)".into(),
-        value: force(p.value, n_fit),
-        truth: force(truth, n_true),
-        interval: if n_free.is_none() {
-            p.interval.map(|[lo, hi]| [force(lo, n_fit), force(hi, n_fit)])
-        } else {
-            None
-        },
     }
 }
 
@@ -542,12 +396,7 @@ fn hidden_pair_inertia_and_camera_roll_inertia_named_roll_measured() {
     let e = c.evidence.as_ref().unwrap();
     let truth = scenario_truth(&scenario, "inertia_factor", "dc");
     let roll = scenario_truth(&scenario, "camera_roll", "roll_deg");
-    let tilts: Vec<f64> = a
-        .shots
-        .iter()
-        .filter_map(|s| s.estimate.surface_tilt_deg.map(|m| m.value))
-        .collect();
-    let measured_roll = -tilts.iter().sum::<f64>() / tilts.len() as f64;
+    let (measured_roll, ..) = measured_roll(&a).expect("the lines measured a tilt");
     eprintln!(
         "| pair-inertia_factor+camera_roll | {} | dc = {:.4} ({:+.1} % of {truth}); roll {measured_roll:.3}° measured from the line (hidden {roll}°) | {} | {:.1} s |",
         d.verdict.kind.name(),

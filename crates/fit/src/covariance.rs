@@ -4,7 +4,7 @@
 
 use crate::Problem;
 use crate::solver::SolverOutcome;
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector};
 use statrs::distribution::{ContinuousCDF, StudentsT};
 
 /// The covariance of a solver outcome's parameters and what goes with it.
@@ -15,7 +15,9 @@ pub struct Covariance {
     pub dof: usize,
     /// Factor applied to `(JᵀJ)⁻¹`: max(1, the minimised objective over `dof`).
     pub scale: f64,
-    /// Student t quantile of the intervals at the requested confidence, ν degrees of freedom.
+    /// Student t quantile of the intervals at the requested confidence: on S − 1 degrees of freedom for S
+    /// shots when the cluster-robust variance is available (the shots are the independent units), else on
+    /// ν.
     pub t_quantile: f64,
     /// The covariance, in the parameters' units squared; rows and columns of a parameter that is not
     /// determined are NaN. `None` without a Jacobian or when no parameter is determined.
@@ -52,16 +54,23 @@ pub fn covariance(problem: &Problem, out: &SolverOutcome, confidence: f64) -> Co
     // Scaled by the objective the solver minimised (with surface levels, the frames' χ² plus each level's
     // prior term).
     let scale = (out.cost / dof as f64).max(1.0);
-    let t_quantile = StudentsT::new(0.0, 1.0, dof as f64)
-        .map(|t| t.inverse_cdf(0.5 + confidence / 2.0))
-        .unwrap_or(f64::NAN);
     let (inverse, not_identified) = match out.jacobian.as_ref() {
         Some(jac) => identified_inverse(jac),
         None => (None, vec![None; p]),
     };
+    let robust = inverse.as_ref().and_then(|c| cluster_robust(c, out, problem));
+    // The shots are the independent units: with the cluster-robust variance the interval takes Student's t
+    // on S − 1 degrees of freedom (S shots), not on the frames' n − p.
+    let t_dof = match robust {
+        Some(_) => problem.shots().len().saturating_sub(1).max(1),
+        None => dof,
+    };
+    let t_quantile = StudentsT::new(0.0, 1.0, t_dof as f64)
+        .map(|t| t.inverse_cdf(0.5 + confidence / 2.0))
+        .unwrap_or(f64::NAN);
     let matrix = inverse.map(|c| {
         let classical = &c * scale;
-        match cluster_robust(&c, out, problem) {
+        match robust {
             // The larger of the two variances is kept.
             Some(robust) => DMatrix::from_fn(c.nrows(), c.ncols(), |i, j| {
                 let k = (robust[(i, i)] / classical[(i, i)]).max(1.0).sqrt()
@@ -161,41 +170,79 @@ pub fn normal_inverse(jac: &DMatrix<f64>) -> Option<DMatrix<f64>> {
     }))
 }
 
-/// The cluster-robust (sandwich) covariance with each shot a cluster: `(JᵀJ)⁻¹ (Σ_s J_sᵀ r_s r_sᵀ J_s) (JᵀJ)⁻¹`,
-/// times `S/(S − p)` for S shots; `None` with fewer than p + 2 shots, where it is not worth having.
-/// The rows and columns of parameters that are not determined (NaN in `inv`) stay NaN.
+/// The cluster-robust covariance with each shot a cluster, by the cluster jackknife (CR3): `(S − 1)/S ·
+/// Σ_s δ_s δ_sᵀ` for S shots, `δ_s = (JᵀJ − J_sᵀJ_s)⁻¹ J_sᵀ r_s` the parameters' move when shot s is left
+/// out (one Gauss–Newton step from the fit). With a dozen shots each one's leverage on the parameters is
+/// large, and the plain sandwich `(JᵀJ)⁻¹ (Σ_s J_sᵀ r_s r_sᵀ J_s) (JᵀJ)⁻¹` (CR1) sees every shot's residual
+/// after the fit has already bent towards that shot, so it understates the variance; the jackknife does
+/// not (Bell and McCaffrey 2002; MacKinnon, Nielsen and Webb 2023; figures in `docs/fit.md`).
+/// Falls back to CR1 (times `S/(S − p)`) when leaving some shot out leaves a parameter undetermined (that
+/// shot alone determines it). `None` with fewer than p + 2 shots, where neither is worth having. The rows
+/// and columns of parameters that are not determined (NaN in `inv`) stay NaN.
 fn cluster_robust(inv: &DMatrix<f64>, out: &SolverOutcome, problem: &Problem) -> Option<DMatrix<f64>> {
     let jac = out.jacobian.as_ref()?;
-    let determined = (0..inv.nrows()).filter(|&j| inv[(j, j)].is_finite()).count();
     let p = inv.nrows();
+    let keep: Vec<usize> = (0..p).filter(|&j| inv[(j, j)].is_finite()).collect();
     let shots = problem.shots();
-    if shots.len() < determined + 2 || jac.nrows() != out.residuals.len() {
+    if shots.len() < keep.len() + 2 || jac.nrows() != out.residuals.len() {
         return None;
     }
-    let nan_rows: Vec<bool> = (0..p).map(|j| !inv[(j, j)].is_finite()).collect();
-    let inv = inv.map(|v| if v.is_finite() { v } else { 0.0 });
-    let mut meat = DMatrix::<f64>::zeros(p, p);
-    let mut row = 0;
-    for shot in shots {
-        let n = 2 * shot.frames.len();
-        let mut score = nalgebra::DVector::<f64>::zeros(p);
-        for k in row..row + n {
-            for j in 0..p {
-                score[j] += jac[(k, j)] * out.residuals[k];
-            }
+    let q = keep.len();
+    let kept = DMatrix::from_fn(jac.nrows(), q, |k, c| jac[(k, keep[c])]);
+    let rows: Vec<usize> = shots.iter().map(|shot| 2 * shot.frames.len()).collect();
+    let reduced = cluster_jackknife(&kept, &out.residuals, &rows).unwrap_or_else(|| {
+        let inv_kept = DMatrix::from_fn(q, q, |i, j| inv[(keep[i], keep[j])]);
+        let s = shots.len() as f64;
+        let meat = cluster_scores(&kept, &out.residuals, &rows)
+            .iter()
+            .fold(DMatrix::zeros(q, q), |m, (score, _)| m + score * score.transpose());
+        &inv_kept * meat * &inv_kept * (s / (s - q as f64))
+    });
+    let mut full = DMatrix::from_element(p, p, f64::NAN);
+    for (x, &i) in keep.iter().enumerate() {
+        for (y, &j) in keep.iter().enumerate() {
+            full[(i, j)] = reduced[(x, y)];
         }
-        meat += &score * score.transpose();
-        row += n;
     }
-    let s = shots.len() as f64;
-    let robust = &inv * meat * &inv * (s / (s - determined as f64));
-    Some(DMatrix::from_fn(p, p, |i, j| {
-        if nan_rows[i] || nan_rows[j] {
-            f64::NAN
-        } else {
-            robust[(i, j)]
+    Some(full)
+}
+
+/// Per cluster (`rows[s]` consecutive rows of `jac` each; rows after the last cluster, such as prior
+/// terms, belong to none): its score `J_sᵀ r_s` and its share `J_sᵀ J_s` of the normal matrix.
+fn cluster_scores(jac: &DMatrix<f64>, residuals: &[f64], rows: &[usize]) -> Vec<(DVector<f64>, DMatrix<f64>)> {
+    let mut at = 0;
+    rows.iter()
+        .map(|&n| {
+            let js = jac.rows(at, n);
+            let rs = DVector::from_column_slice(&residuals[at..at + n]);
+            at += n;
+            (js.transpose() * rs, js.transpose() * js)
+        })
+        .collect()
+}
+
+/// The cluster jackknife covariance `(S − 1)/S · Σ_s δ_s δ_sᵀ` of a least-squares fit with Jacobian `jac`
+/// and residuals `residuals` at its optimum, `δ_s = (JᵀJ − J_sᵀJ_s)⁻¹ J_sᵀ r_s` (for a linear model, exactly
+/// the estimate's move when cluster s is left out). Cost: one p×p Cholesky factorisation per cluster.
+/// `None` when leaving some cluster out leaves the normal matrix singular.
+fn cluster_jackknife(jac: &DMatrix<f64>, residuals: &[f64], rows: &[usize]) -> Option<DMatrix<f64>> {
+    let q = jac.ncols();
+    let per_cluster = cluster_scores(jac, residuals, rows);
+    let normal: DMatrix<f64> = per_cluster.iter().fold(DMatrix::zeros(q, q), |a, (_, n)| a + n);
+    let s = rows.len() as f64;
+    let sum = per_cluster.iter().try_fold(DMatrix::zeros(q, q), |acc, (score, own)| {
+        let left = &normal - own;
+        // Equilibrated, so the factorisation's success is about the parameters' correlation, not units.
+        let d: Vec<f64> = (0..q).map(|j| left[(j, j)].sqrt()).collect();
+        if d.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
+            return None;
         }
-    }))
+        let scaled = DMatrix::from_fn(q, q, |i, j| left[(i, j)] / (d[i] * d[j]));
+        let solved = scaled.cholesky()?.solve(&DVector::from_fn(q, |i, _| score[i] / d[i]));
+        let delta = DVector::from_fn(q, |i, _| solved[i] / d[i]);
+        Some(acc + &delta * delta.transpose())
+    })?;
+    Some(sum * ((s - 1.0) / s))
 }
 
 #[cfg(test)]
@@ -209,6 +256,65 @@ mod tests {
             let t = i as f64 / rows as f64;
             t.powi(j as i32) * (1.0 + 0.3 * (7.0 * t + j as f64).sin())
         })
+    }
+
+    /// For a linear model one Gauss–Newton step is the exact refit, so the jackknife must equal refitting
+    /// with each cluster left out: `(S − 1)/S · Σ_s (β̂_(−s) − β̂)(β̂_(−s) − β̂)ᵀ`.
+    #[test]
+    fn the_cluster_jackknife_is_the_leave_one_cluster_out_refit_of_a_linear_model() {
+        let rows = [7, 9, 6, 8, 10, 7, 9];
+        let n: usize = rows.iter().sum();
+        let x = independent(n, 3);
+        let mut rng = bouncelab_testkit::Rng::new(11);
+        // Errors shared within a cluster plus independent ones: what the jackknife is for.
+        let mut y = DVector::zeros(n);
+        let mut at = 0;
+        for &m in &rows {
+            let shared = rng.normal();
+            for k in at..at + m {
+                y[k] = 1.0 + 2.0 * x[(k, 1)] + 0.5 * shared + 0.1 * rng.normal();
+            }
+            at += m;
+        }
+        let fit =
+            |x: &DMatrix<f64>, y: &DVector<f64>| (x.transpose() * x).cholesky().unwrap().solve(&(x.transpose() * y));
+        let beta = fit(&x, &y);
+        let residuals: Vec<f64> = (&x * &beta - &y).iter().copied().collect();
+        let got = cluster_jackknife(&x, &residuals, &rows).unwrap();
+        let mut want = DMatrix::zeros(3, 3);
+        let mut at = 0;
+        for &m in &rows {
+            let keep: Vec<usize> = (0..n).filter(|k| !(at..at + m).contains(k)).collect();
+            let xs = x.select_rows(&keep);
+            let ys = DVector::from_iterator(keep.len(), keep.iter().map(|&k| y[k]));
+            let d = fit(&xs, &ys) - &beta;
+            want += &d * d.transpose();
+            at += m;
+        }
+        want *= (rows.len() as f64 - 1.0) / rows.len() as f64;
+        for i in 0..3 {
+            for j in 0..3 {
+                let scale = (want[(i, i)] * want[(j, j)]).sqrt();
+                assert!(
+                    (got[(i, j)] - want[(i, j)]).abs() <= 1e-9 * scale,
+                    "({i}, {j}): {} vs {}",
+                    got[(i, j)],
+                    want[(i, j)]
+                );
+            }
+        }
+    }
+
+    /// A cluster that alone determines a parameter leaves the others unable to: no jackknife.
+    #[test]
+    fn a_cluster_that_alone_determines_a_parameter_gives_no_jackknife() {
+        let rows = [5, 5, 5];
+        let mut x = independent(15, 2);
+        for k in 5..15 {
+            x[(k, 1)] = 0.0;
+        }
+        let residuals = vec![0.1; 15];
+        assert!(cluster_jackknife(&x, &residuals, &rows).is_none());
     }
 
     #[test]
