@@ -138,5 +138,9 @@ pub fn measured_shot(
             mu: e.mu.value,
         }),
         surface_sigma_m: Some(e.surface_sigma_m).filter(|s| s.is_finite() && *s > 0.0),
+        frame_sigma_rad: e
+            .surface_tilt_deg
+            .map(|t| t.se.to_radians())
+            .filter(|s| s.is_finite() && *s > 0.0),
     }
 }

@@ -51,6 +51,7 @@ fn session() -> Vec<MeasuredShot> {
                     },
                     measured: None,
                     surface_sigma_m: None,
+                    frame_sigma_rad: None,
                 });
             }
         }

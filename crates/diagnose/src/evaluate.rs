@@ -467,6 +467,7 @@ mod tests {
                     },
                     measured: None,
                     surface_sigma_m: Some(20e-6),
+                    frame_sigma_rad: None,
                 }
             })
             .collect()

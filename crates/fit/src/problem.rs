@@ -18,6 +18,15 @@ use std::sync::atomic::{AtomicU64, Ordering};
 /// residuals, warm-started from the previous evaluation), so the parameter vector holds only the shared
 /// parameters and the cost is a few extra simulations per shot.
 ///
+/// A shot with [`MeasuredShot::frame_sigma_rad`] may also turn its frame: the estimator's frame follows the
+/// surface line's measured tilt, whose error (0.01–0.02° on a sharp 512 px line) turns the start's velocity
+/// with the incoming frames; the bounce reverses the normal part but not the error, so the outgoing
+/// tangential flight drifts by the tilt error times the normal speeds, tens of µm over 35 ms of flight, and
+/// the fit would read it as friction or a missing effect. Each such shot's turn ε is a nuisance with the
+/// line's σ as its prior, taken out to first order in every evaluation (the residuals' change per radian
+/// of turn is differenced once per problem, under the model at its starting values); the prior's own term (ε/σ)² is not added to
+/// the residual vector (about one against a shot's hundreds of frames).
+///
 /// The residual vector holds, for every shot in order and every frame in order, `(x_sim − x_m)/σ` and
 /// `(y_sim − y_m)/σ`, where `x_sim, y_sim` is what the camera sees of the simulated ball (the sample's
 /// `observed` position, so measurement effects such as camera roll apply) at the frame's time. Each
@@ -38,7 +47,20 @@ pub struct Problem {
     touch_x: Vec<f64>,
     /// Per shot: the index of its first residual.
     first_residual: Vec<usize>,
+    /// Per shot with a stated frame direction σ: how its residuals move as its frame turns.
+    turns: Vec<Option<FrameTurn>>,
 }
+
+/// How a shot's residuals move when its measured frame turns by a small angle ε about the contact point
+/// (frames and start turned alike), m per rad for each frame, and the angle's prior σ, rad.
+#[derive(Debug, Clone)]
+struct FrameTurn {
+    gradient: Vec<[f64; 2]>,
+    sigma_rad: f64,
+}
+
+/// The turn, rad, over which a frame turn's effect on the residuals is differenced.
+const TURN_STEP_RAD: f64 = 1e-4;
 
 /// The last profiled surface level of each shot (f64 bits), the warm start of the next evaluation.
 #[derive(Debug)]
@@ -111,7 +133,7 @@ impl Problem {
                 Some(first)
             })
             .collect();
-        Ok(Problem {
+        let mut problem = Problem {
             touch_x,
             first_residual,
             shots,
@@ -123,6 +145,56 @@ impl Problem {
             parallel: true,
             n_residuals,
             offsets: None,
+            turns: Vec::new(),
+        };
+        problem.turns = problem.frame_turns()?;
+        Ok(problem)
+    }
+
+    /// Each shot's [`FrameTurn`] (for shots with [`MeasuredShot::frame_sigma_rad`]), differenced under the
+    /// model at its starting values: the turn's effect is mostly kinematic (the start's velocity and the
+    /// frames turned together), so it is taken once per problem rather than in every evaluation. Two
+    /// simulations per such shot.
+    fn frame_turns(&self) -> Result<Vec<Option<FrameTurn>>, FitError> {
+        let initial = self.initial();
+        let models: Vec<Model> = self
+            .surfaces
+            .iter()
+            .map(|s| s.model(&initial))
+            .collect::<Result<_, _>>()?;
+        let one = |i: usize| -> Option<FrameTurn> {
+            let sigma_rad = self.shots[i].frame_sigma_rad.filter(|s| s.is_finite() && *s > 0.0)?;
+            let model = &models[self.shot_surface[i]];
+            let residuals = |eps: f64| -> Option<Vec<[f64; 2]>> {
+                let turned = turned_shot(&self.shots[i], self.touch_x[i], eps);
+                let sim = self.simulate_measured(i, &turned, model, 0.0).ok()?;
+                Some(
+                    turned
+                        .frames
+                        .iter()
+                        .zip(&sim.samples)
+                        .map(|(f, p)| [p.observed.x - f.x_m, p.observed.y - f.y_m])
+                        .collect(),
+                )
+            };
+            let (up, down) = (residuals(TURN_STEP_RAD)?, residuals(-TURN_STEP_RAD)?);
+            let gradient = up
+                .iter()
+                .zip(&down)
+                .map(|(u, d)| {
+                    [
+                        (u[0] - d[0]) / (2.0 * TURN_STEP_RAD),
+                        (u[1] - d[1]) / (2.0 * TURN_STEP_RAD),
+                    ]
+                })
+                .collect();
+            Some(FrameTurn { gradient, sigma_rad })
+        };
+        let all: Vec<usize> = (0..self.shots.len()).collect();
+        Ok(if self.parallel {
+            all.par_iter().map(|&i| one(i)).collect()
+        } else {
+            all.iter().map(|&i| one(i)).collect()
         })
     }
 
@@ -248,7 +320,21 @@ impl Problem {
     /// camera would see is mapped to the measured frame again. Without measurement effects and at level 0
     /// this is the plain simulation from the measured start.
     pub fn simulate_shot(&self, i: usize, model: &Model, level: f64) -> Result<Simulation, FitError> {
-        let shot = &self.shots[i];
+        let mut sim = self.simulate_measured(i, &self.shots[i], model, level)?;
+        if let Some(turn) = self.turns.get(i).and_then(Option::as_ref) {
+            turn.apply(&self.shots[i], &mut sim);
+        }
+        Ok(sim)
+    }
+
+    /// [`Problem::simulate_shot`] of `shot` (shot `i` or a copy of it turned), without the frame's turn.
+    fn simulate_measured(
+        &self,
+        i: usize,
+        shot: &MeasuredShot,
+        model: &Model,
+        level: f64,
+    ) -> Result<Simulation, FitError> {
         let measured = shot.start.state;
         let observing = observes(model);
         // The contact point in data coordinates (its x only matters with a measurement effect).
@@ -436,6 +522,43 @@ fn check_shot(shot: &MeasuredShot, radius: f64) -> Result<(), FitError> {
         prev = f.t_s;
     }
     Ok(())
+}
+
+impl FrameTurn {
+    /// Moves `sim`'s observed positions as the best turn ε of the shot's frame would, to first order:
+    /// `ε = −Σ w·(r·g) / (Σ w·|g|² + 1/σ²)` over the frames (`r` the residual, `g` the gradient, `w = 1/σ_f²`),
+    /// the minimiser of the frames' χ² plus the prior's (ε/σ)².
+    fn apply(&self, shot: &MeasuredShot, sim: &mut Simulation) {
+        let (mut num, mut den) = (0.0, 1.0 / (self.sigma_rad * self.sigma_rad));
+        for ((f, p), g) in shot.frames.iter().zip(&sim.samples).zip(&self.gradient) {
+            let w = 1.0 / (f.sigma_m * f.sigma_m);
+            num += w * ((p.observed.x - f.x_m) * g[0] + (p.observed.y - f.y_m) * g[1]);
+            den += w * (g[0] * g[0] + g[1] * g[1]);
+        }
+        let eps = -num / den;
+        if !eps.is_finite() {
+            return;
+        }
+        for (p, g) in sim.samples.iter_mut().zip(&self.gradient) {
+            p.observed.x += eps * g[0];
+            p.observed.y += eps * g[1];
+        }
+    }
+}
+
+/// `shot` with its frames and start turned by `eps` (rad, counter-clockwise) about the point `(x0, 0)` on
+/// the surface line.
+fn turned_shot(shot: &MeasuredShot, x0: f64, eps: f64) -> MeasuredShot {
+    let (s, c) = eps.sin_cos();
+    let turn = |x: f64, y: f64| (x0 + c * (x - x0) - s * y, s * (x - x0) + c * y);
+    let mut out = shot.clone();
+    for f in &mut out.frames {
+        (f.x_m, f.y_m) = turn(f.x_m, f.y_m);
+    }
+    let st = &mut out.start.state;
+    (st.x, st.y) = turn(st.x, st.y);
+    (st.vx, st.vy) = (c * st.vx - s * st.vy, s * st.vx + c * st.vy);
+    out
 }
 
 /// Shot `shot`'s weighted residuals `(x_sim − x_m)/σ, (y_sim − y_m)/σ` frame by frame, against what the

@@ -56,4 +56,9 @@ pub struct MeasuredShot {
     /// per-shot surface offsets ([`crate::Problem::with_surface_offsets`]), the shot's offset is a
     /// deviation from the surface's level with this prior; without it, the offset is free.
     pub surface_sigma_m: Option<f64>,
+    /// Standard error of the direction of this shot's frame, rad: the surface line's tilt as measured in
+    /// the image. When given, the fit lets the frame turn by a small angle with this prior (see
+    /// [`crate::Problem`]); `None`: the frame is taken as exact.
+    #[serde(default)]
+    pub frame_sigma_rad: Option<f64>,
 }

@@ -68,6 +68,7 @@ pub fn synth_shot(
             mu: imp.effective_friction + SIGMA_MU * rng.normal(),
         }),
         surface_sigma_m: None,
+        frame_sigma_rad: None,
     };
     let extras = ShotExtras {
         drop_height_m: Some(height_m),

@@ -165,6 +165,7 @@ fn session_of(
                 },
                 measured: None,
                 surface_sigma_m: None,
+                frame_sigma_rad: None,
             });
         }
     }

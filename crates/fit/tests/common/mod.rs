@@ -40,6 +40,7 @@ pub fn synth_shot(
             mu: imp.effective_friction,
         }),
         surface_sigma_m: None,
+        frame_sigma_rad: None,
     }
 }
 
