@@ -151,13 +151,14 @@ pub fn print_candidates(d: &Diagnosis) {
                 ph.chi2_share * 100.0
             );
         }
-        for c in d.candidates.iter().take(5) {
+        for c in &d.candidates {
             match &c.evidence {
                 Some(e) => eprintln!(
-                    "    {}. {} = {:.4e}: held-out {:.1} → {:.1} µm, {:.0} % removed, ΔBIC {:.0}, explains {} (part {}); {}",
+                    "    {}. {} = {:.4e} ({:.1} s): held-out {:.1} → {:.1} µm, {:.0} % removed, ΔBIC {:.0}, explains {} (part {}); {}",
                     c.rank,
                     c.effect,
                     e.param_value,
+                    c.seconds,
                     c.heldout_error_before * 1e6,
                     e.heldout_error_after * 1e6,
                     e.explained_fraction * 100.0,
@@ -166,7 +167,13 @@ pub fn print_candidates(d: &Diagnosis) {
                     c.partly_explains,
                     c.reasons.join("; ")
                 ),
-                None => eprintln!("    {}. {}: {}", c.rank, c.effect, c.reasons.join("; ")),
+                None => eprintln!(
+                    "    {}. {} ({:.1} s): {}",
+                    c.rank,
+                    c.effect,
+                    c.seconds,
+                    c.reasons.join("; ")
+                ),
             }
         }
         level = d.then.as_deref();

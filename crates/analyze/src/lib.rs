@@ -472,10 +472,25 @@ pub fn flagged_shots(shots: &[ShotData]) -> Vec<(String, String)> {
         .collect()
 }
 
+/// Frames next to the contact left out of a flight arc when judging the track's own scatter.
+const SUSPECT_CONTACT_MARGIN_FRAMES: f64 = 3.0;
+
 /// Shots whose flight phases scatter far beyond the session's other shots, with the reason: the fit
-/// crate's rule ([`bouncelab_fit::suspect_flights`]) over each shot's flight fits.
+/// crate's rule ([`bouncelab_fit::suspect_flights`]) over each shot's flight arcs, each fitted on its own
+/// by a cubic in time ([`bouncelab_fit::flight_structure_chi2`]), so that drag, which bends every long
+/// flight away from the estimator's ballistic arcs, does not hide a track that followed something else.
 pub fn suspect_tracks(shots: &[ShotData]) -> Vec<(String, String)> {
-    let flights: Vec<&[f64]> = shots.iter().map(|s| s.estimate.chi2_red.as_slice()).collect();
+    let structure: Vec<Vec<f64>> = shots
+        .iter()
+        .map(|s| {
+            let frames = &s.measured.frames;
+            let mut dt: Vec<f64> = frames.windows(2).map(|w| w[1].t_s - w[0].t_s).collect();
+            dt.sort_by(f64::total_cmp);
+            let margin = dt.get(dt.len() / 2).copied().unwrap_or(0.0) * SUSPECT_CONTACT_MARGIN_FRAMES;
+            bouncelab_fit::flight_structure_chi2(&s.measured, s.estimate.t_touch.value, s.estimate.t_sep.value, margin)
+        })
+        .collect();
+    let flights: Vec<&[f64]> = structure.iter().map(Vec::as_slice).collect();
     bouncelab_fit::suspect_flights(&flights)
         .into_iter()
         .map(|(i, why)| (shots[i].clip.clone(), why))

@@ -311,6 +311,41 @@ fn no_hidden_effect_no_false_alarm_and_k_b_recovered() {
     }
 }
 
+/// No hidden effect, filmed 35 ms either side (drag's flights): each line's tilt error (≈ 0.01°) turns the
+/// outgoing tangential flight by tens of µm over so long a flight; with each shot's frame free to turn
+/// within its line's σ the session is clean: `no_missing_effect`, μ, k and b near the truth.
+#[test]
+#[ignore]
+fn no_hidden_effect_on_long_flights_no_false_alarm() {
+    let text = bouncelab_render::preset_toml("none")
+        .unwrap()
+        .replace("pre_contact_ms = 10", "pre_contact_ms = 35")
+        .replace("post_separation_ms = 10", "post_separation_ms = 35");
+    assert!(text.contains("pre_contact_ms = 35"), "the preset's flight is set");
+    let scenario = Scenario::parse(&text, "none, 35 ms of flight").unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let session = render(&scenario, dir.path());
+    let a = run(&session, dir.path(), None);
+    let d = a.diagnosis.as_ref().expect("the diagnosis ran");
+    eprintln!("none, 35 ms: {}", d.verdict.sentence);
+    print_candidates(d);
+    for name in ["clay:coulomb.mu", "clay:spring.k", "clay:damping.b"] {
+        let p = a.fit.param(name).unwrap();
+        eprintln!("  {name} = {:.4} {:?}", p.value, p.interval);
+    }
+    assert_eq!(d.verdict.kind, VerdictKind::NoMissingEffect, "{}", d.verdict.sentence);
+    let mu = a.fit.param("clay:coulomb.mu").unwrap();
+    assert!((mu.value - 0.5).abs() < 0.025, "μ {}", mu.value);
+    for (name, truth) in [("clay:spring.k", 25650.0), ("clay:damping.b", 14.0)] {
+        let p = a.fit.param(name).unwrap();
+        assert!(
+            ((p.value - truth) / truth).abs() < 0.02,
+            "{name} {} vs {truth}",
+            p.value
+        );
+    }
+}
+
 /// An effect outside the library (an adhesive pull-off near separation, as a custom formula term in the
 /// renderer's physics): no library effect is named.
 #[test]

@@ -38,7 +38,10 @@ pub use solver::{
     Iteration, IterationObserver, LeastSquares, LevenbergMarquardt, LogObserver, NoObserver, SolverOutcome, Termination,
 };
 pub use surface_level::{SURFACE_LEVEL_RANGE_M, add_surface_level};
-pub use suspect::{SUSPECT_FLIGHT_CHI2_MIN, SUSPECT_FLIGHT_FACTOR, suspect_flights};
+pub use suspect::{
+    ARC_DEGREE, MIN_ARC_FRAMES, SUSPECT_FLIGHT_CHI2_MIN, SUSPECT_FLIGHT_FACTOR, arc_residuals, flight_structure_chi2,
+    suspect_flights,
+};
 
 /// Settings of a fit.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -24,8 +24,11 @@ use std::sync::atomic::{AtomicU64, Ordering};
 /// tangential flight drifts by the tilt error times the normal speeds, tens of µm over 35 ms of flight, and
 /// the fit would read it as friction or a missing effect. Each such shot's turn ε is a nuisance with the
 /// line's σ as its prior, taken out to first order in every evaluation (the residuals' change per radian
-/// of turn is differenced once per problem, under the model at its starting values); the prior's own term (ε/σ)² is not added to
-/// the residual vector (about one against a shot's hundreds of frames).
+/// of turn is differenced once per problem, under the model at its starting values) and held within
+/// ±2σ: the prior hardly binds against a shot's hundreds of frames, and they tell the turn only through
+/// the contact, where a turn and a tangential effect (a compliant patch, rolling resistance) move the
+/// outgoing flight alike; left free, the turns took up a hidden tangential spring's misfit shot by shot
+/// and it went unnamed. The prior's own term (ε/σ)² is not added to the residual vector.
 ///
 /// The residual vector holds, for every shot in order and every frame in order, `(x_sim − x_m)/σ` and
 /// `(y_sim − y_m)/σ`, where `x_sim, y_sim` is what the camera sees of the simulated ball (the sample's
@@ -58,6 +61,9 @@ struct FrameTurn {
     gradient: Vec<[f64; 2]>,
     sigma_rad: f64,
 }
+
+/// The largest turn of a shot's frame, in its prior σ.
+const TURN_CAP_SIGMAS: f64 = 2.0;
 
 /// The turn, rad, over which a frame turn's effect on the residuals is differenced.
 const TURN_STEP_RAD: f64 = 1e-4;
@@ -535,7 +541,8 @@ impl FrameTurn {
             num += w * ((p.observed.x - f.x_m) * g[0] + (p.observed.y - f.y_m) * g[1]);
             den += w * (g[0] * g[0] + g[1] * g[1]);
         }
-        let eps = -num / den;
+        let cap = TURN_CAP_SIGMAS * self.sigma_rad;
+        let eps = (-num / den).clamp(-cap, cap);
         if !eps.is_finite() {
             return;
         }
