@@ -124,7 +124,7 @@ mod tests {
         let sigma = 1e-5;
         let frame = |i: usize, jump: f64| {
             let t = i as f64 * 1e-4;
-            let (tc, sign) = ((t - 0.02).abs(), if i % 2 == 0 { 1.0 } else { -1.0 });
+            let (tc, sign) = ((t - 0.02).abs(), if i.is_multiple_of(2) { 1.0 } else { -1.0 });
             crate::MeasuredFrame {
                 t_s: t,
                 x_m: 0.01 + 0.3 * t - 2.0 * t * t * t + sign * sigma + jump,
