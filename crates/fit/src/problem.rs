@@ -162,6 +162,9 @@ impl Problem {
     /// frames turned together), so it is taken once per problem rather than in every evaluation. Two
     /// simulations per such shot.
     fn frame_turns(&self) -> Result<Vec<Option<FrameTurn>>, FitError> {
+        if self.shots.iter().all(|s| s.frame_sigma_rad.is_none()) {
+            return Ok(vec![None; self.shots.len()]);
+        }
         let initial = self.initial();
         let models: Vec<Model> = self
             .surfaces
@@ -533,7 +536,7 @@ fn check_shot(shot: &MeasuredShot, radius: f64) -> Result<(), FitError> {
 impl FrameTurn {
     /// Moves `sim`'s observed positions as the best turn ε of the shot's frame would, to first order:
     /// `ε = −Σ w·(r·g) / (Σ w·|g|² + 1/σ²)` over the frames (`r` the residual, `g` the gradient, `w = 1/σ_f²`),
-    /// the minimiser of the frames' χ² plus the prior's (ε/σ)².
+    /// the minimiser of the frames' χ² plus the prior's (ε/σ)², held within ±[`TURN_CAP_SIGMAS`]·σ.
     fn apply(&self, shot: &MeasuredShot, sim: &mut Simulation) {
         let (mut num, mut den) = (0.0, 1.0 / (self.sigma_rad * self.sigma_rad));
         for ((f, p), g) in shot.frames.iter().zip(&sim.samples).zip(&self.gradient) {
