@@ -6,8 +6,9 @@
 //! Markdown row per session, printed as it finishes: the verdict, whether it is right (issue 16's rule: the
 //! hidden effect named first, alone or first of an ambiguous few; both of a pair named; nothing named on a
 //! clean session; a camera roll whose line is seen measured from the line, not named), each hidden effect's
-//! magnitude against the truth, whether its 95 % interval covers the truth, and the times. The verdict
-//! tables of `docs/accuracy.md` and `docs/diagnosis.md` come from this command.
+//! magnitude against the truth, whether its 95 % interval covers the truth, and the times; every search's
+//! candidates (with their times) go to stderr. The verdict table of `docs/accuracy.md` ("Verdicts on
+//! rendered sessions") and the times in `docs/performance.md` come from this command.
 
 #[path = "../tests/common/verdicts.rs"]
 mod verdicts;
