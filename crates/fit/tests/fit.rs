@@ -53,6 +53,19 @@ fn check(result: &bouncelab_fit::FitResult, name: &str, truth: f64, rel: f64) {
     );
 }
 
+/// χ²_red within 0.15 of 1, and clay's and tape1's k and b within 2 % with intervals covering the truth.
+fn fits_to_the_noise_with_k_and_b_recovered(result: &bouncelab_fit::FitResult) {
+    assert!(
+        (result.reduced_chi2 - 1.0).abs() < 0.15,
+        "χ²_red {}",
+        result.reduced_chi2
+    );
+    check(result, "clay:spring.k", CLAY.0, 0.02);
+    check(result, "clay:damping.b", CLAY.1, 0.02);
+    check(result, "tape1:spring.k", TAPE1.0, 0.02);
+    check(result, "tape1:damping.b", TAPE1.1, 0.02);
+}
+
 #[test]
 fn recovers_k_and_b_per_surface_with_intervals_covering_truth() {
     let spec = ModelSpec::parse(&spec_toml(&["clay", "tape1"], ""), "test model").unwrap();
@@ -357,15 +370,7 @@ fn surface_levels_are_profiled_out() {
     );
     let result = fit(&spec, shots, &FitOptions::default(), &mut NoObserver).unwrap();
     eprintln!("with levels: χ²_red {:.3}", result.reduced_chi2);
-    assert!(
-        (result.reduced_chi2 - 1.0).abs() < 0.15,
-        "χ²_red {}",
-        result.reduced_chi2
-    );
-    check(&result, "clay:spring.k", CLAY.0, 0.02);
-    check(&result, "clay:damping.b", CLAY.1, 0.02);
-    check(&result, "tape1:spring.k", TAPE1.0, 0.02);
-    check(&result, "tape1:damping.b", TAPE1.1, 0.02);
+    fits_to_the_noise_with_k_and_b_recovered(&result);
     let worst = result
         .shots
         .iter()
@@ -409,15 +414,7 @@ fn frames_turned_within_their_stated_sigma_are_taken_out() {
     }
     let result = fit(&spec, shots, &no_levels(), &mut NoObserver).unwrap();
     eprintln!("frames turned within σ: χ²_red {:.3}", result.reduced_chi2);
-    assert!(
-        (result.reduced_chi2 - 1.0).abs() < 0.15,
-        "χ²_red {}",
-        result.reduced_chi2
-    );
-    check(&result, "clay:spring.k", CLAY.0, 0.02);
-    check(&result, "clay:damping.b", CLAY.1, 0.02);
-    check(&result, "tape1:spring.k", TAPE1.0, 0.02);
-    check(&result, "tape1:damping.b", TAPE1.1, 0.02);
+    fits_to_the_noise_with_k_and_b_recovered(&result);
 }
 
 /// A per-surface parameter's Jacobian column re-simulates only its surface's shots: the partial residuals
