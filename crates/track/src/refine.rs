@@ -1,10 +1,12 @@
 //! Sub-pixel centre and radius from edge points found along rays from a first guess.
 //!
 //! Along each of `rays` directions the image is sampled (bilinear) across the expected rim; the edge is the
-//! strongest change of brightness, located to a fraction of a pixel by a parabola through the derivative's
-//! peak. Rays whose rim point lies at or below the surface line are skipped (that part of the ball is
-//! pressed into or hidden by the surface), and so are rays leaving the image. The edge points then go to the
-//! robust circle fit. Cost: rays × samples bilinear reads (128 × 17 ≈ 2,200, ≈ 10 µs) plus the fit.
+//! strongest change of brightness, or the outer side of a thin band it starts (a dark limb, a ring under a
+//! bright limb) when the neighbouring rays see the same band, located to a fraction of a pixel by a parabola
+//! through the derivative's peak. Rays whose rim point lies at or below the surface line are skipped (that
+//! part of the ball is pressed into or hidden by the surface), and so are rays leaving the image. The edge
+//! points then go to the robust circle fit. Cost: rays × samples bilinear reads (128 × 17 ≈ 2,200, ≈ 10 µs)
+//! plus the fit.
 
 use crate::circle_fit::{CircleFit, fit_circle};
 use crate::plane::{Pixel, Plane, parabola_offset};
@@ -451,29 +453,93 @@ fn sample_ray<P: Pixel>(
     }
 }
 
-/// The profile's strongest brightness step: (sample index, step per px on the 0–255 scale, sub-sample
-/// offset of the peak), or `None` when it is weaker than `search.min_contrast` or too near an end for the
-/// parabola.
-fn strongest_edge(profile: &[f32], search: &EdgeSearch) -> Option<(usize, f32, f64)> {
+/// An edge on a ray's profile: (sample index, step per px on the 0–255 scale, sub-sample offset of the peak).
+type ProfileEdge = (usize, f32, f64);
+
+/// The ray's strongest brightness step, and the outer side of a thin band that step starts when there is
+/// one: a step of the other sign at least [`RIM_STEP_SHARE`] of the strongest's size within
+/// [`THIN_BAND_PX`] outside it (and so on outward). `None` when the strongest step is weaker than
+/// `search.min_contrast` or lies too near an end for the parabola; no band when its side does. Cost: one
+/// pass of central differences over the profile, and one over the band's reach.
+fn ray_edges(profile: &[f32], search: &EdgeSearch) -> Option<(ProfileEdge, Option<ProfileEdge>)> {
     let len = profile.len();
-    let (mut best, mut best_j) = (0.0f32, 0);
-    for j in 1..len - 1 {
-        let d = (profile[j + 1] - profile[j - 1]).abs();
-        if d > best {
-            best = d;
-            best_j = j;
+    let d = |j: usize| profile[j + 1] - profile[j - 1];
+    let (mut best, mut strongest) = (0.0f32, 0);
+    for (i, w) in profile.windows(3).enumerate() {
+        let a = (w[2] - w[0]).abs();
+        if a > best {
+            best = a;
+            strongest = i + 1;
         }
     }
-    let per_px = best / (2.0 * search.step as f32);
-    if per_px < search.min_contrast || best_j < 2 || best_j + 3 > len {
+    let to_per_px = 1.0 / (2.0 * search.step as f32);
+    if best * to_per_px < search.min_contrast {
         return None;
     }
-    let m = |j: usize| (profile[j + 1] - profile[j - 1]).abs() as f64;
-    Some((best_j, per_px, parabola_offset(m(best_j - 1), m(best_j), m(best_j + 1))))
+    let edge = |j: usize| -> Option<ProfileEdge> {
+        if j < 2 || j + 3 > len {
+            return None;
+        }
+        let sign = d(j).signum() as f64;
+        let m = |j: usize| sign * d(j) as f64;
+        Some((j, d(j).abs() * to_per_px, parabola_offset(m(j - 1), m(j), m(j + 1))))
+    };
+    let reach = (THIN_BAND_PX / search.step).round() as usize;
+    let mut j = strongest;
+    loop {
+        let other = -d(j).signum();
+        let (mut k, mut size) = (j, RIM_STEP_SHARE * best);
+        for (i, w) in profile[j..].windows(3).take(reach).enumerate() {
+            let a = other * (w[2] - w[0]);
+            if a >= size {
+                (k, size) = (j + 1 + i, a);
+            }
+        }
+        if k == j {
+            break;
+        }
+        j = k;
+    }
+    Some((edge(strongest)?, if j > strongest { edge(j) } else { None }))
+}
+
+/// How strong a step of the other sign just outside the strongest must be, as a share of it, to be the rim
+/// instead. A ball can show a thin band at its silhouette, a dark limb or a dark ring under a bright limb,
+/// whose inner side out-steps the silhouette (25 against 20 DN/px seen); taking that puts the rim 1–2 px
+/// inside the ball. A sharpened edge's undershoot is a step of the other sign too, but a small one.
+const RIM_STEP_SHARE: f32 = 0.5;
+
+/// How far outside the strongest step the band's outer side is looked for, px (the bands seen are ≤ 2.1 px
+/// wide).
+const THIN_BAND_PX: f64 = 3.0;
+
+/// How closely a ray within two of it must agree on a band's width for a ray to take its band's outer side,
+/// px. A band on the ball runs along the rim; a noise spike outside a weak rim looks like a band on one ray
+/// and would push every weak rim outward.
+const BAND_AGREEMENT_PX: f64 = 0.75;
+
+/// What one ray saw, kept between [`rim_edges`]'s two passes.
+struct RaySeen {
+    ray: usize,
+    dir: (f64, f64),
+    /// The strongest step and its edge definition ([`half_level_offset`], samples) when asked for.
+    strongest: (ProfileEdge, Option<f64>),
+    /// The band's outer side, likewise.
+    band: Option<(ProfileEdge, Option<f64>)>,
+}
+
+impl RaySeen {
+    /// The band's width (outer side's distance outside the strongest step), samples.
+    fn band_width(&self) -> Option<f64> {
+        let at = |e: &ProfileEdge| e.0 as f64 + e.2;
+        self.band.map(|b| at(&b.0) - at(&self.strongest.0))
+    }
 }
 
 /// The rim's edge along each of `search.rays` rays about the guess (x, y, r), searched ± `half_width`
-/// across it; `raw_points` also receives each edge as (ray, point).
+/// across it; `raw_points` also receives each edge as (ray, point). A ray's edge is its strongest step, or
+/// the outer side of the thin band that step starts when a ray within two of it sees a band of the same
+/// width ([`ray_edges`], [`BAND_AGREEMENT_PX`]).
 fn rim_edges<P: Pixel>(
     img: &Plane<P>,
     (x, y, r): (f64, f64, f64),
@@ -490,6 +556,7 @@ fn rim_edges<P: Pixel>(
         .filter(|o| o.len() == n);
     let samples = ((2.0 * half_width / search.step).round() as usize).max(4) + 1;
     let mut profile = vec![0.0f32; samples];
+    let mut seen: Vec<RaySeen> = Vec::with_capacity(n);
     let mut edges = RimEdges {
         rays: n,
         points: Vec::with_capacity(n),
@@ -499,6 +566,7 @@ fn rim_edges<P: Pixel>(
         outside: 0,
         hidden: 0,
     };
+    let start = r - half_width;
     // Ray directions by rotating one unit vector: no sin/cos per ray.
     let (dc, ds) = (std::f64::consts::TAU / n as f64).sin_cos();
     let (dc, ds) = (ds, dc); // (cos Δ, sin Δ)
@@ -507,7 +575,6 @@ fn rim_edges<P: Pixel>(
         let (c0, s0) = (c, s);
         (c, s) = (c0 * dc - s0 * ds, s0 * dc + c0 * ds);
         let (c, s) = (c0, s0);
-        let start = r - half_width;
         let len = match ray_span(img, (x, y, r), (c, s), start, samples, search, surface) {
             RaySpan::Samples(len) => len,
             RaySpan::Hidden => {
@@ -521,9 +588,40 @@ fn rim_edges<P: Pixel>(
         };
         let profile = &mut profile[..len];
         sample_ray(img, profile, (x, y), (c, s), start, search);
-        let Some((best_j, per_px, off)) = strongest_edge(profile, search) else {
+        let Some((strongest, band)) = ray_edges(profile, search) else {
             continue;
         };
+        let definition = |e: ProfileEdge| {
+            let o = search
+                .edge_definition
+                .then(|| half_level_offset(profile, e.0, e.0 as f64 + e.2));
+            (e, o.flatten())
+        };
+        seen.push(RaySeen {
+            ray,
+            dir: (c, s),
+            strongest: definition(strongest),
+            band: band.map(definition),
+        });
+    }
+    // Rays in ray order with gaps: a neighbour is found by its ray number.
+    let width_of = |ray: usize| {
+        seen.binary_search_by_key(&ray, |r| r.ray)
+            .ok()
+            .and_then(|i| seen[i].band_width())
+    };
+    for ray_seen in &seen {
+        let ray = ray_seen.ray;
+        let agreed = ray_seen.band_width().is_some_and(|w| {
+            [n - 2, n - 1, 1, 2]
+                .iter()
+                .any(|&k| width_of((ray + k) % n).is_some_and(|wk| (wk - w).abs() * search.step <= BAND_AGREEMENT_PX))
+        });
+        let ((best_j, per_px, off), definition) = match ray_seen.band {
+            Some(band) if agreed => band,
+            _ => ray_seen.strongest,
+        };
+        let (c, s) = ray_seen.dir;
         let d = start + (best_j as f64 + off) * search.step;
         if let Some(raw) = raw_points.as_deref_mut() {
             raw.push((ray, [x + d * c, y + d * s]));
@@ -531,9 +629,7 @@ fn rim_edges<P: Pixel>(
         edges.points.push([x + d * c, y + d * s]);
         edges.shifts.push((shape.map_or(0.0, |o| o[ray]), c, s));
         edges.contrasts.push(per_px);
-        if search.edge_definition
-            && let Some(o) = half_level_offset(profile, best_j, best_j as f64 + off)
-        {
+        if let Some(o) = definition {
             edges.offsets.push(o * search.step);
         }
     }
@@ -842,6 +938,105 @@ mod tests {
             err(plain)
         );
         assert!(err(with) < 0.25 * err(plain), "{} vs {}", err(with), err(plain));
+    }
+
+    /// An image of `level(distance from (cx, cy), above the centre)` sampled 4 × 4 per pixel.
+    fn drawn(cx: f64, cy: f64, level: impl Fn(f64, bool) -> f64) -> Vec<u8> {
+        (0..SIZE * SIZE)
+            .map(|k| {
+                let (px, py) = ((k % SIZE) as f64, (k / SIZE) as f64);
+                let mut sum = 0.0;
+                for i in 0..16 {
+                    let (x, y) = (px - 0.375 + 0.25 * (i % 4) as f64, py - 0.375 + 0.25 * (i / 4) as f64);
+                    sum += level((x - cx).hypot(y - cy), y < cy);
+                }
+                (sum / 16.0).round() as u8
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_rim_is_the_silhouette_not_a_ring_or_dark_limb_inside_it() {
+        let (cx, cy, r) = (108.4, 104.7, 70.0);
+        type Level = Box<dyn Fn(f64, bool) -> f64>;
+        let looks: [(&str, Level); 4] = [
+            // Lit from behind: bright on top; below, as dim as the backdrop with a dark ring (70) inside a
+            // bright limb (118), the ring's inner side the strongest step.
+            (
+                "bright limb",
+                Box::new(move |d, top| match d {
+                    d if d > r => 90.0,
+                    _ if top => 190.0,
+                    d if d > r - 1.4 => 118.0,
+                    d if d > r - 2.6 && d < r - 1.6 => 70.0,
+                    _ => 100.0,
+                }),
+            ),
+            // The same mirrored about 128: a ball darker than its backdrop.
+            (
+                "mirrored",
+                Box::new(move |d, top| {
+                    256.0
+                        - match d {
+                            d if d > r => 90.0,
+                            _ if top => 190.0,
+                            d if d > r - 1.4 => 118.0,
+                            d if d > r - 2.6 && d < r - 1.6 => 70.0,
+                            _ => 100.0,
+                        }
+                }),
+            ),
+            // A light ball whose limb is darker than the backdrop, the limb's inner side the stronger step.
+            (
+                "dark limb",
+                Box::new(move |d, _| match d {
+                    d if d > r => 120.0,
+                    d if d > r - 2.0 => 70.0,
+                    _ => 150.0,
+                }),
+            ),
+            // Lit from above: lighter than the backdrop on top, darker below.
+            (
+                "shaded",
+                Box::new(move |d, top| match d {
+                    d if d > r => 110.0,
+                    _ if top => 190.0,
+                    _ => 50.0,
+                }),
+            ),
+        ];
+        for (look, level) in &looks {
+            let img = drawn(cx, cy, level);
+            let plane = Plane::new(&img, SIZE, SIZE);
+            // The guess 1 px small, as a track that had settled inside the rim would give.
+            let f = refine_circle(&plane, cx, cy - 0.5, r - 1.0, &EdgeSearch::default(), None)
+                .unwrap()
+                .fit;
+            let (centre, radius) = ((f.x - cx).hypot(f.y - cy), f.r - r);
+            assert!(centre < 0.1 && radius.abs() < 0.1, "{look}: {f:?}");
+        }
+    }
+
+    #[test]
+    fn noise_outside_a_faint_rim_does_not_push_it_outward() {
+        // A rim only 20 DN above the backdrop in 8 DN of noise, sampled unsmoothed: on single rays a noise
+        // spike just outside looks like a band's outer side (taken on every ray alone, +0.15 px).
+        let (cx, cy, r) = (108.4, 104.7, 70.0);
+        let clean = drawn(cx, cy, |d, _| if d > r { 90.0 } else { 110.0 });
+        let search = EdgeSearch::default();
+        let mut rng = bouncelab_testkit::Rng::new(7);
+        let bias: f64 = (0..12)
+            .map(|_| {
+                let noisy: Vec<u8> = clean
+                    .iter()
+                    .map(|&v| (v as f64 + 8.0 * rng.normal()).round().clamp(0.0, 255.0) as u8)
+                    .collect();
+                let plane = Plane::new(&noisy, SIZE, SIZE);
+                refine_circle(&plane, cx, cy, r, &search, None).unwrap().fit.r - r
+            })
+            .sum::<f64>()
+            / 12.0;
+        assert!(bias.abs() < 0.05, "mean radius error {bias:+.3} px");
     }
 
     #[test]
