@@ -959,33 +959,19 @@ mod tests {
     fn the_rim_is_the_silhouette_not_a_ring_or_dark_limb_inside_it() {
         let (cx, cy, r) = (108.4, 104.7, 70.0);
         type Level = Box<dyn Fn(f64, bool) -> f64>;
+        // Lit from behind: bright on top; below, as dim as the backdrop with a dark ring (70) inside a bright
+        // limb (118), the ring's inner side the strongest step.
+        let bright_limb = move |d: f64, top: bool| match d {
+            d if d > r => 90.0,
+            _ if top => 190.0,
+            d if d > r - 1.4 => 118.0,
+            d if d > r - 2.6 && d < r - 1.6 => 70.0,
+            _ => 100.0,
+        };
         let looks: [(&str, Level); 4] = [
-            // Lit from behind: bright on top; below, as dim as the backdrop with a dark ring (70) inside a
-            // bright limb (118), the ring's inner side the strongest step.
-            (
-                "bright limb",
-                Box::new(move |d, top| match d {
-                    d if d > r => 90.0,
-                    _ if top => 190.0,
-                    d if d > r - 1.4 => 118.0,
-                    d if d > r - 2.6 && d < r - 1.6 => 70.0,
-                    _ => 100.0,
-                }),
-            ),
+            ("bright limb", Box::new(bright_limb)),
             // The same mirrored about 128: a ball darker than its backdrop.
-            (
-                "mirrored",
-                Box::new(move |d, top| {
-                    256.0
-                        - match d {
-                            d if d > r => 90.0,
-                            _ if top => 190.0,
-                            d if d > r - 1.4 => 118.0,
-                            d if d > r - 2.6 && d < r - 1.6 => 70.0,
-                            _ => 100.0,
-                        }
-                }),
-            ),
+            ("mirrored", Box::new(move |d, top| 256.0 - bright_limb(d, top))),
             // A light ball whose limb is darker than the backdrop, the limb's inner side the stronger step.
             (
                 "dark limb",
