@@ -170,12 +170,15 @@ struct Onset {
 const GRID_FRAMES: f64 = 0.1;
 /// Standardized residual that counts as a departure from the arc (three frames in a row).
 const DEPARTURE_SIGMAS: f64 = 3.0;
+/// Standardized residual under which the centre is back on its arc (see [`onset`]).
+const RETURN_SIGMAS: f64 = 2.0;
 /// How far before the first clear departure the touch may lie, frames (the onset grows as τ², so a touch
 /// is seen at 3σ some frames later; 12 frames covers a damping-free spring's cubic onset at 0.05 px noise).
 const LOOK_BACK_FRAMES: f64 = 12.0;
 
 /// The onset fit on `side` (flight first, the lowest point last): the arc of the first half of the frames
-/// (in time) extrapolated until the centre departs from it for three frames in a row, then the onset model
+/// (in time) extrapolated until the centre departs from it for three frames in a row after its last frame
+/// back within [`RETURN_SIGMAS`] of it, then the onset model
 /// fitted for touch times on a grid up to that departure, over the frames up to 40 % of the way from the
 /// departure to the lowest centre.
 fn onset(side: &[HeightPoint], _lowest: f64, a_px: f64, _radius_px: f64) -> Option<Onset> {
@@ -199,12 +202,19 @@ fn onset(side: &[HeightPoint], _lowest: f64, a_px: f64, _radius_px: f64) -> Opti
     let (c, _, chi2) = fit_onset(&early, a_px, &clock, None)?;
     let inflate = (chi2 / (early.len() as f64 - 2.0).max(1.0)).max(1.0).sqrt();
     let a_u = a_px * dt * dt;
-    let departs = |p: &HeightPoint| {
+    let off_arc = |p: &HeightPoint| {
         let u = clock.u(p.t);
-        (p.h - (c[0] + c[1] * u + 0.5 * a_u * u * u)) / (p.sigma * inflate) > DEPARTURE_SIGMAS
+        (p.h - (c[0] + c[1] * u + 0.5 * a_u * u * u)) / (p.sigma * inflate)
     };
+    let departs = |p: &HeightPoint| off_arc(p) > DEPARTURE_SIGMAS;
     let rest = &side[early.len()..];
-    let first_departure = (0..rest.len().saturating_sub(2)).find(|&i| rest[i..i + 3].iter().all(departs))?;
+    // The push only grows from the touch to the lowest centre, so a track back on its arc had not touched
+    // yet: a track biased differently across the frame creeps off its arc and back before the contact.
+    let from = rest
+        .iter()
+        .rposition(|p| off_arc(p) < RETURN_SIGMAS)
+        .map_or(0, |i| i + 1);
+    let first_departure = (from..rest.len().saturating_sub(2)).find(|&i| rest[i..i + 3].iter().all(departs))?;
     let t_dep = rest[first_departure].t;
     let t_end = t_dep + 0.4 * (t_low - t_dep);
     let used: Vec<HeightPoint> = side.iter().copied().filter(|p| p.t <= t_end).collect();
@@ -449,5 +459,27 @@ mod tests {
             eprintln!("{phase}: {tc:?} (touch at {t_touch})");
             assert!((tc.level_px - 100.0).abs() < 0.3, "{tc:?}");
         }
+    }
+
+    #[test]
+    fn a_track_that_creeps_off_its_arc_and_back_has_not_touched_yet() {
+        // A track biased differently across the frame: 0.2 px (4σ) off its arc for 1 ms, back on it 1.5 ms
+        // before the touch.
+        let (mut pts, t_touch) = bounce(100.0, 5000.0, 0.3);
+        for p in &mut pts {
+            let s = (p.t - (t_touch - 0.0025)) / 0.001;
+            if (0.0..1.0).contains(&s) {
+                p.h += 0.2 * (std::f64::consts::PI * s).sin();
+            }
+        }
+        let low = find_impact(&pts, -9.81 / 4e-4, 4e-4).unwrap();
+        let tc = trajectory_contact(&pts, low, -9.81 / 4e-4, 84.0).unwrap();
+        eprintln!("{tc:?} (touch at {t_touch})");
+        assert!(
+            (tc.t_touch.0 - t_touch).abs() < 2e-4,
+            "touch {:?} for {t_touch}",
+            tc.t_touch
+        );
+        assert!((tc.level_px - 100.0).abs() < 2.0 * tc.level_se_px, "{tc:?}");
     }
 }
