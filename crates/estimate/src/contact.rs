@@ -178,9 +178,8 @@ const LOOK_BACK_FRAMES: f64 = 12.0;
 
 /// The onset fit on `side` (flight first, the lowest point last): the arc of the first half of the frames
 /// (in time) extrapolated until the centre departs from it for three frames in a row after its last frame
-/// back within [`RETURN_SIGMAS`] of it, then the onset model
-/// fitted for touch times on a grid up to that departure, over the frames up to 40 % of the way from the
-/// departure to the lowest centre.
+/// back within [`RETURN_SIGMAS`] of it, then the onset model fitted for touch times on a grid up to that
+/// departure, over the frames up to 40 % of the way from the departure to the lowest centre.
 fn onset(side: &[HeightPoint], _lowest: f64, a_px: f64, _radius_px: f64) -> Option<Onset> {
     if side.len() < MIN_FLIGHT_FRAMES + 4 {
         return None;
