@@ -272,42 +272,57 @@ fn no_hidden_effect_no_false_alarm_and_k_b_recovered() {
         scenario.seed = seed;
         let session = render(&scenario, dir.path());
         let a = run(&session, dir.path(), None);
-        let d = a.diagnosis.as_ref().expect("the diagnosis ran");
-        eprintln!("none, seed {seed}: {}", d.verdict.sentence);
-        assert_eq!(
-            d.verdict.kind,
-            VerdictKind::NoMissingEffect,
-            "seed {seed}: {}",
-            d.verdict.sentence
-        );
-        // μ is fitted per surface: determined by the oblique shots, and near the hidden 0.5.
+        let label = format!("seed {seed}");
+        assert_clean_clay(&a, &label);
+        // μ is fitted per surface: determined by the oblique shots.
         let mu = a.fit.param("clay:coulomb.mu").expect("μ fitted per surface");
-        eprintln!(
-            "  clay:coulomb.mu = {:.4} {:?} (truth 0.5){}",
-            mu.value,
-            mu.interval,
-            mu.not_identified
-                .as_deref()
-                .map(|w| format!(", not identified: {w}"))
-                .unwrap_or_default()
-        );
-        assert!(mu.not_identified.is_none(), "seed {seed}: {:?}", mu.not_identified);
-        assert!((mu.value - 0.5).abs() < 0.05 * 0.5, "seed {seed}: μ {}", mu.value);
-        for (name, truth) in [("clay:spring.k", 25650.0), ("clay:damping.b", 14.0)] {
-            let p = a.fit.param(name).unwrap();
-            let [lo, hi] = p.interval.expect("an interval");
-            let err = (p.value - truth) / truth;
-            eprintln!(
-                "  {name} = {:.4} [{lo:.4}, {hi:.4}] (truth {truth}, {:+.3} %)",
-                p.value,
-                err * 100.0
-            );
-            assert!(err.abs() < 0.02, "seed {seed}: {name} {} vs {truth}", p.value);
+        assert!(mu.not_identified.is_none(), "{label}: {:?}", mu.not_identified);
+        for (name, truth) in CLAY_K_B {
+            let [lo, hi] = a.fit.param(name).unwrap().interval.expect("an interval");
             assert!(
                 lo <= truth && truth <= hi,
-                "seed {seed}: {name} [{lo}, {hi}] misses {truth}"
+                "{label}: {name} [{lo}, {hi}] misses {truth}"
             );
         }
+    }
+}
+
+/// The `none` preset's clay spring and damping: (parameter, truth).
+const CLAY_K_B: [(&str, f64); 2] = [("clay:spring.k", 25650.0), ("clay:damping.b", 14.0)];
+
+/// A session with no hidden effect: `no_missing_effect`, μ within 5 % of the hidden 0.5 and k, b within 2 %
+/// of the truth (each printed with its interval).
+fn assert_clean_clay(a: &Analysis, label: &str) {
+    let d = a.diagnosis.as_ref().expect("the diagnosis ran");
+    eprintln!("{label}: {}", d.verdict.sentence);
+    print_candidates(d);
+    assert_eq!(
+        d.verdict.kind,
+        VerdictKind::NoMissingEffect,
+        "{label}: {}",
+        d.verdict.sentence
+    );
+    let mu = a.fit.param("clay:coulomb.mu").expect("μ fitted per surface");
+    eprintln!(
+        "  clay:coulomb.mu = {:.4} {:?} (truth 0.5){}",
+        mu.value,
+        mu.interval,
+        mu.not_identified
+            .as_deref()
+            .map(|w| format!(", not identified: {w}"))
+            .unwrap_or_default()
+    );
+    assert!((mu.value - 0.5).abs() < 0.05 * 0.5, "{label}: μ {}", mu.value);
+    for (name, truth) in CLAY_K_B {
+        let p = a.fit.param(name).unwrap();
+        let err = (p.value - truth) / truth;
+        eprintln!(
+            "  {name} = {:.4} {:?} (truth {truth}, {:+.3} %)",
+            p.value,
+            p.interval,
+            err * 100.0
+        );
+        assert!(err.abs() < 0.02, "{label}: {name} {} vs {truth}", p.value);
     }
 }
 
@@ -326,24 +341,7 @@ fn no_hidden_effect_on_long_flights_no_false_alarm() {
     let dir = tempfile::tempdir().unwrap();
     let session = render(&scenario, dir.path());
     let a = run(&session, dir.path(), None);
-    let d = a.diagnosis.as_ref().expect("the diagnosis ran");
-    eprintln!("none, 35 ms: {}", d.verdict.sentence);
-    print_candidates(d);
-    for name in ["clay:coulomb.mu", "clay:spring.k", "clay:damping.b"] {
-        let p = a.fit.param(name).unwrap();
-        eprintln!("  {name} = {:.4} {:?}", p.value, p.interval);
-    }
-    assert_eq!(d.verdict.kind, VerdictKind::NoMissingEffect, "{}", d.verdict.sentence);
-    let mu = a.fit.param("clay:coulomb.mu").unwrap();
-    assert!((mu.value - 0.5).abs() < 0.025, "μ {}", mu.value);
-    for (name, truth) in [("clay:spring.k", 25650.0), ("clay:damping.b", 14.0)] {
-        let p = a.fit.param(name).unwrap();
-        assert!(
-            ((p.value - truth) / truth).abs() < 0.02,
-            "{name} {} vs {truth}",
-            p.value
-        );
-    }
+    assert_clean_clay(&a, "none, 35 ms");
 }
 
 /// An effect outside the library (an adhesive pull-off near separation, as a custom formula term in the
