@@ -128,6 +128,7 @@ fn synthetic_scene(i: usize) -> Scene {
         surface: Some((SURFACE_Y, 0.0)),
         band: (120.0, 50.0),
         distractors: vec![(440.0, 120.0, 9.0, 40.0), (60.0, 470.0, 25.0, 190.0)],
+        marks: Vec::new(),
         noise: 5.0,
         seed: 1000 + i as u64,
         roughness: 0.0,

@@ -6,9 +6,15 @@
 //! cast no votes, then measured on the frame itself. A circle counts as the ball when it moved between two
 //! frames 1 ms apart (ten at 10,000 fps, see `SIGHTING_GAP_S`), is found again half-way between where its
 //! path puts it, and is not one of the circles that stayed put. When the difference holds no such circle (a
-//! ball too large or slow for the median to forget it), the frames themselves are searched the same way. Clean circles centred beyond the frame's
-//! edges (a ball mostly out of view) are looked for after clean ones inside it and before doubtful ones, so
-//! that a seam's lobe on the visible cap of a ball whose centre is out of view is not taken for the ball.
+//! ball too large or slow for the median to forget it), the frames themselves are searched the same way.
+//! Clean circles centred beyond the frame's edges (a ball mostly out of view) are looked for after clean ones
+//! inside it and before doubtful ones, so that a seam's lobe on the visible cap of a ball whose centre is out
+//! of view is not taken for the ball.
+//!
+//! Most clips show the ball from their first frame, so the first pair of frames is tried before the clip is
+//! searched one octave of radii at a time: a search through the whole clip for radii larger than the ball's
+//! was most of a clip's tracking cost. A circle found there that lies inside a larger moving one is left to
+//! the full search, which settles such a lobe.
 
 use crate::ball_search::{BALL_CANDIDATES, MIN_BALL_RADIUS_PX, hint_window, radius_window};
 use crate::clip::{ClipTracking, TrackError, on_plane, with_plane};
@@ -80,6 +86,9 @@ pub(crate) fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32, noise: f32) -
         found: HashMap::new(),
         still: Vec::new(),
     };
+    if let Some(found) = search.at_first_pair(&bands)? {
+        return Ok(found);
+    }
     // Clean circles centred in the frame, then clean circles centred beyond its edges (a ball mostly out of
     // view: a third of a rim lines up by chance more easily than a whole one, so only clean ones count, and
     // before doubtful circles in the frame, which on such a ball are the seam's lobes on its visible cap),
@@ -93,22 +102,17 @@ pub(crate) fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32, noise: f32) -
         (CANDIDATE_QUALITY, false),
     ] {
         for (band, &radii) in bands.iter().enumerate() {
-            for voters in [Voters::Strongest, Voters::AboveNoise] {
-                for votes in [Votes::Moving, Votes::Frame] {
-                    if votes == Votes::Moving && search.background.is_none() {
-                        continue;
-                    }
-                    let pass = Pass {
-                        threshold,
-                        band,
-                        radii,
-                        beyond_edge,
-                        votes,
-                        voters,
-                    };
-                    if let Some(found) = search.through_clip(&pass)? {
-                        return Ok(found);
-                    }
+            for (voters, votes) in search.sources() {
+                let pass = Pass {
+                    threshold,
+                    band,
+                    radii,
+                    beyond_edge,
+                    votes,
+                    voters,
+                };
+                if let Some(found) = search.through_clip(&pass)? {
+                    return Ok(found);
                 }
             }
         }
@@ -169,58 +173,164 @@ impl PairSearch<'_> {
     /// Pairs of files `gap` apart through the first half of the clip, in this pass: the first moving pair
     /// ([`moving_pair`]) as the ball, else `None`. The clean frame pass also notes the circles that stayed.
     fn through_clip(&mut self, pass: &Pass) -> Result<Option<Acquired>, TrackError> {
-        let (n, gap, width) = (self.clip.len(), self.gap, self.width);
+        let (n, gap) = (self.clip.len(), self.gap);
         let mut k = 0;
         while k + gap < n && k <= n / 2 {
-            let good = |s: &Seen| s.circle.support > pass.threshold;
-            let a: Vec<Seen> = self.circles(k, pass)?.into_iter().filter(good).collect();
-            let b: Vec<Seen> = self.circles(k + gap, pass)?.into_iter().filter(good).collect();
-            let (a_moved, a_static) = split_static(&a, &b);
-            let (b_moved, _) = split_static(&b, &a);
-            let loose = |s: &Seen| s.circle.support > CANDIDATE_QUALITY;
-            let a_all: Vec<Seen> = self.circles(k, pass)?.into_iter().filter(loose).collect();
-            let b_all: Vec<Seen> = self.circles(k + gap, pass)?.into_iter().filter(loose).collect();
-            let (a_loose, _) = split_static(&a_all, &b_all);
-            let (b_loose, _) = split_static(&b_all, &a_all);
-            if pass.threshold == CLEAN_QUALITY
-                && !pass.beyond_edge
-                && pass.votes == Votes::Frame
-                && pass.voters == Voters::Strongest
-            {
-                for c in a_static.iter().map(|s| &s.circle) {
-                    if !self.still.iter().any(|s| (s.0 - c.x).hypot(s.1 - c.y) < 0.5 * c.r) {
-                        self.still.push((c.x, c.y, c.r, c.support));
-                    }
-                }
-            }
-            if let Some(MovingPair { a: ca, b: cb, other }) = moving_pair(
-                &a_moved,
-                &b_moved,
-                (&a_loose, &b_loose),
-                width,
-                pass.threshold,
-                |mx, my, r, reach, least| {
-                    Ok(gap < 2
-                        || self.circles(k + gap / 2, pass)?.iter().map(|s| &s.circle).any(|c| {
-                            c.support > least
-                                && (c.x - mx).hypot(c.y - my) <= reach
-                                && (c.r - r).abs() <= 0.05 * r + 1.0
-                        }))
-                },
-            )? {
-                let r = 0.5 * (ca.r + cb.r);
-                // `k` counts files; time follows frame indices, which count dropped frames too.
-                let clip = self.clip;
-                let t = |pos: usize| clip.time_of(clip.files()[pos].index);
-                return Ok(Some(Acquired {
-                    radius: radius_window(r),
-                    seed: ((t(k), ca.x, ca.y), (t(k + gap), cb.x, cb.y)),
-                    second: other.map(|o| (clip.files()[k].index as usize, o.x, o.y)),
-                }));
+            if let Some(pair) = self.pair_at(k, pass)? {
+                return Ok(Some(self.acquired(k, &pair)));
             }
             k += gap;
         }
         Ok(None)
+    }
+
+    /// The ball moving cleanly in the clip's first pair of files, the common case, found without going through
+    /// the clip band by band: bands largest first and every vote source, as [`acquire`] orders them, but at
+    /// the first pair only. A circle there that lies inside a larger moving one (centred in the frame or beyond
+    /// its edge, at any quality acquisition considers) is not taken: it may be a seam's lobe on a ball whose
+    /// rim is not yet clean or not yet in view, which the full search settles. The first band with a circle
+    /// in the first file (any acquisition considers) that is not the ball there (at rest, cut by the frame's
+    /// edge, or a ball moving too little yet) ends this search: the full search starts with the same bands
+    /// and frames, so a miss costs little, where going on through the smaller bands (the costliest, at full
+    /// resolution) would cost the most.
+    fn at_first_pair(&mut self, bands: &[(f64, f64)]) -> Result<Option<Acquired>, TrackError> {
+        if self.gap >= self.clip.len() {
+            return Ok(None);
+        }
+        for (band, &radii) in bands.iter().enumerate() {
+            let mut seen = false;
+            for (voters, votes) in self.sources() {
+                let pass = Pass {
+                    threshold: CLEAN_QUALITY,
+                    band,
+                    radii,
+                    beyond_edge: false,
+                    votes,
+                    voters,
+                };
+                if let Some(pair) = self.pair_at(0, &pass)? {
+                    if !self.on_still_ground(&pair.a) && self.inside_larger_moving(&pair.a, &bands[..band])? {
+                        return Ok(None);
+                    }
+                    return Ok(Some(self.acquired(0, &pair)));
+                }
+                seen |= !self.circles(0, &pass)?.is_empty();
+            }
+            if seen {
+                return Ok(None);
+            }
+        }
+        Ok(None)
+    }
+
+    /// The vote sources in the order they are tried: the strongest voters before all significant ones, moving
+    /// votes before the frame's (moving votes only with a background).
+    fn sources(&self) -> Vec<(Voters, Votes)> {
+        let mut out = Vec::new();
+        for voters in [Voters::Strongest, Voters::AboveNoise] {
+            for votes in [Votes::Moving, Votes::Frame] {
+                if votes == Votes::Frame || self.background.is_some() {
+                    out.push((voters, votes));
+                }
+            }
+        }
+        out
+    }
+
+    /// Whether what surrounds `c`, seen in the first file, stays still ([`ring_motion`] below
+    /// [`STILL_RING_SIGMAS`]): then `c` is not a mark on something larger that moves, and the search for such a
+    /// thing ([`Self::inside_larger_moving`]) is not needed. `false` without a background.
+    fn on_still_ground(&self, c: &Circle) -> bool {
+        let (w, h) = self.frames.size();
+        self.frames
+            .moving
+            .get(&0)
+            .and_then(|m| ring_motion(&Plane::new(m, w, h), c, self.noise))
+            .is_some_and(|z| z < STILL_RING_SIGMAS)
+    }
+
+    /// Whether `c`, seen in the first file, lies inside a circle of one of the `larger` radius bands that moves
+    /// between the first pair of files (its centre within that circle, which is at least 1.2 times as large),
+    /// seen at [`CANDIDATE_QUALITY`] or better, centred in the frame or beyond its edge.
+    fn inside_larger_moving(&mut self, c: &Circle, larger: &[(f64, f64)]) -> Result<bool, TrackError> {
+        for (band, &radii) in larger.iter().enumerate() {
+            for beyond_edge in [false, true] {
+                for (voters, votes) in self.sources() {
+                    let pass = Pass {
+                        threshold: CANDIDATE_QUALITY,
+                        band,
+                        radii,
+                        beyond_edge,
+                        votes,
+                        voters,
+                    };
+                    let here = self.circles(0, &pass)?;
+                    let there = self.circles(self.gap, &pass)?;
+                    let (moved, _) = split_static(&here, &there);
+                    let contains = |s: &Seen| {
+                        let o = &s.circle;
+                        o.r >= 1.2 * c.r && (o.x - c.x).hypot(o.y - c.y) < o.r
+                    };
+                    if moved.iter().any(contains) {
+                        return Ok(true);
+                    }
+                }
+            }
+        }
+        Ok(false)
+    }
+
+    /// The ball's two sightings in files `k` and `k + gap` in this pass ([`moving_pair`]), if it moved there.
+    /// The clean frame pass also notes the circles that stayed.
+    fn pair_at(&mut self, k: usize, pass: &Pass) -> Result<Option<MovingPair>, TrackError> {
+        let (gap, width) = (self.gap, self.width);
+        let good = |s: &Seen| s.circle.support > pass.threshold;
+        let a: Vec<Seen> = self.circles(k, pass)?.into_iter().filter(good).collect();
+        let b: Vec<Seen> = self.circles(k + gap, pass)?.into_iter().filter(good).collect();
+        let (a_moved, a_static) = split_static(&a, &b);
+        let (b_moved, _) = split_static(&b, &a);
+        let loose = |s: &Seen| s.circle.support > CANDIDATE_QUALITY;
+        let a_all: Vec<Seen> = self.circles(k, pass)?.into_iter().filter(loose).collect();
+        let b_all: Vec<Seen> = self.circles(k + gap, pass)?.into_iter().filter(loose).collect();
+        let (a_loose, _) = split_static(&a_all, &b_all);
+        let (b_loose, _) = split_static(&b_all, &a_all);
+        if pass.threshold == CLEAN_QUALITY
+            && !pass.beyond_edge
+            && pass.votes == Votes::Frame
+            && pass.voters == Voters::Strongest
+        {
+            for c in a_static.iter().map(|s| &s.circle) {
+                if !self.still.iter().any(|s| (s.0 - c.x).hypot(s.1 - c.y) < 0.5 * c.r) {
+                    self.still.push((c.x, c.y, c.r, c.support));
+                }
+            }
+        }
+        moving_pair(
+            &a_moved,
+            &b_moved,
+            (&a_loose, &b_loose),
+            width,
+            pass.threshold,
+            |mx, my, r, reach, least| {
+                Ok(gap < 2
+                    || self.circles(k + gap / 2, pass)?.iter().map(|s| &s.circle).any(|c| {
+                        c.support > least && (c.x - mx).hypot(c.y - my) <= reach && (c.r - r).abs() <= 0.05 * r + 1.0
+                    }))
+            },
+        )
+    }
+
+    /// What acquisition learnt from the moving pair seen in files `k` and `k + gap`.
+    fn acquired(&self, k: usize, pair: &MovingPair) -> Acquired {
+        let r = 0.5 * (pair.a.r + pair.b.r);
+        // `k` counts files; time follows frame indices, which count dropped frames too.
+        let clip = self.clip;
+        let t = |pos: usize| clip.time_of(clip.files()[pos].index);
+        Acquired {
+            radius: radius_window(r),
+            seed: ((t(k), pair.a.x, pair.a.y), (t(k + self.gap), pair.b.x, pair.b.y)),
+            second: pair.other.map(|o| (clip.files()[k].index as usize, o.x, o.y)),
+        }
     }
 }
 
@@ -245,6 +355,10 @@ fn nothing_moved(clip: &Clip, mut still: Vec<(f64, f64, f64, f64)>, min_radius: 
             .join(", "),
     }
 }
+
+/// The most [`ring_motion`] round a circle standing on still ground: a few times the ≈ 0.7 σ of noise alone,
+/// well under the tens of gray levels between a ball and its backdrop.
+const STILL_RING_SIGMAS: f64 = 3.0;
 
 /// The least distance between a pair's two sightings for it to count as moving, px.
 const MIN_PAIR_MOVE_PX: f64 = 1.5;
@@ -393,6 +507,19 @@ const MIN_DISC_CONTRAST: f64 = 1.0;
 /// same texture inside as outside (contrast well below 1). Pixels outside the image are skipped; 0 when
 /// fewer than 16 remain on either side. Cost: O(r²) pixel reads on a grid of step r / 12.
 fn disc_contrast<P: Pixel>(img: &Plane<P>, x: f64, y: f64, r: f64) -> f64 {
+    let (mut inside, mut ring) = disc_and_ring(img, x, y, r);
+    if inside.len() < 16 || ring.len() < 16 {
+        return 0.0;
+    }
+    let m_in = median(&mut inside);
+    let m_out = median(&mut ring);
+    let mut dev: Vec<f64> = ring.iter().map(|v| (v - m_out).abs()).collect();
+    (m_in - m_out).abs() / (1.4826 * median(&mut dev)).max(1.0)
+}
+
+/// The image's levels on a grid of step r / 12 (at least a pixel) within 0.8 r of (x, y), and on the ring
+/// 1.2 r … 1.6 r around it; pixels outside the image skipped. Cost: O(r²) pixel reads.
+fn disc_and_ring<P: Pixel>(img: &Plane<P>, x: f64, y: f64, r: f64) -> (Vec<f64>, Vec<f64>) {
     let step = (r / 12.0).max(1.0);
     let reach = 1.6 * r;
     let (mut inside, mut ring) = (Vec::new(), Vec::new());
@@ -413,13 +540,16 @@ fn disc_contrast<P: Pixel>(img: &Plane<P>, x: f64, y: f64, r: f64) -> f64 {
             }
         }
     }
-    if inside.len() < 16 || ring.len() < 16 {
-        return 0.0;
-    }
-    let m_in = median(&mut inside);
-    let m_out = median(&mut ring);
-    let mut dev: Vec<f64> = ring.iter().map(|v| (v - m_out).abs()).collect();
-    (m_in - m_out).abs() / (1.4826 * median(&mut dev)).max(1.0)
+    (inside, ring)
+}
+
+/// How far the ring 1.2 r … 1.6 r around a circle is from still, in a frame's difference from the background
+/// (`moving`): the ring's median difference over the sensor noise σ (floored at one gray level). Around a
+/// ball the ring is the backdrop, still but for noise (≈ 0.7); around a mark printed on a ball it is the
+/// ball, moving. `None` when fewer than 16 ring pixels are in view.
+fn ring_motion(moving: &Plane<f32>, c: &Circle, noise: f32) -> Option<f64> {
+    let (_, mut ring) = disc_and_ring(moving, c.x, c.y, c.r);
+    (ring.len() >= 16).then(|| median(&mut ring) / f64::from(noise.max(1.0)))
 }
 
 fn median(v: &mut [f64]) -> f64 {
@@ -459,13 +589,54 @@ fn look_correlation(a: &[f32], b: &[f32]) -> f64 {
     sab / (saa * sbb).sqrt()
 }
 
+/// Pixels sorted side by side in [`pixel_median`]: the compare-exchanges of a block run in SIMD lanes.
+const MEDIAN_LANES: usize = 64;
+
+/// The per-pixel median of `planes` (all of one length): at each pixel the value of rank `planes.len() / 2`
+/// (the upper median for an even count). An odd–even transposition network sorts each pixel's values
+/// ([`MEDIAN_LANES`] pixels at a time), branch-free, where a selection per pixel branches on every value.
+/// Cost: m(m − 1)/2 min–max pairs per pixel for m planes.
+fn pixel_median(planes: &[Vec<f32>]) -> Vec<f32> {
+    let m = planes.len();
+    let len = planes.first().map_or(0, Vec::len);
+    let mut out = vec![0.0f32; len];
+    if m == 0 {
+        return out;
+    }
+    let mut block = vec![[0.0f32; MEDIAN_LANES]; m];
+    for start in (0..len).step_by(MEDIAN_LANES) {
+        let n = MEDIAN_LANES.min(len - start);
+        for (b, p) in block.iter_mut().zip(planes) {
+            b[..n].copy_from_slice(&p[start..start + n]);
+        }
+        for round in 0..m {
+            for i in (round % 2..m.saturating_sub(1)).step_by(2) {
+                let (lo, hi) = block.split_at_mut(i + 1);
+                for (a, b) in lo[i].iter_mut().zip(hi[0].iter_mut()) {
+                    let (x, y) = (*a, *b);
+                    *a = x.min(y);
+                    *b = x.max(y);
+                }
+            }
+        }
+        out[start..start + n].copy_from_slice(&block[m / 2][..n]);
+    }
+    out
+}
+
 /// Frames decoded once each, by file position.
 struct FrameCache<'a> {
     clip: &'a Clip,
     opts: &'a ClipTracking,
     gain: f32,
     frames: HashMap<usize, Frame>,
+    /// Frames' differences from the background (see [`FrameCache::keep_moving`]).
+    moving: HashMap<usize, Vec<f32>>,
 }
+
+/// Frames' differences from the background kept at once: the pairs and half-way frames being compared (a
+/// 512×512 frame's is 1 MB).
+const MOVING_KEPT: usize = 8;
 
 impl<'a> FrameCache<'a> {
     fn new(clip: &'a Clip, opts: &'a ClipTracking, gain: f32) -> Self {
@@ -474,6 +645,7 @@ impl<'a> FrameCache<'a> {
             opts,
             gain,
             frames: HashMap::new(),
+            moving: HashMap::new(),
         }
     }
 
@@ -499,6 +671,26 @@ impl<'a> FrameCache<'a> {
         ))
     }
 
+    /// The searched region's width and height, px.
+    fn size(&self) -> (usize, usize) {
+        let (w, h) = self.opts.roi.map_or(self.clip.dimensions(), |r| (r.width, r.height));
+        (w as usize, h as usize)
+    }
+
+    /// Keeps frame `k`'s difference from the background `bg` (levels, 0–255 scale): what moves. Computed once
+    /// for every radius band and vote source that asks; all are let go when [`MOVING_KEPT`] are held.
+    fn keep_moving(&mut self, k: usize, bg: &[f32]) -> Result<(), TrackError> {
+        if self.moving.contains_key(&k) {
+            return Ok(());
+        }
+        if self.moving.len() >= MOVING_KEPT {
+            self.moving.clear();
+        }
+        let m = self.levels(k)?.iter().zip(bg).map(|(a, b)| (a - b).abs()).collect();
+        self.moving.insert(k, m);
+        Ok(())
+    }
+
     /// The per-pixel median of [`BACKGROUND_FRAMES`] frames spread over the clip: the scene without what
     /// moves. `None` for a clip of fewer than 5 frames. Cost: that many decodes and a median of as many values
     /// per pixel.
@@ -510,15 +702,7 @@ impl<'a> FrameCache<'a> {
         let m = BACKGROUND_FRAMES.min(n);
         let picks: Vec<usize> = (0..m).map(|i| i * (n - 1) / (m - 1)).collect();
         let planes: Vec<Vec<f32>> = picks.iter().map(|&k| self.levels(k)).collect::<Result<_, _>>()?;
-        let len = planes[0].len();
-        let mut column = vec![0.0f32; m];
-        let mut out = vec![0.0f32; len];
-        for (i, o) in out.iter_mut().enumerate() {
-            for (c, p) in column.iter_mut().zip(&planes) {
-                *c = p[i];
-            }
-            *o = *column.select_nth_unstable_by(m / 2, f32::total_cmp).1;
-        }
+        let out = pixel_median(&planes);
         // Frames other than the first and last are not needed again.
         for &k in &picks[1..m - 1] {
             self.frames.remove(&k);
@@ -534,24 +718,18 @@ impl<'a> FrameCache<'a> {
         votes: Votes,
         background: Option<&[f32]>,
     ) -> Result<Vec<Seen>, TrackError> {
-        let (w, h) = self.opts.roi.map_or(self.clip.dimensions(), |r| (r.width, r.height));
-        let (w, h) = (w as usize, h as usize);
-        let moving: Option<Vec<f32>> = match background {
-            Some(bg) => Some(self.levels(k)?.iter().zip(bg).map(|(a, b)| (a - b).abs()).collect()),
-            None => None,
-        };
+        let (w, h) = self.size();
+        if let Some(bg) = background {
+            self.keep_moving(k, bg)?;
+        }
+        self.get(k)?;
+        let (f, gain) = (&self.frames[&k], self.gain);
+        let moving = background.map(|_| Plane::new(&self.moving[&k], w, h));
         let peaks = match (votes, &moving) {
-            (Votes::Moving, Some(m)) => detect_circles(&Plane::new(m, w, h), det),
-            _ => {
-                let gain = self.gain;
-                let f = self.get(k)?;
-                with_plane(&f.pixels, gain, |p| on_plane!(p, p => detect_circles(&p, det)))
-            }
+            (Votes::Moving, Some(m)) => detect_circles(m, det),
+            _ => with_plane(&f.pixels, gain, |p| on_plane!(p, p => detect_circles(&p, det))),
         };
-        let gain = self.gain;
         let search = &self.opts.tracker.search;
-        let f = self.get(k)?;
-        let moving = moving.as_ref().map(|m| Plane::new(m, w, h));
         Ok(with_plane(&f.pixels, gain, |p| {
             on_plane!(p, p => refine_candidates(&p, peaks, det, search, None, CANDIDATE_QUALITY)
                 .into_iter()
@@ -571,6 +749,20 @@ impl<'a> FrameCache<'a> {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn the_pixel_median_is_the_middle_value_at_every_pixel() {
+        use proptest::prelude::*;
+        let planes = proptest::collection::vec(proptest::collection::vec(-300.0f32..300.0, 150), 1..12);
+        proptest!(|(planes in planes)| {
+            let got = pixel_median(&planes);
+            for (i, g) in got.iter().enumerate() {
+                let mut column: Vec<f32> = planes.iter().map(|p| p[i]).collect();
+                let m = column.len();
+                prop_assert_eq!(*g, *column.select_nth_unstable_by(m / 2, f32::total_cmp).1);
+            }
+        });
+    }
+
     #[test]
     fn the_sighting_gap_is_a_time_not_a_frame_count() {
         use super::sighting_gap;
@@ -646,6 +838,39 @@ mod tests {
             let c = disc_contrast(&Plane::new(&grains, 256, 256), 128.0, 128.0, 30.0);
             assert!(c < 0.5 * MIN_DISC_CONTRAST, "grains {level}/{grain}: {c}");
         }
+    }
+
+    #[test]
+    fn a_ball_stands_on_still_ground_and_a_mark_on_it_does_not() {
+        let noise = 3.0;
+        let scene = Scene {
+            marks: vec![(5.0, 10.0, 12.0, 40.0)],
+            noise,
+            ..Scene::default()
+        };
+        let backdrop = render(&Scene {
+            ball: (-500.0, -500.0, 1.0),
+            seed: 2,
+            ..scene.clone()
+        });
+        let frame = render(&scene);
+        let moving: Vec<f32> = frame
+            .iter()
+            .zip(&backdrop)
+            .map(|(&a, &b)| (f32::from(a) - f32::from(b)).abs())
+            .collect();
+        let moving = Plane::new(&moving, 256, 256);
+        let (x, y, r) = scene.ball;
+        let ball = ring_motion(&moving, &Circle { x, y, r, support: 1.0 }, noise as f32).unwrap();
+        assert!(ball < STILL_RING_SIGMAS, "ball {ball}");
+        let mark = Circle {
+            x: x + 5.0,
+            y: y + 10.0,
+            r: 12.0,
+            support: 1.0,
+        };
+        let mark = ring_motion(&moving, &mark, noise as f32).unwrap();
+        assert!(mark > 3.0 * STILL_RING_SIGMAS, "mark {mark}");
     }
 
     #[test]

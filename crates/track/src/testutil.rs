@@ -1,6 +1,6 @@
-//! Small synthetic frames for tests: a shaded disc with sub-pixel centre over a gradient backdrop, an
-//! optional textured surface band that hides the disc below its top edge, distractor discs and noise, drawn
-//! with the workspace's one seeded generator (`bouncelab_testkit::Rng`).
+//! Small synthetic frames for tests: a shaded disc with sub-pixel centre over a gradient backdrop, marks on
+//! the disc, an optional textured surface band that hides the disc below its top edge, distractor discs and
+//! noise, drawn with the workspace's one seeded generator (`bouncelab_testkit::Rng`).
 
 use bouncelab_testkit::Rng;
 
@@ -21,6 +21,8 @@ pub struct Scene {
     pub band: (f64, f64),
     /// Other discs (x, y, r, level).
     pub distractors: Vec<(f64, f64, f64, f64)>,
+    /// Discs drawn on the ball, moving with it (dx, dy from its centre, r, level): a print, a seam's lobe.
+    pub marks: Vec<(f64, f64, f64, f64)>,
     /// Gaussian noise standard deviation, 0–255 scale.
     pub noise: f64,
     /// Noise seed.
@@ -39,6 +41,7 @@ impl Default for Scene {
             surface: None,
             band: (90.0, 25.0),
             distractors: Vec::new(),
+            marks: Vec::new(),
             noise: 2.0,
             seed: 1,
             roughness: 0.0,
@@ -57,6 +60,7 @@ pub fn opencv_scene(ball: (f64, f64, f64), seed: u64) -> Scene {
         surface: Some((430.0, 0.02)),
         band: (120.0, 50.0),
         distractors: vec![(450.0, 80.0, 9.0, 40.0)],
+        marks: Vec::new(),
         noise: 5.0,
         seed,
         roughness: 0.0,
@@ -119,6 +123,10 @@ pub fn render(scene: &Scene) -> Vec<u8> {
                 let (nx, ny) = ((x as f64 - cx) / r, (y as f64 - cy) / r);
                 let shade = 0.75 + 0.25 * (-0.5 * nx - 0.6 * ny).clamp(-1.0, 1.0);
                 v = v * (1.0 - c) + scene.ball_level * shade * c;
+                for &(dx, dy, dr, level) in &scene.marks {
+                    let m = c.min(coverage(x, y, cx + dx, cy + dy, dr));
+                    v = v * (1.0 - m) + level * m;
+                }
             }
             if let Some((y0, slope)) = scene.surface {
                 let edge = y0 + slope * (x as f64 - xc) + scene.roughness * ragged[x] / peak;

@@ -34,6 +34,42 @@ fn bounce(i: usize) -> Scene {
     }
 }
 
+/// A ball of radius 60 px falling into view from above the frame (its centre at y = −10 px in frame 0, 4 px
+/// lower each frame), with a dark lobe of radius 12 px printed on its visible cap.
+fn falling_y(i: usize) -> f64 {
+    -10.0 + 4.0 * i as f64
+}
+
+fn falling_into_view(i: usize) -> Scene {
+    Scene {
+        ball: (128.0, falling_y(i), 60.0),
+        marks: vec![(0.0, 30.0, 12.0, 40.0)],
+        seed: i as u64,
+        ..Scene::default()
+    }
+}
+
+/// In the first frames the lobe is a clean moving circle inside the frame and the ball's rim is not: the
+/// circle that moves is the lobe's, but it lies inside the larger moving circle of the ball's cap, so it is not
+/// taken for the ball; once the ball is in view its rim is.
+#[test]
+fn a_lobe_printed_on_a_ball_still_out_of_view_is_not_the_ball() {
+    let dir = tempfile::tempdir().unwrap();
+    write_clip(dir.path(), 64, falling_into_view);
+    let clip = Clip::open(dir.path()).unwrap();
+    let track = track_clip(&clip, &ClipTracking::default(), |_, _| {}).unwrap();
+    // The ball is whole in view from frame 18 to 51.
+    let whole: Vec<_> = track.fixes.iter().filter(|f| (18..=51).contains(&f.frame)).collect();
+    assert_eq!(whole.len(), 34);
+    for f in whole {
+        let y = falling_y(f.frame);
+        assert!(
+            (f.r_px - 60.0).abs() < 1.0 && (f.x_px - 128.0).abs() < 1.0 && (f.y_px - y).abs() < 1.0,
+            "{f:?}"
+        );
+    }
+}
+
 #[test]
 fn the_moving_circle_is_the_ball_and_the_scale_follows_from_its_radius() {
     let dir = tempfile::tempdir().unwrap();
