@@ -264,14 +264,17 @@ impl PairSearch<'_> {
                         votes,
                         voters,
                     };
-                    let here = self.circles(0, &pass)?;
-                    let there = self.circles(self.gap, &pass)?;
-                    let (moved, _) = split_static(&here, &there);
                     let contains = |s: &Seen| {
                         let o = &s.circle;
                         o.r >= 1.2 * c.r && (o.x - c.x).hypot(o.y - c.y) < o.r
                     };
-                    if moved.iter().any(contains) {
+                    let here: Vec<Seen> = self.circles(0, &pass)?.into_iter().filter(contains).collect();
+                    // Only a circle that holds `c` is asked whether it moved.
+                    if here.is_empty() {
+                        continue;
+                    }
+                    let there = self.circles(self.gap, &pass)?;
+                    if !split_static(&here, &there).0.is_empty() {
                         return Ok(true);
                     }
                 }
@@ -286,6 +289,10 @@ impl PairSearch<'_> {
         let (gap, width) = (self.gap, self.width);
         let good = |s: &Seen| s.circle.support > pass.threshold;
         let a: Vec<Seen> = self.circles(k, pass)?.into_iter().filter(good).collect();
+        // Nothing in the first file, no pair (and nothing that stayed): the second is not looked at.
+        if a.is_empty() {
+            return Ok(None);
+        }
         let b: Vec<Seen> = self.circles(k + gap, pass)?.into_iter().filter(good).collect();
         let (a_moved, a_static) = split_static(&a, &b);
         let (b_moved, _) = split_static(&b, &a);
