@@ -34,12 +34,13 @@ fn bounce(i: usize) -> Scene {
     }
 }
 
-/// A ball of radius 60 px falling into view from above the frame (its centre at y = −10 px in frame 0, 4 px
-/// lower each frame), with a dark lobe of radius 12 px printed on its visible cap.
+/// The falling ball's centre height in frame `i`, px: above the frame at first, 4 px lower each frame.
 fn falling_y(i: usize) -> f64 {
     -10.0 + 4.0 * i as f64
 }
 
+/// A ball of radius 60 px falling into view from above the frame (its centre at y = −10 px in frame 0), with
+/// a dark lobe of radius 12 px printed on its visible cap.
 fn falling_into_view(i: usize) -> Scene {
     Scene {
         ball: (128.0, falling_y(i), 60.0),
