@@ -3,7 +3,7 @@
 
 use bouncelab_frames::Clip;
 use bouncelab_track::testutil::{Scene, render};
-use bouncelab_track::{ClipTracking, TrackError, track_clip};
+use bouncelab_track::{ClipTracking, Track, TrackError, track_clip};
 use std::path::Path;
 
 fn path(i: usize) -> (f64, f64) {
@@ -19,6 +19,14 @@ fn write_clip(dir: &Path, frames: usize, scene: impl Fn(usize) -> Scene) {
         let img = image::GrayImage::from_raw(s.size.0 as u32, s.size.1 as u32, px).unwrap();
         img.save(dir.join(format!("C001H001S0001{:06}.png", 1000 + i))).unwrap();
     }
+}
+
+/// The clip of `frames` frames drawn by `scene`, written to a temporary folder and tracked with the defaults.
+fn tracked(frames: usize, scene: impl Fn(usize) -> Scene) -> Track {
+    let dir = tempfile::tempdir().unwrap();
+    write_clip(dir.path(), frames, scene);
+    let clip = Clip::open(dir.path()).unwrap();
+    track_clip(&clip, &ClipTracking::default(), |_, _| {}).unwrap()
 }
 
 fn bounce(i: usize) -> Scene {
@@ -55,10 +63,7 @@ fn falling_into_view(i: usize) -> Scene {
 /// taken for the ball; once the ball is in view its rim is.
 #[test]
 fn a_lobe_printed_on_a_ball_still_out_of_view_is_not_the_ball() {
-    let dir = tempfile::tempdir().unwrap();
-    write_clip(dir.path(), 64, falling_into_view);
-    let clip = Clip::open(dir.path()).unwrap();
-    let track = track_clip(&clip, &ClipTracking::default(), |_, _| {}).unwrap();
+    let track = tracked(64, falling_into_view);
     // The ball is whole in view from frame 18 to 51.
     let whole: Vec<_> = track.fixes.iter().filter(|f| (18..=51).contains(&f.frame)).collect();
     assert_eq!(whole.len(), 34);
@@ -73,10 +78,7 @@ fn a_lobe_printed_on_a_ball_still_out_of_view_is_not_the_ball() {
 
 #[test]
 fn the_moving_circle_is_the_ball_and_the_scale_follows_from_its_radius() {
-    let dir = tempfile::tempdir().unwrap();
-    write_clip(dir.path(), 40, bounce);
-    let clip = Clip::open(dir.path()).unwrap();
-    let track = track_clip(&clip, &ClipTracking::default(), |_, _| {}).unwrap();
+    let track = tracked(40, bounce);
     assert_eq!(track.fixes.len(), 40);
     for f in &track.fixes {
         let (x, y) = path(f.frame);
@@ -144,8 +146,7 @@ fn a_clip_where_nothing_moves_names_the_static_circles() {
 /// much clearer it is.
 #[test]
 fn a_faint_moving_ball_beats_a_clear_static_screw() {
-    let dir = tempfile::tempdir().unwrap();
-    write_clip(dir.path(), 40, |i| {
+    let track = tracked(40, |i| {
         let (x, y) = path(i);
         Scene {
             ball: (x, y, 40.0),
@@ -158,8 +159,6 @@ fn a_faint_moving_ball_beats_a_clear_static_screw() {
             ..Scene::default()
         }
     });
-    let clip = Clip::open(dir.path()).unwrap();
-    let track = track_clip(&clip, &ClipTracking::default(), |_, _| {}).unwrap();
     for f in track.fixes.iter().filter(|f| f.status.measured()) {
         let (x, y) = path(f.frame);
         assert!(
