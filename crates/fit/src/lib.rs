@@ -35,7 +35,8 @@ pub use problem::{Problem, profile_surface_level, surface_prior, weighted_residu
 pub use result::{FitResult, FittedParam, MAX_RELATIVE_STD_ERROR, ObliqueRow, ShotFit, SurfaceError};
 pub use shot::{MeasuredFrame, MeasuredOutputs, MeasuredShot, StartState};
 pub use solver::{
-    Iteration, IterationObserver, LeastSquares, LevenbergMarquardt, LogObserver, NoObserver, SolverOutcome, Termination,
+    Differences, Iteration, IterationObserver, LeastSquares, LevenbergMarquardt, LogObserver, NoObserver,
+    SolverOutcome, Termination,
 };
 pub use surface_level::{SURFACE_LEVEL_RANGE_M, add_surface_level};
 pub use suspect::{

@@ -184,43 +184,65 @@ impl PairSearch<'_> {
         Ok(None)
     }
 
-    /// The ball moving cleanly in the clip's first pair of files, the common case, found without going through
-    /// the clip band by band: bands largest first and every vote source, as [`acquire`] orders them, but at
-    /// the first pair only. A circle there that lies inside a larger moving one (centred in the frame or beyond
-    /// its edge, at any quality acquisition considers) is not taken: it may be a seam's lobe on a ball whose
-    /// rim is not yet clean or not yet in view, which the full search settles. The first band with a circle
-    /// in the first file (any acquisition considers) that is not the ball there (at rest, cut by the frame's
-    /// edge, or a ball moving too little yet) ends this search: the full search starts with the same bands
-    /// and frames, so a miss costs little, where going on through the smaller bands (the costliest, at full
-    /// resolution) would cost the most.
+    /// The ball moving cleanly near the clip's start, the common case, found without going through the clip
+    /// band by band: bands largest first and every vote source, as [`acquire`] orders them, at the first pair
+    /// of files. The first band with a circle in the first file (any acquisition considers) ends the bands:
+    /// the full search starts with the same bands and frames, so a miss costs little, where going on through
+    /// the smaller bands (the costliest, at full resolution) would cost the most. When that circle is not yet
+    /// the ball (cut by the frame's edge, or moving too little in one gap), the next [`EARLY_PAIRS`] pairs
+    /// are tried in its band: the ball's band shows from the first file on. A circle that lies inside a larger
+    /// moving one (centred in the frame or beyond its edge, at any quality acquisition considers) is not taken:
+    /// it may be a seam's lobe on a ball whose rim is not yet clean or not yet in view, which the full search
+    /// settles.
     fn at_first_pair(&mut self, bands: &[(f64, f64)]) -> Result<Option<Acquired>, TrackError> {
-        if self.gap >= self.clip.len() {
+        let (n, gap) = (self.clip.len(), self.gap);
+        if gap >= n {
             return Ok(None);
         }
-        for (band, &radii) in bands.iter().enumerate() {
-            let mut seen = false;
-            for (voters, votes) in self.sources() {
-                let pass = Pass {
-                    threshold: CLEAN_QUALITY,
-                    band,
-                    radii,
-                    beyond_edge: false,
-                    votes,
-                    voters,
-                };
-                if let Some(pair) = self.pair_at(0, &pass)? {
-                    if !self.on_still_ground(&pair.a) && self.inside_larger_moving(&pair.a, &bands[..band])? {
-                        return Ok(None);
-                    }
-                    return Ok(Some(self.acquired(0, &pair)));
+        for band in 0..bands.len() {
+            match self.early_pair_at(0, band, bands)? {
+                Early::Nothing => continue,
+                Early::Ball(found) => return Ok(Some(found)),
+                Early::Lobe => return Ok(None),
+                Early::Seen => {}
+            }
+            for k in (1..=EARLY_PAIRS)
+                .map(|i| i * gap)
+                .take_while(|&k| k + gap < n && k <= n / 2)
+            {
+                match self.early_pair_at(k, band, bands)? {
+                    Early::Ball(found) => return Ok(Some(found)),
+                    Early::Lobe => return Ok(None),
+                    Early::Nothing | Early::Seen => {}
                 }
-                seen |= !self.circles(0, &pass)?.is_empty();
             }
-            if seen {
-                return Ok(None);
-            }
+            return Ok(None);
         }
         Ok(None)
+    }
+
+    /// The clean pair at files `k` and `k + gap` in radius band `band` of `bands`, every vote source in turn
+    /// (see [`Self::at_first_pair`]).
+    fn early_pair_at(&mut self, k: usize, band: usize, bands: &[(f64, f64)]) -> Result<Early, TrackError> {
+        let mut seen = false;
+        for (voters, votes) in self.sources() {
+            let pass = Pass {
+                threshold: CLEAN_QUALITY,
+                band,
+                radii: bands[band],
+                beyond_edge: false,
+                votes,
+                voters,
+            };
+            if let Some(pair) = self.pair_at(k, &pass)? {
+                if !self.on_still_ground(k, &pair.a)? && self.inside_larger_moving(k, &pair.a, &bands[..band])? {
+                    return Ok(Early::Lobe);
+                }
+                return Ok(Early::Ball(self.acquired(k, &pair)));
+            }
+            seen |= !self.circles(k, &pass)?.is_empty();
+        }
+        Ok(if seen { Early::Seen } else { Early::Nothing })
     }
 
     /// The vote sources in the order they are tried: the strongest voters before all significant ones, moving
@@ -237,22 +259,23 @@ impl PairSearch<'_> {
         out
     }
 
-    /// Whether what surrounds `c`, seen in the first file, stays still ([`ring_motion`] below
+    /// Whether what surrounds `c`, seen in file `k`, stays still ([`ring_motion`] below
     /// [`STILL_RING_SIGMAS`]): then `c` is not a mark on something larger that moves, and the search for such a
     /// thing ([`Self::inside_larger_moving`]) is not needed. `false` without a background.
-    fn on_still_ground(&self, c: &Circle) -> bool {
+    fn on_still_ground(&mut self, k: usize, c: &Circle) -> Result<bool, TrackError> {
+        let Some(bg) = &self.background else {
+            return Ok(false);
+        };
+        self.frames.keep_moving(k, bg)?;
         let (w, h) = self.frames.size();
-        self.frames
-            .moving
-            .get(&0)
-            .and_then(|m| ring_motion(&Plane::new(m, w, h), c, self.noise))
-            .is_some_and(|z| z < STILL_RING_SIGMAS)
+        let z = ring_motion(&Plane::new(&self.frames.moving[&k], w, h), c, self.noise);
+        Ok(z.is_some_and(|z| z < STILL_RING_SIGMAS))
     }
 
-    /// Whether `c`, seen in the first file, lies inside a circle of one of the `larger` radius bands that moves
-    /// between the first pair of files (its centre within that circle, which is at least 1.2 times as large),
+    /// Whether `c`, seen in file `k`, lies inside a circle of one of the `larger` radius bands that moves
+    /// between files `k` and `k + gap` (its centre within that circle, which is at least 1.2 times as large),
     /// seen at [`CANDIDATE_QUALITY`] or better, centred in the frame or beyond its edge.
-    fn inside_larger_moving(&mut self, c: &Circle, larger: &[(f64, f64)]) -> Result<bool, TrackError> {
+    fn inside_larger_moving(&mut self, k: usize, c: &Circle, larger: &[(f64, f64)]) -> Result<bool, TrackError> {
         for (band, &radii) in larger.iter().enumerate() {
             for beyond_edge in [false, true] {
                 for (voters, votes) in self.sources() {
@@ -268,12 +291,12 @@ impl PairSearch<'_> {
                         let o = &s.circle;
                         o.r >= 1.2 * c.r && (o.x - c.x).hypot(o.y - c.y) < o.r
                     };
-                    let here: Vec<Seen> = self.circles(0, &pass)?.into_iter().filter(contains).collect();
+                    let here: Vec<Seen> = self.circles(k, &pass)?.into_iter().filter(contains).collect();
                     // Only a circle that holds `c` is asked whether it moved.
                     if here.is_empty() {
                         continue;
                     }
-                    let there = self.circles(self.gap, &pass)?;
+                    let there = self.circles(k + self.gap, &pass)?;
                     if !split_static(&here, &there).0.is_empty() {
                         return Ok(true);
                     }
@@ -362,6 +385,23 @@ fn nothing_moved(clip: &Clip, mut still: Vec<(f64, f64, f64, f64)>, min_radius: 
             .join(", "),
     }
 }
+
+/// What one early pair of files showed in one radius band (see [`PairSearch::at_first_pair`]).
+enum Early {
+    /// No circle in the pair's first file.
+    Nothing,
+    /// Circles, none of them the ball moving cleanly.
+    Seen,
+    /// The ball.
+    Ball(Acquired),
+    /// A moving circle inside a larger moving one: left to the full search.
+    Lobe,
+}
+
+/// Pairs of files tried after the first in the band of the first circle seen (see
+/// [`PairSearch::at_first_pair`]): 8 ms at the sighting gap, long enough for a ball cut by the frame's edge
+/// to come into view at drop speeds, or for a slow one to move a twentieth of its radius in a gap.
+const EARLY_PAIRS: usize = 8;
 
 /// The most [`ring_motion`] round a circle standing on still ground: a few times the ≈ 0.7 σ of noise alone,
 /// well under the tens of gray levels between a ball and its backdrop.
