@@ -45,6 +45,7 @@ fn shot_extras(s: &ShotData) -> ShotExtras {
         drop_height_m: Some(s.drop_height_m),
         contact_time_s: Some(s.estimate.contact_ms.value * 1e-3),
         camera_roll_deg: s.track.surface_tilt_deg,
+        camera_roll_se_deg: s.track.surface_tilt_deg.and(s.estimate.surface_tilt_deg).map(|m| m.se),
         spin,
     }
 }

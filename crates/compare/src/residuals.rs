@@ -108,6 +108,9 @@ pub struct ShotExtras {
     pub contact_time_s: Option<f64>,
     /// Camera roll from the surface line's tilt in the image, degrees.
     pub camera_roll_deg: Option<f64>,
+    /// The camera roll's standard error, degrees, if known.
+    #[serde(default)]
+    pub camera_roll_se_deg: Option<f64>,
     /// Measured spin at some of the frame times.
     pub spin: Vec<SpinFrame>,
 }
@@ -190,6 +193,9 @@ pub struct ShotComparison {
     pub drop_height_m: Option<f64>,
     /// Camera roll from the surface line, degrees, if known.
     pub camera_roll_deg: Option<f64>,
+    /// Its standard error, degrees, if known.
+    #[serde(default)]
+    pub camera_roll_se_deg: Option<f64>,
     /// Contact time, measured − predicted, ms, if measured.
     pub contact_time_error_ms: Option<f64>,
     /// One point per frame.
@@ -329,6 +335,7 @@ pub fn compare_shot(
         impact_speed_m_s: imp.state_in.vy.abs(),
         drop_height_m: extras.drop_height_m,
         camera_roll_deg: extras.camera_roll_deg,
+        camera_roll_se_deg: extras.camera_roll_se_deg,
         contact_time_error_ms: extras.contact_time_s.map(|tc| (tc - imp.contact_time()) * 1e3),
         residuals,
         by_phase,

@@ -74,6 +74,7 @@ pub fn synth_shot(
         drop_height_m: Some(height_m),
         contact_time_s: Some(imp.contact_time() + SIGMA_TC * rng.normal()),
         camera_roll_deg: None,
+        camera_roll_se_deg: None,
         spin,
     };
     (shot, extras)
