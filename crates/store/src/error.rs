@@ -147,3 +147,17 @@ pub enum StoreError {
         source: csv::Error,
     },
 }
+
+impl StoreError {
+    /// Whether SQLite answered that the database is busy or locked by another connection.
+    pub(crate) fn is_busy(&self) -> bool {
+        let code = match self {
+            StoreError::Open { source, .. } | StoreError::Sql { source, .. } => source.sqlite_error_code(),
+            _ => None,
+        };
+        matches!(
+            code,
+            Some(rusqlite::ErrorCode::DatabaseBusy | rusqlite::ErrorCode::DatabaseLocked)
+        )
+    }
+}

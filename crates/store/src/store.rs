@@ -98,6 +98,24 @@ impl Store {
     /// migrated to the latest version.
     pub fn open(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref().to_path_buf();
+        // Setting up a new store takes its file's lock exclusively (the switch to WAL, the first migration).
+        // Two runs opening it at once can deadlock there, and SQLite then answers one of them "busy" at
+        // once, without waiting: that one opens again, until the busy timeout.
+        let start = std::time::Instant::now();
+        let mut attempt = 0u32;
+        loop {
+            match Self::open_once(&path) {
+                Err(e) if e.is_busy() && start.elapsed() < BUSY_TIMEOUT => {
+                    attempt += 1;
+                    std::thread::sleep(Duration::from_millis(10 * u64::from(attempt.min(20))));
+                }
+                done => return done,
+            }
+        }
+    }
+
+    fn open_once(path: &Path) -> Result<Self> {
+        let path = path.to_path_buf();
         let conn = Connection::open(&path).map_err(|source| StoreError::Open {
             path: path.clone(),
             source,

@@ -133,3 +133,30 @@ fn the_measuring_lock_makes_a_second_run_wait() {
             .is_none()
     );
 }
+
+/// Runs started together on a new store all open it: setting it up (the switch to WAL, the first migration)
+/// takes the file's lock exclusively, and where two connections deadlock on it SQLite answers one "database
+/// is locked" at once, without waiting (seen failing `two_concurrent_runs_track_each_shot_once`).
+#[test]
+fn runs_opening_a_new_store_at_once_all_open_it() {
+    for round in 0..100 {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("s.sqlite");
+        let barrier = std::sync::Barrier::new(6);
+        std::thread::scope(|s| {
+            let opened: Vec<_> = (0..6)
+                .map(|_| {
+                    s.spawn(|| {
+                        barrier.wait();
+                        Store::open(&path).map(|_| ())
+                    })
+                })
+                .collect();
+            for o in opened {
+                if let Err(e) = o.join().unwrap() {
+                    panic!("round {round}: {e}");
+                }
+            }
+        });
+    }
+}
