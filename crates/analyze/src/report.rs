@@ -858,6 +858,7 @@ fn candidate(c: &bouncelab_diagnose::Candidate) -> r::Candidate {
             param_z: _,
             detection_limit: _,
             cross_validated: _,
+            kept_at_neutral: _,
             fit: _,
         } = e;
         (*error_after, *delta_bic, *heldout_error_after)

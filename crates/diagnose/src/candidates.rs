@@ -102,7 +102,8 @@ pub(crate) fn candidate_names(spec: &ModelSpec) -> Vec<&'static str> {
 /// stiffness, a damping ≥ 0) the search range is mirrored about it (`k_h ∈ (−∞, ∞)`, `φ ∈ [−0.95,
 /// 0.95]`). A fit that wants the other side then finds it (and the candidate is refused as unphysical)
 /// instead of pressing against the bound, where a projected Levenberg–Marquardt creeps for many iterations,
-/// and the distance from neutral in standard errors is an honest test in both directions.
+/// and the distance from neutral in standard errors is an honest test in both directions. Not where the
+/// other side is no model ([`search_range`]).
 pub(crate) fn with_candidate(spec: &ModelSpec, setup: &CandidateSetup) -> Result<ModelSpec, DiagnoseError> {
     let info = library_effect(&setup.effect)?;
     if info.base {
@@ -143,7 +144,7 @@ pub(crate) fn with_candidate(spec: &ModelSpec, setup: &CandidateSetup) -> Result
         .map(|ps| {
             let free = setup.free.iter().find(|(p, _)| p == ps.name);
             let (min, max) = match free {
-                Some(_) => search_range(ps),
+                Some(_) => search_range(info.name, ps),
                 None => (ps.min, ps.max),
             };
             let setting = ParamSetting {
@@ -164,10 +165,19 @@ pub(crate) fn with_candidate(spec: &ModelSpec, setup: &CandidateSetup) -> Result
     Ok(out)
 }
 
-/// The range a search gives a free parameter: its physical range, mirrored about the neutral value where it
-/// ends there.
-pub(crate) fn search_range(p: &ParamSpec) -> (f64, f64) {
+/// Parameters whose other side of the neutral value is no model at all rather than the opposite effect: a
+/// negative tangential compliance is a patch that pushes the contact point along its slip (the simulated
+/// ball leaves at 3.5 m/s where the rigid contact gives 0.4 m/s), so the response jumps at the neutral
+/// value and a fit there is meaningless. Their search range is their physical range.
+const NOT_MIRRORED: &[(&str, &str)] = &[("tangential_spring", "compliance")];
+
+/// The range a search gives a free parameter of `effect`: its physical range, mirrored about the neutral
+/// value where it ends there (except for [`NOT_MIRRORED`]).
+pub(crate) fn search_range(effect: &str, p: &ParamSpec) -> (f64, f64) {
     let (mut lo, mut hi) = (p.min, p.max);
+    if NOT_MIRRORED.contains(&(effect, p.name)) {
+        return (lo, hi);
+    }
     if lo == p.neutral && hi > p.neutral {
         lo = p.neutral - (hi - p.neutral);
     } else if hi == p.neutral && lo < p.neutral {

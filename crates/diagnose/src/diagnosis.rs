@@ -153,6 +153,11 @@ pub struct Evidence {
     /// nothing); its held-out test then counts as failed.
     #[serde(default = "yes")]
     pub cross_validated: bool,
+    /// True when the candidate is reported at its switch's neutral value, i.e. as the current model: no
+    /// value on the scan of its start fitted better, or its fit ended above the neutral value's χ² (a
+    /// response that rings as the parameter moves has local minima the fit can stop in).
+    #[serde(default)]
+    pub kept_at_neutral: bool,
     /// The fit with the candidate (every parameter, base ones refitted too, with intervals).
     pub fit: FitSummary,
 }

@@ -24,6 +24,9 @@ pub(crate) struct Evaluator {
     surfaces: Vec<String>,
     /// Each shot's surface level, m: none, profiled, or held.
     levels: Levels,
+    /// The parameter values (by name) whose model the shots' frame turns were differenced under, when not
+    /// the starting values ([`Evaluator::turn_frames_at`]).
+    turn_point: Option<Vec<(String, f64)>>,
 }
 
 /// How each shot's surface level (the true surface's height in the measured frame) enters.
@@ -70,7 +73,33 @@ impl Evaluator {
             shot_surface,
             surfaces,
             levels,
+            turn_point: None,
         })
+    }
+
+    /// Differences the shots' frame turns under the model at the values `named` (by parameter name; the
+    /// others at their starting values), so that models nested in each other take the turns out alike: the
+    /// current model at its fit and each candidate at its neutral value (see `Problem::turn_frames_at`).
+    pub fn turn_frames_at(&mut self, named: &[(String, f64)]) -> Result<(), FitError> {
+        let mut theta = self.problem.initial();
+        for (j, name) in self.names().iter().enumerate() {
+            if let Some((_, v)) = named.iter().find(|(n, _)| n == name) {
+                theta[j] = *v;
+            }
+        }
+        self.problem.turn_frames_at(&theta)?;
+        self.turn_point = Some(named.to_vec());
+        Ok(())
+    }
+
+    /// The values the frame turns were differenced under, when set by [`Evaluator::turn_frames_at`].
+    pub fn turn_point(&self) -> Option<&[(String, f64)]> {
+        self.turn_point.as_deref()
+    }
+
+    /// Parameter names paired with `theta`'s values.
+    pub fn named(&self, theta: &[f64]) -> Vec<(String, f64)> {
+        self.names().into_iter().zip(theta.iter().copied()).collect()
     }
 
     /// Surface levels start at `levels` (one per shot, m): profiled from there if they are profiled,

@@ -90,6 +90,7 @@ pub(crate) fn evidence_of(
         param_z,
         detection_limit,
         cross_validated: run.cross_validated,
+        kept_at_neutral: run.kept_at_neutral,
         fit: run.summary.clone(),
     });
     cand

@@ -9,6 +9,7 @@ use bouncelab_fit::{
     Termination,
 };
 use bouncelab_model::{ModelSpec, Simulation};
+use nalgebra::DMatrix;
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -24,6 +25,8 @@ pub(crate) struct ModelRun {
     pub n_params: usize,
     /// Each shot's surface level at the full fit, m (with surface levels).
     pub levels: Option<Vec<f64>>,
+    /// A candidate reported at its switch's neutral value: no value on its scan, nor its fit, did better.
+    pub kept_at_neutral: bool,
     pub seconds: f64,
 }
 
@@ -46,35 +49,59 @@ const MAX_STARTS: usize = 2;
 /// while the fit leaves a systematic residual above `floor_m` (over the noise `noise_m`).
 pub(crate) struct Scan<'a> {
     pub name: &'a str,
+    /// The switch's neutral value (the effect does nothing there: the candidate is the current model).
+    pub neutral: f64,
     pub noise_m: f64,
     pub floor_m: f64,
     /// The current model's systematic residual, m.
     pub base_systematic_m: f64,
 }
 
-/// `p0` with the parameter `name` set to each value of `p0[name] × SCAN_FACTORS` (within its bounds), best
-/// (lowest χ²) first, at most `n`; just `p0` when it is not free or every simulation fails.
-fn scan_starts(ev: &Evaluator, name: &str, p0: &[f64], n: usize) -> Vec<Vec<f64>> {
-    let Some(j) = ev.names().iter().position(|x| x == name) else {
-        return vec![p0.to_vec()];
+/// What the scan of a candidate's switch found.
+struct Scanned {
+    /// Starts for the fit, best (lowest χ²) first.
+    starts: Vec<Vec<f64>>,
+    /// The start with the switch at its neutral value, and whether it fitted at least as well as every
+    /// start on the grid.
+    neutral: Option<(Vec<f64>, bool)>,
+}
+
+/// `p0` with the switch `sc.name` set to each value of `p0[name] × SCAN_FACTORS` (within its bounds), best
+/// (lowest χ²) first, at most `n`, and set to its neutral value; just `p0` when it is not free or every
+/// simulation fails.
+fn scan_starts(ev: &Evaluator, sc: &Scan<'_>, p0: &[f64], n: usize) -> Scanned {
+    let Some(j) = ev.names().iter().position(|x| x == sc.name) else {
+        return Scanned {
+            starts: vec![p0.to_vec()],
+            neutral: None,
+        };
     };
     let fp = &ev.problem().params()[j];
-    let mut tried: Vec<(f64, Vec<f64>)> = SCAN_FACTORS
-        .iter()
-        .filter_map(|f| {
-            let mut theta = p0.to_vec();
-            theta[j] = (p0[j] * f).clamp(fp.min, fp.max);
-            let sims = ev.simulate(&theta).ok()?;
-            let chi2: f64 = ev.per_shot(&sims).iter().map(|s| s.chi2).sum();
-            chi2.is_finite().then_some((chi2, theta))
-        })
-        .collect();
-    if tried.is_empty() {
-        return vec![p0.to_vec()];
-    }
+    let at = |v: f64| -> Option<(f64, Vec<f64>)> {
+        let mut theta = p0.to_vec();
+        theta[j] = v.clamp(fp.min, fp.max);
+        let sims = ev.simulate(&theta).ok()?;
+        let chi2: f64 = ev.per_shot(&sims).iter().map(|s| s.chi2).sum();
+        chi2.is_finite().then_some((chi2, theta))
+    };
+    let mut tried: Vec<(f64, Vec<f64>)> = SCAN_FACTORS.iter().filter_map(|f| at(p0[j] * f)).collect();
     tried.sort_by(|a, b| a.0.total_cmp(&b.0));
     tried.dedup_by(|a, b| a.1 == b.1);
-    tried.into_iter().take(n).map(|(_, t)| t).collect()
+    let neutral = at(sc.neutral).map(|(chi2, theta)| (theta, tried.first().is_none_or(|best| chi2 <= best.0)));
+    let starts = if tried.is_empty() {
+        vec![p0.to_vec()]
+    } else {
+        tried.into_iter().take(n).map(|(_, t)| t).collect()
+    };
+    Scanned { starts, neutral }
+}
+
+/// True when the switch `name`'s neutral value is an end of its search range (a range not mirrored about it).
+fn neutral_on_bound(ev: &Evaluator, sc: &Scan<'_>) -> bool {
+    ev.names().iter().position(|x| x == sc.name).is_some_and(|j| {
+        let fp = &ev.problem().params()[j];
+        sc.neutral <= fp.min || sc.neutral >= fp.max
+    })
 }
 
 /// Where a model's fit starts and what it reports.
@@ -148,16 +175,43 @@ pub(crate) fn run_model(
         .max(1) as f64;
     let mut observer = |it: &Iteration<'_>| on_iteration(it.iteration, it.cost / dof);
     let p0 = ev.problem().initial();
-    let starts = match scan {
+    let scanned = match scan {
         Some(sc) => {
+            // The frame turns under the candidate at its neutral value: the current model's.
+            if let Some(j) = ev.names().iter().position(|x| x == sc.name) {
+                let fp = &ev.problem().params()[j];
+                let mut theta = p0.clone();
+                theta[j] = sc.neutral.clamp(fp.min, fp.max);
+                ev.turn_frames_at(&ev.named(&theta))?;
+            }
             if let Some(levels) = seed {
                 ev.set_levels(levels, false);
             }
-            scan_starts(&ev, sc.name, &p0, MAX_STARTS)
+            scan_starts(&ev, sc, &p0, MAX_STARTS)
         }
-        None => vec![p0],
+        None => Scanned {
+            starts: vec![p0],
+            neutral: None,
+        },
     };
     let zero = ev.levels();
+    // The candidate at its neutral value is the current model, from its levels (no fit, no Jacobian yet).
+    let at_neutral = |ev: &mut Evaluator, theta: &[f64]| -> Result<SolverOutcome, FitError> {
+        if let Some(levels) = seed.or(zero.as_deref()) {
+            ev.set_levels(levels, true);
+        }
+        outcome_at(ev, theta, (0, 0, Termination::Stalled))
+    };
+    // Nothing on the scan fits better than the neutral value, and the fit cannot cross it: a fit from the
+    // grid could only end on the far side of a ringing response (the tangential spring's), above it.
+    if let (Some(sc), Some((theta, true))) = (scan, &scanned.neutral)
+        && neutral_on_bound(&ev, sc)
+    {
+        let mut out = at_neutral(&mut ev, theta)?;
+        out.jacobian = covariance_jacobian(&ev, opts, theta);
+        return finish_run(spec, shots, fold_of, k, opts, &ev, &out, gate, clock, true);
+    }
+    let starts = scanned.starts;
     let mut fit_from = |ev: &mut Evaluator, start: &[f64]| -> Result<(SolverOutcome, f64), FitError> {
         let out = match &zero {
             None => ev.fit_observed(&opts.solver, start, &mut observer)?,
@@ -184,7 +238,32 @@ pub(crate) fn run_model(
             (out, systematic) = (next, s);
         }
     }
-    finish_run(spec, shots, fold_of, k, opts, &ev, &out, gate, clock)
+    // A fit that ended above the candidate's neutral value (a local minimum of a response that is not
+    // monotone) reports the neutral value: the candidate is never worse than the current model it contains.
+    if let Some((theta, _)) = &scanned.neutral {
+        let fitted_levels = ev.levels();
+        let mut neutral = at_neutral(&mut ev, theta)?;
+        if neutral.cost < out.cost {
+            neutral.jacobian = covariance_jacobian(&ev, opts, theta);
+            return finish_run(spec, shots, fold_of, k, opts, &ev, &neutral, gate, clock, true);
+        }
+        if let Some(levels) = fitted_levels {
+            ev.set_levels(&levels, true);
+        }
+    }
+    // The current model (no scan) is reported with its frame turns differenced under its fit, as its
+    // candidates take them at their neutral values and as a given fit's are (`run_fitted`).
+    if scan.is_none() && ev.problem().shots().iter().any(|s| s.frame_sigma_rad.is_some()) {
+        ev.turn_frames_at(&ev.named(&out.params))?;
+        let mut again = outcome_at(
+            &ev,
+            &out.params,
+            (out.iterations, out.evaluations, out.termination.clone()),
+        )?;
+        again.jacobian = covariance_jacobian(&ev, opts, &out.params);
+        out = again;
+    }
+    finish_run(spec, shots, fold_of, k, opts, &ev, &out, gate, clock, false)
 }
 
 /// The current model at values the caller already fitted (`theta`, in the parameter order of `spec` on
@@ -205,27 +284,42 @@ pub(crate) fn run_fitted(
 ) -> Result<ModelRun, FitError> {
     let clock = Instant::now();
     let mut ev = Evaluator::new(spec, shots.to_vec(), opts.sim, opts.surface_levels)?;
+    ev.turn_frames_at(&ev.named(theta))?;
     if let Some(levels) = levels {
         ev.set_levels(levels, true);
     }
-    // With surface levels, each shot's level is profiled from the fit's value at `theta`.
+    let mut out = outcome_at(&ev, theta, fitted)?;
+    out.jacobian = covariance_jacobian(&ev, opts, theta);
+    finish_run(spec, shots, fold_of, k, opts, &ev, &out, None, clock, false)
+}
+
+/// `ev`'s residuals and cost at `theta` as a solver's outcome without a Jacobian, reporting `fitted`'s
+/// iterations, evaluations and termination. With surface levels, each shot's level is profiled from its
+/// current value at `theta`.
+fn outcome_at(
+    ev: &Evaluator,
+    theta: &[f64],
+    (iterations, evaluations, termination): (usize, usize, Termination),
+) -> Result<SolverOutcome, FitError> {
     let residuals = ev.residuals(theta)?;
-    let cost = residuals.iter().map(|r| r * r).sum();
-    let jacobian = match ev.levels() {
-        Some(levels) => ev.reduced_jacobian(&opts.solver, theta, &levels).ok(),
-        None => opts.solver.jacobian_at(&ev, theta).ok(),
-    };
-    let (iterations, evaluations, termination) = fitted;
-    let out = SolverOutcome {
+    Ok(SolverOutcome {
         params: theta.to_vec(),
+        cost: residuals.iter().map(|r| r * r).sum(),
         residuals,
-        cost,
-        jacobian,
+        jacobian: None,
         iterations,
         evaluations,
         termination,
-    };
-    finish_run(spec, shots, fold_of, k, opts, &ev, &out, None, clock)
+    })
+}
+
+/// The Jacobian the standard errors come from at `theta` (with surface levels, marginalised over them as a
+/// search fit's is); `None` when a simulation fails.
+fn covariance_jacobian(ev: &Evaluator, opts: &SearchOptions, theta: &[f64]) -> Option<DMatrix<f64>> {
+    match ev.levels() {
+        Some(levels) => ev.reduced_jacobian(&opts.solver, theta, &levels).ok(),
+        None => opts.solver.jacobian_at(ev, theta).ok(),
+    }
 }
 
 /// A model's run from its fit `out` on `ev`: the residual sums at the fit, the summary, and (unless its
@@ -241,6 +335,7 @@ fn finish_run(
     out: &SolverOutcome,
     gate: Option<BicGate>,
     clock: Instant,
+    kept_at_neutral: bool,
 ) -> Result<ModelRun, FitError> {
     // (With profiled levels, this also leaves them at the kept fit's optimum.)
     let sims = ev.simulate(&out.params)?;
@@ -255,7 +350,14 @@ fn finish_run(
     let per_fold: Vec<Vec<(usize, Option<ShotSums>)>> = if cross_validated {
         (0..k)
             .into_par_iter()
-            .map(|f| heldout_fold(spec, shots, fold_of, f, &fitted, levels.as_deref(), opts))
+            .map(|f| {
+                let at = Fold {
+                    fitted: &fitted,
+                    levels: levels.as_deref(),
+                    turn_point: ev.turn_point(),
+                };
+                heldout_fold(spec, shots, fold_of, f, &at, opts)
+            })
             .collect()
     } else {
         Vec::new()
@@ -272,6 +374,7 @@ fn finish_run(
         cross_validated,
         n_params,
         levels,
+        kept_at_neutral,
         seconds: clock.elapsed().as_secs_f64(),
     })
 }
@@ -336,6 +439,14 @@ fn fit_with_levels(
     Ok(joint)
 }
 
+/// Where a fold starts: the full fit's values (by name), its surface levels and the values its frame
+/// turns were differenced under.
+struct Fold<'a> {
+    fitted: &'a [(String, f64)],
+    levels: Option<&'a [f64]>,
+    turn_point: Option<&'a [(String, f64)]>,
+}
+
 /// The shots of fold `f` predicted by the model fitted to the other folds; `None` for a shot that cannot
 /// be predicted (its surface has no shot left to fit, or a fit or simulation failed).
 fn heldout_fold(
@@ -343,16 +454,27 @@ fn heldout_fold(
     shots: &[MeasuredShot],
     fold_of: &[usize],
     f: usize,
-    full: &[(String, f64)],
-    levels: Option<&[f64]>,
+    at: &Fold<'_>,
     opts: &SearchOptions,
 ) -> Vec<(usize, Option<ShotSums>)> {
+    let Fold {
+        fitted: full,
+        levels,
+        turn_point,
+    } = *at;
+    let new_evaluator = |shots: Vec<MeasuredShot>| -> Option<Evaluator> {
+        let mut ev = Evaluator::new(spec, shots, opts.sim, opts.surface_levels).ok()?;
+        if let Some(point) = turn_point {
+            ev.turn_frames_at(point).ok()?;
+        }
+        Some(ev)
+    };
     let test: Vec<usize> = (0..shots.len()).filter(|&i| fold_of[i] == f).collect();
     let train_idx: Vec<usize> = (0..shots.len()).filter(|&i| fold_of[i] != f).collect();
     let train: Vec<MeasuredShot> = train_idx.iter().map(|&i| shots[i].clone()).collect();
     let lookup = |table: &[(String, f64)], name: &str| table.iter().find(|(n, _)| n == name).map(|(_, v)| *v);
     let fitted: Option<Vec<(String, f64)>> = (|| {
-        let mut ev = Evaluator::new(spec, train, opts.sim, opts.surface_levels).ok()?;
+        let mut ev = new_evaluator(train)?;
         if let Some(levels) = levels {
             let held: Vec<f64> = train_idx.iter().map(|&i| levels[i]).collect();
             ev.set_levels(&held, false);
@@ -371,7 +493,7 @@ fn heldout_fold(
     test.into_iter()
         .map(|i| {
             let sums = fitted.as_ref().and_then(|fitted| {
-                let mut ev = Evaluator::new(spec, vec![shots[i].clone()], opts.sim, opts.surface_levels).ok()?;
+                let mut ev = new_evaluator(vec![shots[i].clone()])?;
                 if let Some(levels) = levels {
                     ev.set_levels(&[levels[i]], true);
                 }

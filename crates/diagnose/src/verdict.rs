@@ -267,6 +267,11 @@ fn check(c: &mut Candidate, o: &SearchOptions, noise: f64) {
     c.checks.parameter = e.param_z.is_some_and(|z| z >= o.min_param_z) && !at_bound && !unphysical;
     if !c.checks.parameter {
         reasons.push(match (e.param_z, range) {
+            _ if e.kept_at_neutral => format!(
+                "no value of {} fitted better than its neutral value {} (the current model), where it is kept",
+                c.param,
+                num(c.neutral)
+            ),
             (_, Some((lo, hi))) if unphysical => format!(
                 "{} = {} is outside its physical range [{}, {}]: the data pull it the other way",
                 c.param,

@@ -153,24 +153,27 @@ impl Problem {
             offsets: None,
             turns: Vec::new(),
         };
-        problem.turns = problem.frame_turns()?;
+        problem.turns = problem.frame_turns(&problem.initial())?;
         Ok(problem)
     }
 
+    /// Differences each shot's frame turn again under the model at `theta` instead of the starting values:
+    /// problems that must agree where their models agree (a model and the same model with one more effect
+    /// at its neutral value, started elsewhere) then take the turns out alike.
+    pub fn turn_frames_at(&mut self, theta: &[f64]) -> Result<(), FitError> {
+        self.turns = self.frame_turns(theta)?;
+        Ok(())
+    }
+
     /// Each shot's [`FrameTurn`] (for shots with [`MeasuredShot::frame_sigma_rad`]), differenced under the
-    /// model at its starting values: the turn's effect is mostly kinematic (the start's velocity and the
-    /// frames turned together), so it is taken once per problem rather than in every evaluation. Two
-    /// simulations per such shot.
-    fn frame_turns(&self) -> Result<Vec<Option<FrameTurn>>, FitError> {
+    /// model at `theta`: the turn's effect is mostly kinematic (the start's velocity and the frames turned
+    /// together), so it is taken once per problem rather than in every evaluation. Two simulations per
+    /// such shot.
+    fn frame_turns(&self, theta: &[f64]) -> Result<Vec<Option<FrameTurn>>, FitError> {
         if self.shots.iter().all(|s| s.frame_sigma_rad.is_none()) {
             return Ok(vec![None; self.shots.len()]);
         }
-        let initial = self.initial();
-        let models: Vec<Model> = self
-            .surfaces
-            .iter()
-            .map(|s| s.model(&initial))
-            .collect::<Result<_, _>>()?;
+        let models: Vec<Model> = self.surfaces.iter().map(|s| s.model(theta)).collect::<Result<_, _>>()?;
         let one = |i: usize| -> Option<FrameTurn> {
             let sigma_rad = self.shots[i].frame_sigma_rad.filter(|s| s.is_finite() && *s > 0.0)?;
             let model = &models[self.shot_surface[i]];
