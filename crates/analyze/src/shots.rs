@@ -142,5 +142,6 @@ pub fn measured_shot(
             .surface_tilt_deg
             .map(|t| t.se.to_radians())
             .filter(|s| s.is_finite() && *s > 0.0),
+        spin_sigma_rad_s: e.spin_in.map(|s| s.se).filter(|s| s.is_finite() && *s > 0.0),
     }
 }

@@ -52,6 +52,7 @@ fn session() -> Vec<MeasuredShot> {
                     measured: None,
                     surface_sigma_m: None,
                     frame_sigma_rad: None,
+                    spin_sigma_rad_s: None,
                 });
             }
         }

@@ -24,9 +24,6 @@ pub(crate) struct Evaluator {
     surfaces: Vec<String>,
     /// Each shot's surface level, m: none, profiled, or held.
     levels: Levels,
-    /// The parameter values (by name) whose model the shots' frame turns were differenced under, when not
-    /// the starting values ([`Evaluator::turn_frames_at`]).
-    turn_point: Option<Vec<(String, f64)>>,
 }
 
 /// How each shot's surface level (the true surface's height in the measured frame) enters.
@@ -50,9 +47,28 @@ impl Evaluator {
         sim: SimOptions,
         surface_levels: bool,
     ) -> Result<Evaluator, FitError> {
+        Ok(Evaluator::of(Problem::new(spec, shots, sim)?, surface_levels))
+    }
+
+    /// [`Evaluator::new`] for the shots `which` (indices into `source`'s shots) of `source`, with their
+    /// start nuisances as `source` differenced them (a cross-validation fold: nothing simulated to set it
+    /// up).
+    pub fn part_of(
+        spec: &ModelSpec,
+        source: &Evaluator,
+        which: &[usize],
+        sim: SimOptions,
+        surface_levels: bool,
+    ) -> Result<Evaluator, FitError> {
+        let shots = which.iter().map(|&i| source.problem.shots()[i].clone()).collect();
+        let problem = Problem::with_nuisances_of(spec, shots, sim, &source.problem, which)?;
+        Ok(Evaluator::of(problem, surface_levels))
+    }
+
+    fn of(problem: Problem, surface_levels: bool) -> Evaluator {
         let mut surfaces: Vec<String> = Vec::new();
-        let mut shot_surface = Vec::with_capacity(shots.len());
-        for s in &shots {
+        let mut shot_surface = Vec::with_capacity(problem.shots().len());
+        for s in problem.shots() {
             let i = match surfaces.iter().position(|n| n == &s.surface) {
                 Some(i) => i,
                 None => {
@@ -63,43 +79,23 @@ impl Evaluator {
             shot_surface.push(i);
         }
         let levels = if surface_levels {
-            Levels::Profiled(shots.iter().map(|_| AtomicU64::new(0)).collect())
+            Levels::Profiled(problem.shots().iter().map(|_| AtomicU64::new(0)).collect())
         } else {
             Levels::None
         };
-        let problem = Problem::new(spec, shots, sim)?;
-        Ok(Evaluator {
+        Evaluator {
             problem,
             shot_surface,
             surfaces,
             levels,
-            turn_point: None,
-        })
-    }
-
-    /// Differences the shots' frame turns under the model at the values `named` (by parameter name; the
-    /// others at their starting values), so that models nested in each other take the turns out alike: the
-    /// current model at its fit and each candidate at its neutral value (see `Problem::turn_frames_at`).
-    pub fn turn_frames_at(&mut self, named: &[(String, f64)]) -> Result<(), FitError> {
-        let mut theta = self.problem.initial();
-        for (j, name) in self.names().iter().enumerate() {
-            if let Some((_, v)) = named.iter().find(|(n, _)| n == name) {
-                theta[j] = *v;
-            }
         }
-        self.problem.turn_frames_at(&theta)?;
-        self.turn_point = Some(named.to_vec());
-        Ok(())
     }
 
-    /// The values the frame turns were differenced under, when set by [`Evaluator::turn_frames_at`].
-    pub fn turn_point(&self) -> Option<&[(String, f64)]> {
-        self.turn_point.as_deref()
-    }
-
-    /// Parameter names paired with `theta`'s values.
-    pub fn named(&self, theta: &[f64]) -> Vec<(String, f64)> {
-        self.names().into_iter().zip(theta.iter().copied()).collect()
+    /// Differences the shots' start nuisances (frame turn, incoming spin) under the model at `theta`, so
+    /// that models nested in each other take them out alike: the current model at its fit and each
+    /// candidate at its neutral value (see `Problem::difference_nuisances_at`).
+    pub fn difference_nuisances_at(&mut self, theta: &[f64]) -> Result<(), FitError> {
+        self.problem.difference_nuisances_at(theta)
     }
 
     /// Surface levels start at `levels` (one per shot, m): profiled from there if they are profiled,
@@ -497,6 +493,7 @@ mod tests {
                     measured: None,
                     surface_sigma_m: Some(20e-6),
                     frame_sigma_rad: None,
+                    spin_sigma_rad_s: None,
                 }
             })
             .collect()

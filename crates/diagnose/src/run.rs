@@ -177,12 +177,12 @@ pub(crate) fn run_model(
     let p0 = ev.problem().initial();
     let scanned = match scan {
         Some(sc) => {
-            // The frame turns under the candidate at its neutral value: the current model's.
+            // The start nuisances under the candidate at its neutral value: the current model's.
             if let Some(j) = ev.names().iter().position(|x| x == sc.name) {
                 let fp = &ev.problem().params()[j];
                 let mut theta = p0.clone();
                 theta[j] = sc.neutral.clamp(fp.min, fp.max);
-                ev.turn_frames_at(&ev.named(&theta))?;
+                ev.difference_nuisances_at(&theta)?;
             }
             if let Some(levels) = seed {
                 ev.set_levels(levels, false);
@@ -251,10 +251,11 @@ pub(crate) fn run_model(
             ev.set_levels(&levels, true);
         }
     }
-    // The current model (no scan) is reported with its frame turns differenced under its fit, as its
+    // The current model (no scan) is reported with its start nuisances differenced under its fit, as its
     // candidates take them at their neutral values and as a given fit's are (`run_fitted`).
-    if scan.is_none() && ev.problem().shots().iter().any(|s| s.frame_sigma_rad.is_some()) {
-        ev.turn_frames_at(&ev.named(&out.params))?;
+    let nuisances = |s: &MeasuredShot| s.frame_sigma_rad.is_some() || s.spin_sigma_rad_s.is_some();
+    if scan.is_none() && ev.problem().shots().iter().any(nuisances) {
+        ev.difference_nuisances_at(&out.params)?;
         let mut again = outcome_at(
             &ev,
             &out.params,
@@ -284,7 +285,7 @@ pub(crate) fn run_fitted(
 ) -> Result<ModelRun, FitError> {
     let clock = Instant::now();
     let mut ev = Evaluator::new(spec, shots.to_vec(), opts.sim, opts.surface_levels)?;
-    ev.turn_frames_at(&ev.named(theta))?;
+    ev.difference_nuisances_at(theta)?;
     if let Some(levels) = levels {
         ev.set_levels(levels, true);
     }
@@ -354,7 +355,7 @@ fn finish_run(
                 let at = Fold {
                     fitted: &fitted,
                     levels: levels.as_deref(),
-                    turn_point: ev.turn_point(),
+                    full: ev,
                 };
                 heldout_fold(spec, shots, fold_of, f, &at, opts)
             })
@@ -439,12 +440,12 @@ fn fit_with_levels(
     Ok(joint)
 }
 
-/// Where a fold starts: the full fit's values (by name), its surface levels and the values its frame
-/// turns were differenced under.
+/// Where a fold starts: the full fit's values (by name), its surface levels and the full fit's evaluator
+/// (each shot's start nuisances as differenced there).
 struct Fold<'a> {
     fitted: &'a [(String, f64)],
     levels: Option<&'a [f64]>,
-    turn_point: Option<&'a [(String, f64)]>,
+    full: &'a Evaluator,
 }
 
 /// The shots of fold `f` predicted by the model fitted to the other folds; `None` for a shot that cannot
@@ -460,21 +461,14 @@ fn heldout_fold(
     let Fold {
         fitted: full,
         levels,
-        turn_point,
+        full: source,
     } = *at;
-    let new_evaluator = |shots: Vec<MeasuredShot>| -> Option<Evaluator> {
-        let mut ev = Evaluator::new(spec, shots, opts.sim, opts.surface_levels).ok()?;
-        if let Some(point) = turn_point {
-            ev.turn_frames_at(point).ok()?;
-        }
-        Some(ev)
-    };
+    let new_evaluator = |which: &[usize]| Evaluator::part_of(spec, source, which, opts.sim, opts.surface_levels).ok();
     let test: Vec<usize> = (0..shots.len()).filter(|&i| fold_of[i] == f).collect();
     let train_idx: Vec<usize> = (0..shots.len()).filter(|&i| fold_of[i] != f).collect();
-    let train: Vec<MeasuredShot> = train_idx.iter().map(|&i| shots[i].clone()).collect();
     let lookup = |table: &[(String, f64)], name: &str| table.iter().find(|(n, _)| n == name).map(|(_, v)| *v);
     let fitted: Option<Vec<(String, f64)>> = (|| {
-        let mut ev = new_evaluator(train)?;
+        let mut ev = new_evaluator(&train_idx)?;
         if let Some(levels) = levels {
             let held: Vec<f64> = train_idx.iter().map(|&i| levels[i]).collect();
             ev.set_levels(&held, false);
@@ -493,7 +487,7 @@ fn heldout_fold(
     test.into_iter()
         .map(|i| {
             let sums = fitted.as_ref().and_then(|fitted| {
-                let mut ev = new_evaluator(vec![shots[i].clone()])?;
+                let mut ev = new_evaluator(&[i])?;
                 if let Some(levels) = levels {
                     ev.set_levels(&[levels[i]], true);
                 }

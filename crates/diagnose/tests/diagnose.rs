@@ -343,6 +343,52 @@ fn a_candidate_at_its_neutral_value_fits_as_the_current_model_with_frame_turns()
     }
 }
 
+/// Incoming spins measured 0.3 rad/s off (RMS), as a spin estimator gives them on frames with 14 DN of
+/// sensor noise: taken as exact, they leave the clean session's outgoing tangential flight misfitting and
+/// the verdict is `none_explains`; with each spin's σ stated, the spin errors are taken out: no missing
+/// effect on the clean session, and rolling resistance (a tangential effect the spins could have absorbed)
+/// is still named with its magnitude within 10 %.
+#[test]
+fn incoming_spins_off_by_their_stated_sigma_change_no_verdict() {
+    let sigma = 0.3;
+    let spun = |effect: Option<&str>, stated: bool| {
+        let mut shots = session(&truth(effect), 1, Tracking::default());
+        let mut rng = bouncelab_fit::testutil::Rng::new(5);
+        for s in &mut shots {
+            s.start.state.omega += sigma * rng.normal();
+            s.spin_sigma_rad_s = stated.then_some(sigma);
+        }
+        run(
+            &format!("{effect:?}, spins off, σ stated {stated}"),
+            &shots,
+            &SearchOptions::default(),
+        )
+    };
+    let exact = spun(None, false);
+    assert_eq!(
+        exact.verdict.kind,
+        VerdictKind::NoneExplains,
+        "{}",
+        exact.verdict.sentence
+    );
+    let clean = spun(None, true);
+    assert_eq!(
+        clean.verdict.kind,
+        VerdictKind::NoMissingEffect,
+        "{}",
+        clean.verdict.sentence
+    );
+    let rolling = spun(Some("rolling_resistance"), true);
+    assert_eq!(
+        rolling.verdict.effects,
+        ["rolling_resistance"],
+        "{}",
+        rolling.verdict.sentence
+    );
+    let e = rolling.candidates[0].evidence.as_ref().unwrap();
+    assert!((e.param_value - 0.02).abs() < 0.002, "c_rr {}", e.param_value);
+}
+
 fn invented(name: &str, body: &str, tracking: Tracking) -> Diagnosis {
     invented_from(&base_spec(), name, body, tracking)
 }

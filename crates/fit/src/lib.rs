@@ -13,6 +13,7 @@
 mod covariance;
 mod error;
 mod measurement;
+mod nuisance;
 mod params;
 mod predict;
 mod problem;

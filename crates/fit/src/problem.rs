@@ -2,6 +2,7 @@
 //! trajectories against the measured ones.
 
 use crate::measurement::{observe, observes, true_start};
+use crate::nuisance::{Nuisance, StartNuisances};
 use crate::params::{self, FreeParam, SurfaceModel};
 use crate::solver::LeastSquares;
 use crate::{FitError, MeasuredShot};
@@ -30,6 +31,11 @@ use std::sync::atomic::{AtomicU64, Ordering};
 /// outgoing flight alike; left free, the turns took up a hidden tangential spring's misfit shot by shot
 /// and it went unnamed. The prior's own term (ε/σ)² is not added to the residual vector.
 ///
+/// A shot with [`MeasuredShot::spin_sigma_rad_s`] has its incoming spin's error as a second such nuisance,
+/// taken out with the first: a ball that ends its contact rolling leaves with `c·R·Δω/(1 + c)` more
+/// tangential speed per Δω of incoming spin (6.7 mm/s for 0.5 rad/s with a thin shell), and the spin
+/// estimator's error grows with the sensor's noise (±0.6 rad/s at 14 DN, ±0.03 rad/s on clean frames).
+///
 /// The residual vector holds, for every shot in order and every frame in order, `(x_sim − x_m)/σ` and
 /// `(y_sim − y_m)/σ`, where `x_sim, y_sim` is what the camera sees of the simulated ball (the sample's
 /// `observed` position, so measurement effects such as camera roll apply) at the frame's time. Each
@@ -50,23 +56,30 @@ pub struct Problem {
     touch_x: Vec<f64>,
     /// Per shot: the index of its first residual.
     first_residual: Vec<usize>,
-    /// Per shot with a stated frame direction σ: how its residuals move as its frame turns.
-    turns: Vec<Option<FrameTurn>>,
+    /// Per shot with a stated frame direction σ or incoming spin σ: how its residuals move as its frame
+    /// turns and its incoming spin changes.
+    nuisances: Vec<Option<StartNuisances>>,
 }
 
-/// How a shot's residuals move when its measured frame turns by a small angle ε about the contact point
-/// (frames and start turned alike), m per rad for each frame, and the angle's prior σ, rad.
-#[derive(Debug, Clone)]
-struct FrameTurn {
-    gradient: Vec<[f64; 2]>,
-    sigma_rad: f64,
-}
-
-/// The largest turn of a shot's frame, in its prior σ.
-const TURN_CAP_SIGMAS: f64 = 2.0;
+/// The largest correction of a start nuisance, in its prior σ: the prior hardly binds against a shot's
+/// hundreds of frames, and the frames tell a turn or a spin error only through the contact, where a
+/// tangential effect moves the outgoing flight alike. Left unbounded, the turns took up a hidden
+/// tangential spring's misfit shot by shot and it went unnamed, and spins 0.3 rad/s off took up rolling
+/// resistance's.
+const CAP_SIGMAS: f64 = 2.0;
 
 /// The turn, rad, over which a frame turn's effect on the residuals is differenced.
 const TURN_STEP_RAD: f64 = 1e-4;
+
+/// How much better than its prior the frames must tell a shot's incoming spin (`Σ w·|g|²·σ²`, the ratio
+/// of the prior's variance to the frames' own) for the spin to be a nuisance. Below it the correction
+/// would be shrunk to a fraction of a σ anyway, and on clean frames (σ 0.003–0.03 rad/s, a ratio near 1)
+/// it only cost time: corrections pressed on the cap where a candidate misfits, and the search's fits took
+/// more iterations over that kink.
+const SPIN_TOLD_MIN: f64 = 4.0;
+
+/// The change of incoming spin, rad/s, over which its effect on the residuals is differenced (centred).
+const SPIN_STEP_RAD_S: f64 = 0.05;
 
 /// The last profiled surface level of each shot (f64 bits), the warm start of the next evaluation.
 #[derive(Debug)]
@@ -94,6 +107,33 @@ impl Problem {
     /// Fails with the shot's name when a shot has no frames, a non-positive σ, a frame before its start,
     /// a start that is not finite or inside the surface, or a surface the model file does not know.
     pub fn new(spec: &ModelSpec, shots: Vec<MeasuredShot>, sim: SimOptions) -> Result<Problem, FitError> {
+        let mut problem = Problem::build(spec, shots, sim)?;
+        problem.nuisances = problem.start_nuisances(&problem.initial())?;
+        Ok(problem)
+    }
+
+    /// [`Problem::new`] for a subset of `source`'s shots (`which`, indices into `source`'s shots, in the
+    /// order of `shots`), taking each shot's start nuisances from `source` as they were differenced there
+    /// instead of simulating them again: the cross-validation folds of a problem whose nuisances were
+    /// differenced under one model ([`Problem::difference_nuisances_at`]).
+    pub fn with_nuisances_of(
+        spec: &ModelSpec,
+        shots: Vec<MeasuredShot>,
+        sim: SimOptions,
+        source: &Problem,
+        which: &[usize],
+    ) -> Result<Problem, FitError> {
+        let mut problem = Problem::build(spec, shots, sim)?;
+        problem.nuisances = which
+            .iter()
+            .map(|&i| source.nuisances.get(i).cloned().flatten())
+            .collect();
+        problem.nuisances.resize(problem.shots.len(), None);
+        Ok(problem)
+    }
+
+    /// The problem without its start nuisances.
+    fn build(spec: &ModelSpec, shots: Vec<MeasuredShot>, sim: SimOptions) -> Result<Problem, FitError> {
         if shots.is_empty() {
             return Err(FitError::NoShots);
         }
@@ -139,7 +179,7 @@ impl Problem {
                 Some(first)
             })
             .collect();
-        let mut problem = Problem {
+        let problem = Problem {
             touch_x,
             first_residual,
             shots,
@@ -151,56 +191,87 @@ impl Problem {
             parallel: true,
             n_residuals,
             offsets: None,
-            turns: Vec::new(),
+            nuisances: Vec::new(),
         };
-        problem.turns = problem.frame_turns(&problem.initial())?;
         Ok(problem)
     }
 
-    /// Differences each shot's frame turn again under the model at `theta` instead of the starting values:
-    /// problems that must agree where their models agree (a model and the same model with one more effect
-    /// at its neutral value, started elsewhere) then take the turns out alike.
-    pub fn turn_frames_at(&mut self, theta: &[f64]) -> Result<(), FitError> {
-        self.turns = self.frame_turns(theta)?;
+    /// Differences each shot's start nuisances (frame turn, incoming spin) again under the model at `theta`
+    /// instead of the starting values: problems that must agree where their models agree (a model and the
+    /// same model with one more effect at its neutral value, started elsewhere) then take them out alike.
+    pub fn difference_nuisances_at(&mut self, theta: &[f64]) -> Result<(), FitError> {
+        self.nuisances = self.start_nuisances(theta)?;
         Ok(())
     }
 
-    /// Each shot's [`FrameTurn`] (for shots with [`MeasuredShot::frame_sigma_rad`]), differenced under the
-    /// model at `theta`: the turn's effect is mostly kinematic (the start's velocity and the frames turned
-    /// together), so it is taken once per problem rather than in every evaluation. Two simulations per
-    /// such shot.
-    fn frame_turns(&self, theta: &[f64]) -> Result<Vec<Option<FrameTurn>>, FitError> {
-        if self.shots.iter().all(|s| s.frame_sigma_rad.is_none()) {
+    /// Each shot's [`StartNuisances`]: its frame's turn (for shots with [`MeasuredShot::frame_sigma_rad`])
+    /// and its incoming spin's error (with [`MeasuredShot::spin_sigma_rad_s`]), each differenced
+    /// (centred) under the model at `theta`: their effect is smooth and hardly depends on the parameters,
+    /// so it is taken once per problem rather than in every evaluation. Two simulations per nuisance and
+    /// shot.
+    fn start_nuisances(&self, theta: &[f64]) -> Result<Vec<Option<StartNuisances>>, FitError> {
+        let positive = |s: Option<f64>| s.filter(|s| s.is_finite() && *s > 0.0);
+        if self
+            .shots
+            .iter()
+            .all(|s| positive(s.frame_sigma_rad).is_none() && positive(s.spin_sigma_rad_s).is_none())
+        {
             return Ok(vec![None; self.shots.len()]);
         }
         let models: Vec<Model> = self.surfaces.iter().map(|s| s.model(theta)).collect::<Result<_, _>>()?;
-        let one = |i: usize| -> Option<FrameTurn> {
-            let sigma_rad = self.shots[i].frame_sigma_rad.filter(|s| s.is_finite() && *s > 0.0)?;
+        let one = |i: usize| -> Option<StartNuisances> {
             let model = &models[self.shot_surface[i]];
-            let residuals = |eps: f64| -> Option<Vec<[f64; 2]>> {
-                let turned = turned_shot(&self.shots[i], self.touch_x[i], eps);
-                let sim = self.simulate_measured(i, &turned, model, 0.0).ok()?;
+            let observed = |shot: &MeasuredShot| -> Option<Vec<[f64; 2]>> {
+                let sim = self.simulate_measured(i, shot, model, 0.0).ok()?;
                 Some(
-                    turned
-                        .frames
+                    shot.frames
                         .iter()
                         .zip(&sim.samples)
                         .map(|(f, p)| [p.observed.x - f.x_m, p.observed.y - f.y_m])
                         .collect(),
                 )
             };
-            let (up, down) = (residuals(TURN_STEP_RAD)?, residuals(-TURN_STEP_RAD)?);
-            let gradient = up
-                .iter()
-                .zip(&down)
-                .map(|(u, d)| {
-                    [
-                        (u[0] - d[0]) / (2.0 * TURN_STEP_RAD),
-                        (u[1] - d[1]) / (2.0 * TURN_STEP_RAD),
-                    ]
-                })
-                .collect();
-            Some(FrameTurn { gradient, sigma_rad })
+            let centred = |up: Vec<[f64; 2]>, down: Vec<[f64; 2]>, step: f64| -> Vec<[f64; 2]> {
+                up.iter()
+                    .zip(&down)
+                    .map(|(u, d)| [(u[0] - d[0]) / (2.0 * step), (u[1] - d[1]) / (2.0 * step)])
+                    .collect()
+            };
+            let shot = &self.shots[i];
+            let mut all = Vec::new();
+            if let Some(sigma) = positive(shot.frame_sigma_rad) {
+                let turned = |eps: f64| observed(&turned_shot(shot, self.touch_x[i], eps));
+                let (up, down) = (turned(TURN_STEP_RAD)?, turned(-TURN_STEP_RAD)?);
+                all.push(Nuisance {
+                    gradient: centred(up, down, TURN_STEP_RAD),
+                    sigma,
+                    cap_sigmas: CAP_SIGMAS,
+                });
+            }
+            if let Some(sigma) = positive(shot.spin_sigma_rad_s) {
+                let spun = |d: f64| {
+                    let mut s = shot.clone();
+                    s.start.state.omega += d;
+                    observed(&s)
+                };
+                let (up, down) = (spun(SPIN_STEP_RAD_S)?, spun(-SPIN_STEP_RAD_S)?);
+                let gradient = centred(up, down, SPIN_STEP_RAD_S);
+                // How well the frames tell the spin, against its prior: Σ w·|g|²·σ².
+                let told: f64 = shot
+                    .frames
+                    .iter()
+                    .zip(&gradient)
+                    .map(|(f, g)| (g[0] * g[0] + g[1] * g[1]) * sigma * sigma / (f.sigma_m * f.sigma_m))
+                    .sum();
+                if told >= SPIN_TOLD_MIN {
+                    all.push(Nuisance {
+                        gradient,
+                        sigma,
+                        cap_sigmas: CAP_SIGMAS,
+                    });
+                }
+            }
+            (!all.is_empty()).then_some(StartNuisances(all))
         };
         let all: Vec<usize> = (0..self.shots.len()).collect();
         Ok(if self.parallel {
@@ -333,8 +404,8 @@ impl Problem {
     /// this is the plain simulation from the measured start.
     pub fn simulate_shot(&self, i: usize, model: &Model, level: f64) -> Result<Simulation, FitError> {
         let mut sim = self.simulate_measured(i, &self.shots[i], model, level)?;
-        if let Some(turn) = self.turns.get(i).and_then(Option::as_ref) {
-            turn.apply(&self.shots[i], &mut sim);
+        if let Some(nuisances) = self.nuisances.get(i).and_then(Option::as_ref) {
+            nuisances.apply(&self.shots[i], &mut sim);
         }
         Ok(sim)
     }
@@ -534,29 +605,6 @@ fn check_shot(shot: &MeasuredShot, radius: f64) -> Result<(), FitError> {
         prev = f.t_s;
     }
     Ok(())
-}
-
-impl FrameTurn {
-    /// Moves `sim`'s observed positions as the best turn ε of the shot's frame would, to first order:
-    /// `ε = −Σ w·(r·g) / (Σ w·|g|² + 1/σ²)` over the frames (`r` the residual, `g` the gradient, `w = 1/σ_f²`),
-    /// the minimiser of the frames' χ² plus the prior's (ε/σ)², held within ±[`TURN_CAP_SIGMAS`]·σ.
-    fn apply(&self, shot: &MeasuredShot, sim: &mut Simulation) {
-        let (mut num, mut den) = (0.0, 1.0 / (self.sigma_rad * self.sigma_rad));
-        for ((f, p), g) in shot.frames.iter().zip(&sim.samples).zip(&self.gradient) {
-            let w = 1.0 / (f.sigma_m * f.sigma_m);
-            num += w * ((p.observed.x - f.x_m) * g[0] + (p.observed.y - f.y_m) * g[1]);
-            den += w * (g[0] * g[0] + g[1] * g[1]);
-        }
-        let cap = TURN_CAP_SIGMAS * self.sigma_rad;
-        let eps = (-num / den).clamp(-cap, cap);
-        if !eps.is_finite() {
-            return;
-        }
-        for (p, g) in sim.samples.iter_mut().zip(&self.gradient) {
-            p.observed.x += eps * g[0];
-            p.observed.y += eps * g[1];
-        }
-    }
 }
 
 /// `shot` with its frames and start turned by `eps` (rad, counter-clockwise) about the point `(x0, 0)` on

@@ -61,4 +61,10 @@ pub struct MeasuredShot {
     /// [`crate::Problem`]); `None`: the frame is taken as exact.
     #[serde(default)]
     pub frame_sigma_rad: Option<f64>,
+    /// Standard error of the start's spin, rad/s (the estimator's incoming spin). When given, the fit lets
+    /// the incoming spin differ from the measured one with this prior (see [`crate::Problem`]): a spin error
+    /// changes how much friction works while the ball goes from sliding to rolling, and so the outgoing
+    /// tangential flight; `None`: the spin is taken as exact.
+    #[serde(default)]
+    pub spin_sigma_rad_s: Option<f64>,
 }

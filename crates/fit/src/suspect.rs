@@ -146,6 +146,7 @@ mod tests {
             measured: None,
             surface_sigma_m: None,
             frame_sigma_rad: None,
+            spin_sigma_rad_s: None,
         };
         let clean = flight_structure_chi2(&shot(false), 0.0195, 0.0205, 3e-4);
         assert_eq!(clean.len(), 2);

@@ -69,6 +69,7 @@ pub fn synth_shot(
         }),
         surface_sigma_m: None,
         frame_sigma_rad: None,
+        spin_sigma_rad_s: None,
     };
     let extras = ShotExtras {
         drop_height_m: Some(height_m),

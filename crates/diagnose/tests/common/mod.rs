@@ -166,6 +166,7 @@ fn session_of(
                 measured: None,
                 surface_sigma_m: None,
                 frame_sigma_rad: None,
+                spin_sigma_rad_s: None,
             });
         }
     }
