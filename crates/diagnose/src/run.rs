@@ -353,7 +353,7 @@ fn finish_run(
             .into_par_iter()
             .map(|f| {
                 let at = Fold {
-                    fitted: &fitted,
+                    values: &fitted,
                     levels: levels.as_deref(),
                     full: ev,
                 };
@@ -443,7 +443,7 @@ fn fit_with_levels(
 /// Where a fold starts: the full fit's values (by name), its surface levels and the full fit's evaluator
 /// (each shot's start nuisances as differenced there).
 struct Fold<'a> {
-    fitted: &'a [(String, f64)],
+    values: &'a [(String, f64)],
     levels: Option<&'a [f64]>,
     full: &'a Evaluator,
 }
@@ -458,12 +458,8 @@ fn heldout_fold(
     at: &Fold<'_>,
     opts: &SearchOptions,
 ) -> Vec<(usize, Option<ShotSums>)> {
-    let Fold {
-        fitted: full,
-        levels,
-        full: source,
-    } = *at;
-    let new_evaluator = |which: &[usize]| Evaluator::part_of(spec, source, which, opts.sim, opts.surface_levels).ok();
+    let Fold { values, levels, full } = *at;
+    let new_evaluator = |which: &[usize]| Evaluator::part_of(spec, full, which, opts.sim, opts.surface_levels).ok();
     let test: Vec<usize> = (0..shots.len()).filter(|&i| fold_of[i] == f).collect();
     let train_idx: Vec<usize> = (0..shots.len()).filter(|&i| fold_of[i] != f).collect();
     let lookup = |table: &[(String, f64)], name: &str| table.iter().find(|(n, _)| n == name).map(|(_, v)| *v);
@@ -474,7 +470,7 @@ fn heldout_fold(
             ev.set_levels(&held, false);
         }
         let names = ev.names();
-        let p0: Vec<f64> = names.iter().map(|n| lookup(full, n)).collect::<Option<_>>()?;
+        let p0: Vec<f64> = names.iter().map(|n| lookup(values, n)).collect::<Option<_>>()?;
         // Only the fold's parameters are wanted, not their covariance.
         let solver = LevenbergMarquardt {
             max_iterations: opts.fold_max_iterations,
