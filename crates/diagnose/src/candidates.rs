@@ -76,6 +76,15 @@ impl CandidateSetup {
     pub fn primary(&self) -> Option<&str> {
         self.free.first().map(|(p, _)| p.as_str())
     }
+
+    /// The switch parameter's neutral value (the effect does nothing there); 0 for an effect or parameter
+    /// the library does not know.
+    pub(crate) fn neutral(&self) -> f64 {
+        library_effect(&self.effect)
+            .ok()
+            .and_then(|i| i.params.iter().find(|p| Some(p.name) == self.primary()))
+            .map_or(0.0, |p| p.neutral)
+    }
 }
 
 /// The library effect `name`, or an error listing the library.

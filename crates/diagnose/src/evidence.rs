@@ -1,7 +1,7 @@
 //! A candidate's evidence against the current model: its fit to all shots, the paired held-out comparison,
 //! its switch parameter and the smallest value of it the session could have shown.
 
-use crate::candidates::{CandidateSetup, library_effect};
+use crate::candidates::CandidateSetup;
 use crate::diagnosis::{Candidate, Checks, Evidence};
 use crate::evaluate::ShotSums;
 use crate::options::SearchOptions;
@@ -21,11 +21,7 @@ pub(crate) fn evidence_of(
     opts: &SearchOptions,
 ) -> Candidate {
     let param = setup.primary().unwrap_or("-").to_string();
-    let neutral = library_effect(&setup.effect)
-        .ok()
-        .and_then(|i| i.params.iter().find(|p| p.name == param))
-        .map(|p| p.neutral)
-        .unwrap_or(0.0);
+    let neutral = setup.neutral();
     let mut cand = Candidate {
         effect: setup.effect.clone(),
         rank: 0,

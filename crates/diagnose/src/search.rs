@@ -383,13 +383,9 @@ impl Search<'_> {
                 .map_err(|e| e.to_string())
                 .and_then(|cspec| {
                     let primary = setup.primary().map(|p| format!("{}.{p}", setup.effect));
-                    let neutral = library_effect(&setup.effect)
-                        .ok()
-                        .and_then(|i| i.params.iter().find(|p| Some(p.name) == setup.primary()))
-                        .map_or(0.0, |p| p.neutral);
                     let scan = primary.as_deref().map(|name| Scan {
                         name,
-                        neutral,
+                        neutral: setup.neutral(),
                         noise_m,
                         floor_m: options.tolerance_m,
                         base_systematic_m: excess(base.summary.rms_m.powi(2), noise_m),

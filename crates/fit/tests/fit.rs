@@ -2,7 +2,7 @@
 
 mod common;
 
-use bouncelab_fit::{FitError, FitOptions, Iteration, ModelSpec, NoObserver, Problem, SimOptions, fit};
+use bouncelab_fit::{FitError, FitOptions, Iteration, MeasuredShot, ModelSpec, NoObserver, Problem, SimOptions, fit};
 use bouncelab_model::Model;
 use bouncelab_model::effects::Hertz;
 use common::*;
@@ -401,19 +401,23 @@ fn frames_turned_within_their_stated_sigma_are_taken_out() {
         (st.x, st.y) = turn(st.x, st.y);
         (st.vx, st.vy) = (c * st.vx - s * st.vy, s * st.vx + c * st.vy);
     }
+    misfit_until_stated(shots, "frame turns", 2.0, |shot| shot.frame_sigma_rad = Some(sigma));
+}
+
+/// Fitted with `shots` as they are, the χ² must show their start errors (χ²_red above `min_chi2_red`);
+/// with each shot's σ stated by `state`, the fit takes them out: it fits to the noise, k and b recovered.
+fn misfit_until_stated(mut shots: Vec<MeasuredShot>, what: &str, min_chi2_red: f64, state: impl Fn(&mut MeasuredShot)) {
     let spec = ModelSpec::parse(&spec_toml(&["clay", "tape1"], ""), "test model").unwrap();
     let plain = fit(&spec, shots.clone(), &no_levels(), &mut NoObserver).unwrap();
-    eprintln!("frames taken as exact: χ²_red {:.3}", plain.reduced_chi2);
+    eprintln!("{what} taken as exact: χ²_red {:.3}", plain.reduced_chi2);
     assert!(
-        plain.reduced_chi2 > 2.0,
-        "turns this large must show: χ²_red {}",
+        plain.reduced_chi2 > min_chi2_red,
+        "{what} this large must show: χ²_red {}",
         plain.reduced_chi2
     );
-    for shot in &mut shots {
-        shot.frame_sigma_rad = Some(sigma);
-    }
+    shots.iter_mut().for_each(state);
     let result = fit(&spec, shots, &no_levels(), &mut NoObserver).unwrap();
-    eprintln!("frames turned within σ: χ²_red {:.3}", result.reduced_chi2);
+    eprintln!("{what} within σ: χ²_red {:.3}", result.reduced_chi2);
     fits_to_the_noise_with_k_and_b_recovered(&result);
 }
 
@@ -427,20 +431,7 @@ fn incoming_spins_off_within_their_stated_sigma_are_taken_out() {
     for (i, shot) in shots.iter_mut().enumerate() {
         shot.start.state.omega += sigma * (i as f64 * 0.77 + 0.3).sin();
     }
-    let spec = ModelSpec::parse(&spec_toml(&["clay", "tape1"], ""), "test model").unwrap();
-    let plain = fit(&spec, shots.clone(), &no_levels(), &mut NoObserver).unwrap();
-    eprintln!("spins taken as exact: χ²_red {:.3}", plain.reduced_chi2);
-    assert!(
-        plain.reduced_chi2 > 1.5,
-        "spin errors this large must show: χ²_red {}",
-        plain.reduced_chi2
-    );
-    for shot in &mut shots {
-        shot.spin_sigma_rad_s = Some(sigma);
-    }
-    let result = fit(&spec, shots, &no_levels(), &mut NoObserver).unwrap();
-    eprintln!("spins within σ: χ²_red {:.3}", result.reduced_chi2);
-    fits_to_the_noise_with_k_and_b_recovered(&result);
+    misfit_until_stated(shots, "incoming spins", 1.5, |shot| shot.spin_sigma_rad_s = Some(sigma));
 }
 
 /// A per-surface parameter's Jacobian column re-simulates only its surface's shots: the partial residuals
