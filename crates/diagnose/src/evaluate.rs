@@ -6,11 +6,11 @@
 //! neither, and the sums and summaries the search compares.
 
 use bouncelab_fit::{
-    FitError, IterationObserver, LeastSquares, LevenbergMarquardt, MeasuredShot, NoObserver, Problem, SolverOutcome,
-    Termination, covariance, profile_surface_level, surface_prior, weighted_residuals,
+    Differences, FitError, IterationObserver, LeastSquares, LevenbergMarquardt, MeasuredShot, NoObserver, Problem,
+    SolverOutcome, Termination, covariance, profile_surface_level, surface_prior, weighted_residuals,
 };
 use bouncelab_model::{Model, ModelSpec, SimOptions, Simulation};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -161,73 +161,16 @@ impl Evaluator {
         all.into_iter().collect()
     }
 
-    /// All residuals (frames, then each shot's level prior) with `theta` and every shot at its level in
-    /// `levels` (m).
-    fn residuals_held(&self, theta: &[f64], levels: &[f64]) -> Result<DVector<f64>, FitError> {
-        let n = self.problem.shots().len();
-        let all: Vec<usize> = (0..n).collect();
-        let sims = self.simulate_held(theta, levels, &all)?;
-        let mut r = Vec::with_capacity(self.problem.n_residuals() + n);
-        for (shot, sim) in self.problem.shots().iter().zip(&sims) {
-            r.extend(weighted_residuals(shot, sim));
-        }
-        r.extend(
-            self.problem
-                .shots()
-                .iter()
-                .zip(levels)
-                .map(|(shot, &l)| surface_prior(shot, l).unwrap_or(0.0)),
-        );
-        Ok(DVector::from_vec(r))
-    }
-
-    /// Simulates the shots `which` with `theta`, each at its level in `levels` (one per shot, m).
-    fn simulate_held(&self, theta: &[f64], levels: &[f64], which: &[usize]) -> Result<Vec<Simulation>, FitError> {
-        let models = self
-            .surfaces
-            .iter()
-            .map(|s| self.problem.model_for(s, theta))
-            .collect::<Result<Vec<_>, _>>()?;
-        which
-            .par_iter()
-            .map(|&i| self.simulate_at(i, &models[self.shot_surface[i]], levels[i]))
-            .collect()
-    }
-
-    /// The Jacobian of the residuals with respect to the shared parameters at `theta`, with every shot's
-    /// surface level (m, `levels`) marginalised: central differences with the levels held, then each
-    /// shot's level column (all levels stepped at once: a level moves only its own shot's residuals and
-    /// prior) projected out of that shot's rows, the Schur complement of the joint Jacobian. Its
-    /// `(JᵀJ)⁻¹` is the shared parameters' covariance with the levels free, as profiling them gives, but
-    /// without the noise that profiling inside each finite difference puts into the columns (which made
-    /// the nearly collinear λ and n of Hunt–Crossley look determined to 0.05 %). Cost: 2p + 2 evaluations.
+    /// The Jacobian the standard errors come from at `theta`, with every shot's surface level (m,
+    /// `levels`) marginalised ([`Problem::reduced_jacobian`], central differences).
     pub fn reduced_jacobian(
         &self,
         solver: &LevenbergMarquardt,
         theta: &[f64],
         levels: &[f64],
     ) -> Result<DMatrix<f64>, FitError> {
-        let mut jac = solver.jacobian_at(&HeldLevels { ev: self, levels }, theta)?;
-        let h = LEVEL_STEP_M;
-        let up: Vec<f64> = levels.iter().map(|l| l + h).collect();
-        let dn: Vec<f64> = levels.iter().map(|l| l - h).collect();
-        let dl = (self.residuals_held(theta, &up)? - self.residuals_held(theta, &dn)?) / (2.0 * h);
-        let n_frames = self.problem.n_residuals();
-        for (i, shot) in self.problem.shots().iter().enumerate() {
-            let at = self.problem.first_residual(i);
-            let rows: Vec<usize> = (at..at + 2 * shot.frames.len()).chain([n_frames + i]).collect();
-            let ll: f64 = rows.iter().map(|&k| dl[k] * dl[k]).sum();
-            if ll <= 0.0 {
-                continue;
-            }
-            for j in 0..theta.len() {
-                let coef = rows.iter().map(|&k| dl[k] * jac[(k, j)]).sum::<f64>() / ll;
-                for &k in &rows {
-                    jac[(k, j)] -= coef * dl[k];
-                }
-            }
-        }
-        Ok(jac)
+        self.problem
+            .reduced_jacobian(solver, theta, levels, Differences::Central)
     }
 
     /// Shot `i` with the true surface at height `level` in the measured frame (m), measurement effects
@@ -321,42 +264,28 @@ impl LeastSquares for Evaluator {
     }
 
     fn bounds(&self, j: usize) -> (f64, f64) {
-        let p = &self.problem.params()[j];
-        (p.min, p.max)
+        self.problem.bounds(j)
     }
 
     fn scale(&self, j: usize) -> f64 {
-        self.problem.params()[j].scale
+        self.problem.scale(j)
+    }
+
+    /// With the levels profiled in every evaluation, the reduced Jacobian at the levels the last evaluation
+    /// profiled (those of `theta`), forward-differenced with them held: the solver then takes variable
+    /// projection's steps (Kaufman's), whose gradient is the profiled problem's own, instead of differencing
+    /// through the profile (2p profiled evaluations of 3–5 simulations a shot each, and noisy columns).
+    fn step_jacobian(&self, solver: &LevenbergMarquardt, theta: &[f64]) -> Option<Result<DMatrix<f64>, FitError>> {
+        let Levels::Profiled(_) = &self.levels else {
+            return None;
+        };
+        let levels = self.levels()?;
+        Some(
+            self.problem
+                .reduced_jacobian(solver, theta, &levels, solver.step_differences),
+        )
     }
 }
-
-/// The evaluator's residuals with every shot's surface level held at `levels` (m), as a least-squares
-/// problem in the shared parameters only.
-struct HeldLevels<'a> {
-    ev: &'a Evaluator,
-    levels: &'a [f64],
-}
-
-impl LeastSquares for HeldLevels<'_> {
-    fn n_params(&self) -> usize {
-        self.ev.n_params()
-    }
-
-    fn residuals(&self, theta: &[f64]) -> Result<Vec<f64>, FitError> {
-        Ok(self.ev.residuals_held(theta, self.levels)?.data.into())
-    }
-
-    fn bounds(&self, j: usize) -> (f64, f64) {
-        self.ev.bounds(j)
-    }
-
-    fn scale(&self, j: usize) -> f64 {
-        self.ev.scale(j)
-    }
-}
-
-/// Finite-difference step of a surface level, m (as the fit crate's profile of a level steps).
-const LEVEL_STEP_M: f64 = 1e-6;
 
 /// A shot's sums of squared residuals.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -508,7 +437,7 @@ mod tests {
         let solver = LevenbergMarquardt::default();
         let reduced = ev.reduced_jacobian(&solver, &theta, &levels).unwrap();
         // The joint Jacobian by brute force: each shared parameter, then each level on its own.
-        let r = |t: &[f64], l: &[f64]| ev.residuals_held(t, l).unwrap();
+        let r = |t: &[f64], l: &[f64]| ev.problem().residuals_held(t, l).unwrap();
         let (p, n) = (theta.len(), levels.len());
         let mut joint = DMatrix::zeros(reduced.nrows(), p + n);
         for j in 0..p {
@@ -518,6 +447,7 @@ mod tests {
             dn[j] -= h;
             joint.set_column(j, &((r(&up, &levels) - r(&dn, &levels)) / (2.0 * h)));
         }
+        const LEVEL_STEP_M: f64 = 1e-6;
         for i in 0..n {
             let (mut up, mut dn) = (levels, levels);
             up[i] += LEVEL_STEP_M;
@@ -537,5 +467,38 @@ mod tests {
         let held = joint.columns(0, p).into_owned();
         let cov_held = held.tr_mul(&held).try_inverse().unwrap();
         assert!(cov_held[(0, 0)] < cov_joint[(0, 0)] && cov_held[(1, 1)] < cov_joint[(1, 1)]);
+    }
+
+    #[test]
+    fn the_step_jacobian_gives_the_profiled_cost_s_gradient() {
+        let spec = ModelSpec::parse(&spec_toml("t", &["clay"], ""), "test").unwrap();
+        let ev = Evaluator::new(&spec, shots(), SimOptions::default(), true).unwrap();
+        // Away from the optimum, so the gradient is large.
+        let theta = vec![27_000.0, 12.0];
+        let solver = LevenbergMarquardt::default();
+        let r = ev.residuals(&theta).unwrap();
+        let jac = ev
+            .step_jacobian(&solver, &theta)
+            .expect("profiled levels give a step Jacobian")
+            .unwrap();
+        let grad = jac.tr_mul(&DMatrix::from_column_slice(r.len(), 1, &r));
+        // The profiled cost ½Σr² differenced, the levels profiled again at each point.
+        let cost = |t: &[f64]| ev.residuals(t).unwrap().iter().map(|v| v * v).sum::<f64>() / 2.0;
+        for j in 0..theta.len() {
+            let h = 1e-4 * theta[j];
+            let (mut up, mut dn) = (theta.clone(), theta.clone());
+            up[j] += h;
+            dn[j] -= h;
+            let want = (cost(&up) - cost(&dn)) / (2.0 * h);
+            assert!(
+                (grad[j] - want).abs() <= 0.01 * want.abs(),
+                "parameter {j}: {} vs {want}",
+                grad[j]
+            );
+        }
+        // Held levels have no step Jacobian of their own: the solver differences them.
+        let mut held = Evaluator::new(&spec, shots(), SimOptions::default(), true).unwrap();
+        held.set_levels(&[0.0; 4], false);
+        assert!(held.step_jacobian(&solver, &theta).is_none());
     }
 }

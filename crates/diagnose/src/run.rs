@@ -387,10 +387,10 @@ fn finish_run(
 /// correlated (a free surface level per surface against each shot's level, and a restitution-phase effect
 /// against both): on a tracked restitution-damping session it left the current model at 32.9 µm against
 /// the joint optimum's 16.4 µm, and ranked the plastic dent (9.1 µm) above the true effect (9.5 µm; 8.3 µm
-/// at its joint optimum). So a last fit profiles the levels inside every evaluation (the fit crate's joint
-/// problem), warm-started where the rounds ended; from a cold start that fit took eight times longer on
-/// the benchmark (the profiled levels make the Jacobian noisy and the fit long). Every model starts from
-/// the same levels, so all are compared alike. Leaves `ev` profiling from the final levels.
+/// at its joint optimum). So a last fit profiles the levels inside every evaluation, warm-started where the
+/// rounds ended, stepping with the levels projected out (variable projection); when its steps were
+/// differenced through the profile, a cold start took eight times longer on the benchmark. Every model
+/// starts from the same levels, so all are compared alike. Leaves `ev` profiling from the final levels.
 fn fit_with_levels(
     ev: &mut Evaluator,
     start: &[f64],
@@ -429,15 +429,18 @@ fn fit_with_levels(
     let solver = LevenbergMarquardt {
         max_iterations: opts.fold_max_iterations,
         ftol: opts.solver.ftol.max(1e-5),
-        // The levels profiled inside each evaluation make forward differences too noisy to converge in
-        // this budget (restitution damping's fit stopped 1 % higher on a drag session).
+        // Its steps take the reduced Jacobian (variable projection, `Evaluator`'s step Jacobian), here
+        // centrally differenced with the levels held. Differenced through the profiled levels instead,
+        // forward differences were too noisy to converge in this budget (restitution damping's fit stopped
+        // 1 % higher on a drag session) and central ones cost 2p profiles a step: 21.7 → 16.2 s of
+        // search on `paper`.
         step_differences: Differences::Central,
         ..rounds
     };
     let mut joint = ev.fit_observed(&solver, &p, observer)?;
     // The solver's last evaluation may have been a rejected step: profile the levels at the result.
     ev.simulate(&joint.params)?;
-    // Its Jacobian went through the profiled levels; the standard errors come from the smooth one.
+    // The standard errors come from the reduced Jacobian at the result.
     let levels = ev.levels().unwrap_or_default();
     joint.jacobian = ev.reduced_jacobian(&solver, &joint.params, &levels).ok();
     Ok(joint)

@@ -12,6 +12,7 @@
 
 mod covariance;
 mod error;
+mod held_levels;
 mod measurement;
 mod nuisance;
 mod params;

@@ -381,6 +381,23 @@ impl Problem {
         all.into_iter().collect()
     }
 
+    /// Simulates the shots `which` with `theta`, each at its level in `levels` (one per shot, m), in that
+    /// order.
+    pub(crate) fn simulate_at_levels(
+        &self,
+        theta: &[f64],
+        levels: &[f64],
+        which: &[usize],
+    ) -> Result<Vec<Simulation>, FitError> {
+        let models: Vec<Model> = self.surfaces.iter().map(|s| s.model(theta)).collect::<Result<_, _>>()?;
+        let one = |&i: &usize| self.simulate_shot(i, &models[self.shot_surface[i]], levels[i]);
+        if self.parallel {
+            which.par_iter().map(one).collect()
+        } else {
+            which.iter().map(one).collect()
+        }
+    }
+
     /// The shots whose simulation parameter `j` changes: those of its surface for a per-surface parameter,
     /// `None` (every shot) for a shared one.
     pub fn shots_of_param(&self, j: usize) -> Option<Vec<usize>> {

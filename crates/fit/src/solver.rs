@@ -28,6 +28,14 @@ pub trait LeastSquares: Sync {
     fn residuals_changing(&self, p: &[f64], _j: usize, _base: &[f64]) -> Result<Vec<f64>, FitError> {
         self.residuals(p)
     }
+    /// The Jacobian `∂r/∂p` (in the parameters' own units) the solver's step from `p` uses, when the problem
+    /// has a better one than finite differences of [`LeastSquares::residuals`]: a problem that profiles
+    /// nuisances inside each evaluation returns the Jacobian with them held and projected out (variable
+    /// projection), smooth where differences through the profile are not, and far cheaper. `p` is the
+    /// point of the solver's last evaluation. `None` (the default): the solver differences the residuals.
+    fn step_jacobian(&self, _solver: &LevenbergMarquardt, _p: &[f64]) -> Option<Result<DMatrix<f64>, FitError>> {
+        None
+    }
 }
 
 /// What the solver reports after each iteration (iteration 0 is the starting point).
@@ -310,12 +318,45 @@ impl<'a, P: LeastSquares> Eval<'a, P> {
     }
 
     /// [`Eval::jacobian`] back in the parameters' own units: ∂r/∂p = ∂r/∂u / scale.
-    fn jacobian_unscaled(&mut self, u: &[f64], r0: &DVector<f64>, h: f64) -> Result<DMatrix<f64>, FitError> {
-        let mut j = self.jacobian(u, r0, h, Differences::Central)?;
+    fn jacobian_unscaled(
+        &mut self,
+        u: &[f64],
+        r0: &DVector<f64>,
+        h: f64,
+        differences: Differences,
+    ) -> Result<DMatrix<f64>, FitError> {
+        let mut j = self.jacobian(u, r0, h, differences)?;
         for (k, s) in self.scale.iter().enumerate() {
             j.column_mut(k).scale_mut(1.0 / s);
         }
         Ok(j)
+    }
+
+    /// The Jacobian of the step from `u`: the problem's own ([`LeastSquares::step_jacobian`], scaled to `u`)
+    /// or finite differences.
+    fn step_jacobian(
+        &mut self,
+        solver: &LevenbergMarquardt,
+        u: &[f64],
+        r0: &DVector<f64>,
+    ) -> Result<DMatrix<f64>, FitError> {
+        match self.problem.step_jacobian(solver, &self.params(u)) {
+            Some(jac) => {
+                let mut jac = jac?;
+                if jac.shape() != (r0.len(), u.len()) {
+                    return Err(FitError::BadResiduals(format!(
+                        "a step Jacobian of {:?}, expected {:?}",
+                        jac.shape(),
+                        (r0.len(), u.len())
+                    )));
+                }
+                for (k, s) in self.scale.iter().enumerate() {
+                    jac.column_mut(k).scale_mut(*s);
+                }
+                Ok(jac)
+            }
+            None => self.jacobian(u, r0, solver.fd_step, solver.step_differences),
+        }
     }
 }
 
@@ -334,10 +375,21 @@ impl LevenbergMarquardt {
     /// solver computes it: central differences of `fd_step` relative to each parameter's scale, one-sided
     /// at a bound.
     pub fn jacobian_at<P: LeastSquares>(&self, problem: &P, p: &[f64]) -> Result<DMatrix<f64>, FitError> {
+        self.jacobian_with(problem, p, Differences::Central)
+    }
+
+    /// [`LevenbergMarquardt::jacobian_at`] with the given differences (forward: p + 1 evaluations, as the
+    /// solver's steps take them by default).
+    pub fn jacobian_with<P: LeastSquares>(
+        &self,
+        problem: &P,
+        p: &[f64],
+        differences: Differences,
+    ) -> Result<DMatrix<f64>, FitError> {
         let mut ev = Eval::new(problem);
         let u: Vec<f64> = p.iter().zip(&ev.scale).map(|(p, s)| p / s).collect();
         let r0 = ev.residuals(&u, None)?;
-        ev.jacobian_unscaled(&u, &r0, self.fd_step)
+        ev.jacobian_unscaled(&u, &r0, self.fd_step, differences)
     }
 
     /// Minimises `problem` from `p0` (clamped into the bounds), reporting each iteration to `observer`.
@@ -377,7 +429,7 @@ impl LevenbergMarquardt {
                 break Termination::MaxIterations;
             }
             iterations += 1;
-            let jac = match ev.jacobian(&st.u, &st.r, self.fd_step, self.step_differences) {
+            let jac = match ev.step_jacobian(self, &st.u, &st.r) {
                 Ok(j) => j,
                 Err(e) => break failure(&e).ok_or(e)?,
             };
@@ -386,7 +438,8 @@ impl LevenbergMarquardt {
             }
         };
         let jacobian = if self.jacobian_at_end {
-            ev.jacobian_unscaled(&st.u, &st.r, self.fd_step).ok()
+            ev.jacobian_unscaled(&st.u, &st.r, self.fd_step, Differences::Central)
+                .ok()
         } else {
             None
         };
@@ -558,6 +611,77 @@ mod tests {
         assert!(out.jacobian.is_some());
     }
 
+    /// Two fits' parameters agree within 1e-6 relative.
+    fn assert_same_optimum(a: &[f64], b: &[f64]) {
+        for (x, y) in a.iter().zip(b) {
+            assert!((x - y).abs() < 1e-6 * y.abs(), "{a:?} vs {b:?}");
+        }
+    }
+
+    /// [`Decay`] with its exact Jacobian for the solver's steps, counting how often it is asked.
+    struct ExactSteps {
+        decay: Decay,
+        asked: std::sync::atomic::AtomicUsize,
+        shape: Option<(usize, usize)>,
+    }
+
+    impl LeastSquares for ExactSteps {
+        fn n_params(&self) -> usize {
+            3
+        }
+        fn residuals(&self, p: &[f64]) -> Result<Vec<f64>, FitError> {
+            self.decay.residuals(p)
+        }
+        fn bounds(&self, j: usize) -> (f64, f64) {
+            self.decay.bounds(j)
+        }
+        fn scale(&self, j: usize) -> f64 {
+            self.decay.scale(j)
+        }
+        fn step_jacobian(&self, _solver: &LevenbergMarquardt, p: &[f64]) -> Option<Result<DMatrix<f64>, FitError>> {
+            self.asked.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            let (rows, cols) = self.shape.unwrap_or((self.decay.t.len(), 3));
+            Some(Ok(DMatrix::from_fn(rows, cols, |i, j| {
+                let t = self.decay.t[i];
+                let e = (-t / p[1]).exp();
+                [e, p[0] * e * t / (p[1] * p[1]), 1.0][j]
+            })))
+        }
+    }
+
+    #[test]
+    fn a_problem_s_own_step_jacobian_is_used_and_reaches_the_same_optimum() {
+        let exact = ExactSteps {
+            decay: Decay::new([12.0, 0.4, 1.5]),
+            asked: 0.into(),
+            shape: None,
+        };
+        let solver = LevenbergMarquardt::default();
+        let start = [6.0, 0.8, 0.5];
+        let own = solver.run(&exact, &start, &mut NoObserver).unwrap();
+        let differenced = solver.run(&exact.decay, &start, &mut NoObserver).unwrap();
+        assert!(own.termination.converged(), "{}", own.termination);
+        assert_same_optimum(&own.params, &differenced.params);
+        // One request per iteration, and no residual evaluation spent on differences for the steps (the
+        // covariance Jacobian at the end still takes 2p).
+        assert_eq!(exact.asked.load(std::sync::atomic::Ordering::Relaxed), own.iterations);
+        assert!(
+            own.evaluations < differenced.evaluations,
+            "{} vs {}",
+            own.evaluations,
+            differenced.evaluations
+        );
+        // A Jacobian of the wrong shape is an error, not a panic.
+        let wrong = ExactSteps {
+            shape: Some((5, 3)),
+            ..exact
+        };
+        assert!(matches!(
+            solver.run(&wrong, &start, &mut NoObserver),
+            Err(FitError::BadResiduals(_))
+        ));
+    }
+
     #[test]
     fn forward_and_central_steps_reach_one_optimum_and_the_same_covariance_jacobian() {
         // Noisy data, so the optimum is not the truth and the residuals there are not zero.
@@ -575,14 +699,7 @@ mod tests {
         };
         let (central, forward) = (fit(Differences::Central), fit(Differences::Forward));
         assert!(forward.termination.converged(), "{}", forward.termination);
-        for (f, c) in forward.params.iter().zip(&central.params) {
-            assert!(
-                (f - c).abs() < 1e-6 * c.abs(),
-                "{:?} vs {:?}",
-                forward.params,
-                central.params
-            );
-        }
+        assert_same_optimum(&forward.params, &central.params);
         // Each forward Jacobian costs 3 evaluations, a central one 6.
         assert!(
             forward.evaluations < central.evaluations,
