@@ -1,7 +1,8 @@
-// cargo run --release --example verdict_sweep -- [--seeds 1,2,3] [PRESET ...]
+// cargo run --release --example verdict_sweep -- [--seeds 1,2,3] [PRESET | SCENARIO.toml ...]
 //
 //! The missing-effect diagnosis over seeds: each preset (default: `none`, every `effect-<name>` and every
-//! `pair-A+B`) rendered at each seed (default 1, 2, 3), analysed as `bouncelab analyze` does (tracked,
+//! `pair-A+B`; or a scenario file, such as the 16-shot pairs in `fixtures/scenarios/`) rendered at each seed
+//! (default 1, 2, 3), analysed as `bouncelab analyze` does (tracked,
 //! estimated, fitted with the paper's model, searched), and judged against the scenario's truth. One
 //! Markdown row per session, printed as it finishes: the verdict, whether it is right (issue 16's rule: the
 //! hidden effect named first, alone or first of an ambiguous few; both of a pair named; nothing named on a
@@ -48,7 +49,12 @@ fn main() {
     let (mut right, mut total) = (0, 0);
     for preset in &presets {
         for &seed in &seeds {
-            let mut scenario = Scenario::preset(preset).unwrap_or_else(|e| panic!("{preset}: {e}"));
+            let mut scenario = if preset.ends_with(".toml") {
+                Scenario::load(std::path::Path::new(preset))
+            } else {
+                Scenario::preset(preset)
+            }
+            .unwrap_or_else(|e| panic!("{preset}: {e}"));
             scenario.seed = seed;
             let row = session_row(&scenario, preset, seed);
             right += row.1 as usize;
