@@ -52,6 +52,12 @@ fn stdout(c: &mut Command) -> String {
     String::from_utf8(out.stdout).unwrap()
 }
 
+/// A successful run's progress lines (each stage's last word, on stderr).
+fn stages(c: &mut Command) -> String {
+    let out = c.assert().success().get_output().clone();
+    String::from_utf8(out.stderr).unwrap()
+}
+
 #[test]
 fn writes_every_output_and_reuses_unchanged_shots() {
     let dir = tempfile::tempdir().unwrap();
@@ -92,9 +98,30 @@ fn writes_every_output_and_reuses_unchanged_shots() {
     }
     report_figures_hold_the_csv_numbers(&out);
 
-    // Nothing changed: nothing tracked.
-    let second = stdout(&mut analyze(&session, &out));
-    assert!(second.contains("0 measured now, 3 reused"), "{second}");
+    // Nothing changed: nothing tracked, nor fitted.
+    const FIT_REUSED: &str = "fit: unchanged since the last run (fit.json)";
+    let fitted = std::fs::read(out.join("fit.json")).unwrap();
+    let compared = std::fs::read(out.join("comparison.csv")).unwrap();
+    let second = stages(&mut analyze(&session, &out));
+    assert!(second.contains("0 shot(s) tracked, 3 reused"), "{second}");
+    assert!(second.contains(FIT_REUSED), "{second}");
+    assert!(
+        std::fs::read(out.join("fit.json")).unwrap() == fitted,
+        "the fit read back is the fit"
+    );
+    assert!(
+        std::fs::read(out.join("comparison.csv")).unwrap() == compared,
+        "the comparison from the fit read back is the same"
+    );
+    // Another model is fitted again.
+    let model = dir.path().join("model.toml");
+    std::fs::write(
+        &model,
+        bouncelab_model::PAPER_MODEL_TOML.replace("[model]", "[model]\n# a copy\n"),
+    )
+    .unwrap();
+    let other = stages(analyze(&session, &out).arg("--model").arg(&model));
+    assert!(other.contains("fit: ") && !other.contains(FIT_REUSED), "{other}");
 
     // One clip's frames touched (a frame rewritten): only that shot is tracked again.
     let clip = std::fs::read_dir(&session)

@@ -40,6 +40,17 @@ pub(crate) struct Recorded {
     pub model_text: String,
 }
 
+/// The model file's text, or the paper model's when none is given.
+pub(crate) fn model_toml(options: &AnalyzeOptions) -> Result<String, AnalyzeError> {
+    match &options.model_path {
+        Some(p) => std::fs::read_to_string(p).map_err(|source| AnalyzeError::Io {
+            path: p.clone(),
+            source,
+        }),
+        None => Ok(bouncelab_model::PAPER_MODEL_TOML.to_string()),
+    }
+}
+
 /// Stores the model version (the file's text, or the paper model's) and its fit on session `session_id`,
 /// after reading the previous version's fit to compare against.
 pub(crate) fn record_fit(
@@ -48,13 +59,7 @@ pub(crate) fn record_fit(
     options: &AnalyzeOptions,
     fit: &FitResult,
 ) -> Result<Recorded, AnalyzeError> {
-    let model_toml = match &options.model_path {
-        Some(p) => std::fs::read_to_string(p).map_err(|source| AnalyzeError::Io {
-            path: p.clone(),
-            source,
-        })?,
-        None => bouncelab_model::PAPER_MODEL_TOML.to_string(),
-    };
+    let model_toml = model_toml(options)?;
     let version = store.add_model_version(&ModelVersionRecord {
         name: model_name(options.model_path.as_deref()),
         toml: model_toml,

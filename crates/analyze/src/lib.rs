@@ -14,6 +14,7 @@ mod history;
 mod measure;
 mod outputs;
 mod report;
+mod reuse;
 mod search;
 mod session_model;
 mod shots;
@@ -201,7 +202,8 @@ pub fn analyze(
         fitted,
         problem,
         fit,
-    } = timings.time(Stage::Fit, || fit_stage(&spec, &shots, progress))?;
+        inputs_key,
+    } = timings.time(Stage::Fit, || fit_stage(&spec, &shots, options, progress))?;
     let recorded = history::record_fit(&mut store, measure.session_id, options, &fit)?;
     let extras = evidence::fitted_extras(&fitted, &fit, spec.ball.radius_m);
     let (comparison, failure) = timings.time(Stage::Compare, || compare_stage(&problem, &fit, &extras, progress))?;
@@ -231,6 +233,10 @@ pub fn analyze(
         version: recorded.version,
     };
     let outputs = timings.time(Stage::Report, || write_outputs(&options.out_dir, &written))?;
+    // After fit.json: the key of the inputs it was fitted from, for the next run to reuse it.
+    outputs::write_atomic(&options.out_dir.join(FIT_INPUTS), |w| {
+        w.write_all(inputs_key.as_bytes())
+    })?;
     let started_report = Instant::now();
     let fitted_at = store.latest_fit(measure.session_id)?.map(|f| f.created_at);
     let mut analysis = Analysis {
@@ -330,22 +336,29 @@ fn excluded_shots(shots: &[ShotData], progress: &dyn Progress) -> Vec<(String, S
     excluded
 }
 
-/// What the fit stage leaves: the shots left out with the reason, those fitted, the problem and the fit.
+/// What the fit stage leaves: the shots left out with the reason, those fitted, the problem, the fit and
+/// the key of the inputs it depends on.
 struct FitStage<'a> {
     excluded: Vec<(String, String)>,
     fitted: Vec<&'a ShotData>,
     problem: Problem,
     fit: FitResult,
+    inputs_key: String,
 }
+
+/// Beside `fit.json` in the output folder: the key of the inputs it was fitted from.
+const FIT_INPUTS: &str = ".fit-inputs";
 
 /// The model fitted to the shots not excluded ([`excluded_shots`]): the surface level per surface (the
 /// nuisance of [`bouncelab_fit::add_surface_level`]) and, per shot, an offset from it within the surface
 /// line's stated error (a free offset per shot would also absorb most of a missing contact effect:
 /// restitution damping's 65 µm misfit falls to 16 µm). Every solver iteration is reported as the reduced χ²
-/// the result reports.
+/// the result reports. The fit in the output folder's `fit.json` is taken instead when nothing it depends on
+/// changed ([`fit_inputs_key`]): a session re-run with nothing new is not fitted again.
 fn fit_stage<'a>(
     spec: &ModelSpec,
     shots: &'a [ShotData],
+    options: &AnalyzeOptions,
     progress: &dyn Progress,
 ) -> Result<FitStage<'a>, AnalyzeError> {
     progress.start(Stage::Fit, 1);
@@ -361,12 +374,37 @@ fn fit_stage<'a>(
         .n_residuals()
         .saturating_sub(problem.params().len() + problem.nuisance_per_shot() * problem.shots().len())
         .max(1) as f64;
-    let mut observer = |it: &bouncelab_fit::Iteration<'_>| progress.iteration(Stage::Fit, it.iteration, it.cost / dof);
-    let fit = fit_problem(&problem, &spec.origin, &fit_options, &mut observer)?;
+    let inputs_key = fit_inputs_key(spec, &history::model_toml(options)?, &fit_options, &problem, &fitted);
+    let out = &options.out_dir;
+    let (fit, reused) = match reuse::read_back::<FitResult>(&out.join("fit.json"), &out.join(FIT_INPUTS), &inputs_key) {
+        Some(fit) => {
+            // The comparison profiles each shot's level from where the fit left it.
+            if fit
+                .shots
+                .iter()
+                .map(|s| &s.name)
+                .eq(problem.shots().iter().map(|s| &s.name))
+            {
+                let levels: Vec<f64> = fit.shots.iter().map(|s| s.surface_offset_m.unwrap_or(0.0)).collect();
+                problem.start_offsets_at(&levels);
+            }
+            (fit, true)
+        }
+        None => {
+            let mut observer =
+                |it: &bouncelab_fit::Iteration<'_>| progress.iteration(Stage::Fit, it.iteration, it.cost / dof);
+            (fit_problem(&problem, &spec.origin, &fit_options, &mut observer)?, false)
+        }
+    };
     progress.finish(
         Stage::Fit,
         &format!(
-            "{} parameter(s), position RMS {:.1} µm, reduced χ² {:.2}, {} after {} iteration(s)",
+            "{}{} parameter(s), position RMS {:.1} µm, reduced χ² {:.2}, {} after {} iteration(s)",
+            if reused {
+                "unchanged since the last run (fit.json): "
+            } else {
+                ""
+            },
             fit.parameters.len(),
             fit.rms_m * 1e6,
             fit.reduced_chi2,
@@ -379,7 +417,34 @@ fn fit_stage<'a>(
         fitted,
         problem,
         fit,
+        inputs_key,
     })
+}
+
+/// The key of what the fit depends on: the program's version, the model file's text and the model as the
+/// session made it (ball, gravity, effects' settings, per-surface values), the fit's options, the free
+/// parameters and every fitted shot's measurement.
+fn fit_inputs_key(
+    spec: &ModelSpec,
+    model_toml: &str,
+    fit_options: &FitOptions,
+    problem: &Problem,
+    fitted: &[&ShotData],
+) -> String {
+    let mut key = bouncelab_store::Fingerprint::new();
+    key.str(env!("CARGO_PKG_VERSION"))
+        .str(model_toml)
+        .str(&format!("{:?} {:?} {:?}", spec.ball, spec.gravity, spec.surfaces))
+        .str(&format!("{fit_options:?}"))
+        .str(&format!("{:?}", problem.params()));
+    for e in &spec.effects {
+        key.str(&e.name).str(&format!("{:?}", e.params));
+    }
+    for s in fitted {
+        key.str(&s.clip)
+            .str(&serde_json::to_string(&s.measured).unwrap_or_default());
+    }
+    key.finish()
 }
 
 /// The fitted model against every fitted shot, and where it fails.

@@ -6,7 +6,6 @@ use bouncelab_compare::ShotExtras;
 use bouncelab_diagnose::{Diagnosis, FittedBaseline, SearchOptions, SearchProgress, find_missing_effect_from};
 use bouncelab_model::ModelSpec;
 use bouncelab_store::Fingerprint;
-use std::path::Path;
 
 /// The search's options: the defaults, with each shot's surface level fitted within its line's σ.
 fn search_options() -> SearchOptions {
@@ -48,7 +47,7 @@ pub(crate) fn search_stage(
     let key = inputs_key(model_text, &options, shots);
     let path = out_dir.join("diagnosis.json");
     let key_path = out_dir.join(".diagnosis-inputs");
-    if let Some(d) = cached(&path, &key_path, &key) {
+    if let Some(d) = crate::reuse::read_back::<Diagnosis>(&path, &key_path, &key) {
         progress.finish(
             Stage::Diagnose,
             &format!(
@@ -102,14 +101,4 @@ fn inputs_key(model_text: &str, options: &SearchOptions, shots: &[&ShotData]) ->
             .str(&serde_json::to_string(&s.measured).unwrap_or_default());
     }
     key.finish()
-}
-
-/// The diagnosis in `path`, when `key_path` holds `key` (the inputs it was made from).
-fn cached(path: &Path, key_path: &Path, key: &str) -> Option<Diagnosis> {
-    if !std::fs::read_to_string(key_path).is_ok_and(|k| k.trim() == key) {
-        return None;
-    }
-    std::fs::read_to_string(path)
-        .ok()
-        .and_then(|t| serde_json::from_str::<Diagnosis>(&t).ok())
 }

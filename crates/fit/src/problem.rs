@@ -306,6 +306,19 @@ impl Problem {
         }
     }
 
+    /// Each shot's surface level the next evaluation profiles from (one per shot, m): a fit read back
+    /// gives its problem the levels it ended at, so that what is computed from it (the comparison) starts
+    /// where the fit did. Ignored without surface offsets or when the count differs.
+    pub fn start_offsets_at(&self, levels: &[f64]) {
+        if let Some(cache) = &self.offsets
+            && levels.len() == cache.0.len()
+        {
+            for (a, l) in cache.0.iter().zip(levels) {
+                a.store(l.clamp(-MAX_OFFSET_M, MAX_OFFSET_M).to_bits(), Ordering::Relaxed);
+            }
+        }
+    }
+
     /// Nuisance parameters per shot (1 with surface offsets, else 0), for degrees of freedom and BIC.
     pub fn nuisance_per_shot(&self) -> usize {
         usize::from(self.offsets.is_some())
