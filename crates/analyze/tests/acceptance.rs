@@ -411,18 +411,6 @@ fn hidden_pair_hertz_and_drag_both_named() {
     pair("hertz", "drag");
 }
 
-/// The 16-shot Hertz + drag session at seed 2, where Hertz went unnamed: with Hertz alone its k_h stood
-/// only 2.9 standard errors from neutral (drag's misfit widened its robust error), though 200 in the fit
-/// with both.
-#[test]
-#[ignore]
-fn hidden_pair_hertz_and_drag_in_16_shots_both_named() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/scenarios/pair-hertz+drag-16.toml");
-    let mut scenario = Scenario::load(&path).unwrap();
-    scenario.seed = 2;
-    pair_in("hertz", "drag", &scenario);
-}
-
 #[test]
 #[ignore]
 fn hidden_pair_hunt_crossley_and_rolling_resistance_both_named() {
