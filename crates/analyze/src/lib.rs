@@ -391,6 +391,7 @@ fn fit_stage<'a>(
             (fit, true)
         }
         None => {
+            reuse::forget(&out.join(FIT_INPUTS))?;
             let mut observer =
                 |it: &bouncelab_fit::Iteration<'_>| progress.iteration(Stage::Fit, it.iteration, it.cost / dof);
             (fit_problem(&problem, &spec.origin, &fit_options, &mut observer)?, false)

@@ -57,6 +57,7 @@ pub(crate) fn search_stage(
         );
         return Ok(Ok(d));
     }
+    crate::reuse::forget(&key_path)?;
     let measured: Vec<_> = shots.iter().map(|s| s.measured.clone()).collect();
     // The current model plus every library effect it lacks.
     let total = 1 + bouncelab_model::builtin_effects()
