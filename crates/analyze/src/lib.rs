@@ -441,10 +441,7 @@ fn fit_inputs_key(
     for e in &spec.effects {
         key.str(&e.name).str(&format!("{:?}", e.params));
     }
-    for s in fitted {
-        key.str(&s.clip)
-            .str(&serde_json::to_string(&s.measured).unwrap_or_default());
-    }
+    reuse::add_shots(&mut key, fitted);
     key.finish()
 }
 

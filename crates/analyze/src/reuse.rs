@@ -3,7 +3,8 @@
 //! and written after it, so a run stopped in between leaves no key (the next run makes the result again),
 //! never a new result under an old key.
 
-use crate::AnalyzeError;
+use crate::{AnalyzeError, ShotData};
+use bouncelab_store::Fingerprint;
 use serde::de::DeserializeOwned;
 use std::path::Path;
 
@@ -15,6 +16,15 @@ pub(crate) fn read_back<T: DeserializeOwned>(path: &Path, key_path: &Path, key: 
     std::fs::read_to_string(path)
         .ok()
         .and_then(|t| serde_json::from_str::<T>(&t).ok())
+}
+
+/// `key` extended with every shot's clip name and measurement, the inputs every stage after measuring
+/// depends on.
+pub(crate) fn add_shots(key: &mut Fingerprint, shots: &[&ShotData]) {
+    for s in shots {
+        key.str(&s.clip)
+            .str(&serde_json::to_string(&s.measured).unwrap_or_default());
+    }
 }
 
 /// Removes the key at `key_path` before its result is made again (no key there is fine).

@@ -97,9 +97,6 @@ fn inputs_key(model_text: &str, options: &SearchOptions, shots: &[&ShotData]) ->
     key.str(env!("CARGO_PKG_VERSION"))
         .str(model_text)
         .str(&format!("{options:?}"));
-    for s in shots {
-        key.str(&s.clip)
-            .str(&serde_json::to_string(&s.measured).unwrap_or_default());
-    }
+    crate::reuse::add_shots(&mut key, shots);
     key.finish()
 }
