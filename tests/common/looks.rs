@@ -30,8 +30,8 @@ pub struct ClipResult {
     /// COR and μ: (estimate, SE, truth).
     pub cor: Option<(f64, f64, f64)>,
     pub mu: Option<(f64, f64, f64)>,
-    /// Surface tilt error, degrees (measured − truth), when a line was found.
-    pub tilt_err_deg: Option<f64>,
+    /// Surface tilt error, degrees (measured − truth), and its stated standard error, when a line was found.
+    pub tilt_err_deg: Option<(f64, f64)>,
 }
 
 fn rms(v: &[f64]) -> f64 {
@@ -165,7 +165,9 @@ fn evaluate_clip(
             }
             result.cor = Some((e.cor.value, e.cor.se, num(truth, "cor")));
             result.mu = Some((e.mu.value, e.mu.se, num(truth, "mu_eff")));
-            result.tilt_err_deg = e.surface_tilt_deg.map(|t| t.value - num(truth, "surface_tilt_deg"));
+            result.tilt_err_deg = e
+                .surface_tilt_deg
+                .map(|t| (t.value - num(truth, "surface_tilt_deg"), t.se));
             if !e.flags.is_empty() {
                 result.failure = Some(format!("flagged: {}", e.flags.join("; ")));
             }
@@ -191,18 +193,23 @@ pub fn clip_table(results: &[ClipResult]) -> String {
             r.centre_rms_px.0,
             r.centre_rms_px.1,
             r.level.as_ref().map_or("–".into(), |l| l.0.clone()),
-            f(r.level.as_ref().map(|l| l.1), 2),
+            r.level
+                .as_ref()
+                .map_or("–".into(), |l| format!("{:+.2} ± {:.2}", l.1, l.2)),
             f(r.cor.map(|c| c.0 - c.2), 4),
             f(r.mu.map(|c| c.0 - c.2), 4),
-            f(r.tilt_err_deg, 3),
+            r.tilt_err_deg
+                .map_or("–".into(), |t| format!("{:+.3} ± {:.3}", t.0, t.1)),
             r.failure.as_deref().unwrap_or("")
         );
     }
     s
 }
 
-/// One Markdown table row per look family: clips, shots lost, frames found, the worst frame count on
-/// another object, centre RMS in flight and contact, contact level RMS error, COR and μ RMS and worst error.
+/// One Markdown table row per look family: clips, shots lost (no estimate), shots flagged (an estimate the
+/// estimator says not to trust), frames found, the frames on another object, centre RMS in flight and
+/// contact, contact level RMS error, and COR and μ RMS and worst error over the shots estimated without a
+/// flag.
 pub fn family_table(results: &[ClipResult]) -> String {
     let mut fams: BTreeMap<String, Vec<&ClipResult>> = BTreeMap::new();
     for r in results {
@@ -212,21 +219,24 @@ pub fn family_table(results: &[ClipResult]) -> String {
         fams.entry("(all)".into()).or_default().push(r);
     }
     let mut s = String::from(
-        "| family | clips | lost | frames found | on another object | flight RMS px | contact RMS px | level RMS px | COR RMS / worst | μ RMS / worst |\n|---|---|---|---|---|---|---|---|---|---|\n",
+        "| family | clips | lost | flagged | frames found | on another object | flight RMS px | contact RMS px | level RMS px | COR RMS / worst | μ RMS / worst |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for (fam, rs) in &fams {
-        let lost = rs.iter().filter(|r| r.failure.is_some()).count();
+        let flagged = |r: &&&ClipResult| r.failure.as_deref().is_some_and(|f| f.starts_with("flagged"));
+        let lost = rs.iter().filter(|r| r.failure.is_some()).count() - rs.iter().filter(flagged).count();
+        let trusted = || rs.iter().filter(|r| r.failure.is_none());
         let found: usize = rs.iter().map(|r| r.frames_found.0).sum();
         let vis: usize = rs.iter().map(|r| r.frames_found.1).sum();
         let wrong: usize = rs.iter().map(|r| r.frames_wrong).sum();
         let all =
             |k: fn(&ClipResult) -> f64| -> Vec<f64> { rs.iter().map(|r| k(r)).filter(|v| v.is_finite()).collect() };
-        let cor: Vec<f64> = rs.iter().filter_map(|r| r.cor.map(|c| c.0 - c.2)).collect();
-        let mu: Vec<f64> = rs.iter().filter_map(|r| r.mu.map(|c| c.0 - c.2)).collect();
+        let cor: Vec<f64> = trusted().filter_map(|r| r.cor.map(|c| c.0 - c.2)).collect();
+        let mu: Vec<f64> = trusted().filter_map(|r| r.mu.map(|c| c.0 - c.2)).collect();
         let worst = |v: &[f64]| v.iter().fold(0.0f64, |a, b| a.max(b.abs()));
         s += &format!(
-            "| {fam} | {} | {lost} | {found}/{vis} | {wrong} | {:.3} | {:.3} | {:.2} | {:.4} / {:.4} | {:.4} / {:.4} |\n",
+            "| {fam} | {} | {lost} | {} | {found}/{vis} | {wrong} | {:.3} | {:.3} | {:.2} | {:.4} / {:.4} | {:.4} / {:.4} |\n",
             rs.len(),
+            rs.iter().filter(flagged).count(),
             rms(&all(|r| r.centre_rms_px.0)),
             rms(&all(|r| r.centre_rms_px.1)),
             rms(&rs

@@ -13,8 +13,14 @@
 //!
 //! Where both find the band's top they agree to within its roughness and the brightness line is kept (it is
 //! the sharper); where they disagree the topmost is taken and the other is returned as an alternative, so a
-//! later stage can choose with the ball's own trajectory. The roughness of the edge (the scatter of the
-//! column edges about the line) is reported, and widens the line's stated uncertainty on a ragged band.
+//! later stage can choose with the ball's own trajectory (unless the texture line is seen along clearly more
+//! of the band: then it is kept). The roughness of the edge (the scatter of the column edges about the line)
+//! is reported, and widens the line's stated uncertainty on a ragged band: its height's, and its tilt's by a
+//! uniform tilt of up to ± the roughness over the line's half-length, since how each column's edge is
+//! defined can drift smoothly across the frame where no column statistic sees it.
+//!
+//! The tracker looks for the line in the mean of a clip's first frames (`Tracker`), where the noise is
+//! smaller than in any one frame.
 
 use crate::plane::{Pixel, Plane, parabola_offset};
 
@@ -165,8 +171,9 @@ pub fn find_surface_lines<P: Pixel>(img: &Plane<P>, ball: Option<(f64, f64, f64)
 }
 
 /// One list of candidates from both cues, topmost first: where a brightness line and a texture line see the
-/// same edge (within 3 px plus twice the roughness) the brightness line is kept (it is the sharper), with the
-/// larger roughness of the two; a line crossing a better-supported line of the other cue inside the frame
+/// same edge (within 3 px plus twice the roughness) the brightness line is kept (it is the sharper) unless
+/// the texture line is supported by more than 4/3 as many columns (a low-contrast band's weak step is seen
+/// in few columns, and its tilt is then the poorer), with the larger roughness of the two; a line crossing a better-supported line of the other cue inside the frame
 /// (`width` px wide) is dropped, as within a cue (two edges of a scene do not cross).
 fn merge_cues(step: Vec<SurfaceLine>, texture: Vec<SurfaceLine>, width: usize) -> Vec<SurfaceLine> {
     let mut used = vec![false; texture.len()];
@@ -178,9 +185,10 @@ fn merge_cues(step: Vec<SurfaceLine>, texture: Vec<SurfaceLine>, width: usize) -
         match twin {
             Some((i, t)) => {
                 used[i] = true;
+                let kept = if 4 * s.columns >= 3 * t.columns { s } else { *t };
                 out.push(SurfaceLine {
                     roughness_px: s.roughness_px.max(t.roughness_px),
-                    ..s
+                    ..kept
                 });
             }
             None => out.push(s),
@@ -350,6 +358,15 @@ fn sub_pixel_edge(prof: &[f32], y: usize) -> f64 {
     k as f64 + parabola_offset(n(k - 1), n(k), n(k + 1))
 }
 
+/// The variance of a line's slope that the definition of its edge adds, beyond the columns' scatter: what
+/// one column takes for the edge (its steepest step, or the texture's half-way point) can differ from the
+/// band's top by a fraction of the edge's roughness, and differ smoothly across the frame where the
+/// lighting, vignetting or weave changes the edge's profile. No column statistic sees such a trend; it is
+/// taken as a uniform (Type-B) tilt of up to ± `roughness_px` over the line's `half_span_px`.
+pub(crate) fn definition_slope_var(roughness_px: f64, half_span_px: f64) -> f64 {
+    (roughness_px / half_span_px.max(1.0)).powi(2) / 3.0
+}
+
 /// Number of distinct columns with a candidate within `tol` of the line, and their mean edge strength.
 fn column_support(cands: &[(f64, f64, f64)], c: f64, slope: f64, tol: f64) -> (f64, f64) {
     let mut last_x = f64::NAN;
@@ -412,7 +429,9 @@ fn refine_line(
         let rho = if rss > 0.0 { (lag1 / rss).clamp(0.0, 0.95) } else { 0.0 };
         let inflation = (1.0 + rho) / (1.0 - rho);
         let s2 = inflation * rss / (n - 2.0).max(1.0);
-        let sigma_slope = (s2 / sxx).sqrt();
+        let roughness = (rss / n).sqrt();
+        let half_span = 0.5 * (pts.last().map_or(0.0, |p| p.0) - pts.first().map_or(0.0, |p| p.0));
+        let sigma_slope = (s2 / sxx + definition_slope_var(roughness, half_span)).sqrt();
         result = Some(SurfaceLine {
             x0: xc,
             y0,
@@ -424,7 +443,7 @@ fn refine_line(
                 let mid = lean.len() / 2;
                 *lean.select_nth_unstable_by(mid, f64::total_cmp).1
             },
-            roughness_px: (rss / n).sqrt(),
+            roughness_px: roughness,
             cue: LineCue::Brightness,
         });
     }
@@ -480,6 +499,19 @@ mod tests {
         );
         assert_eq!(merged.len(), 1);
         assert_eq!(merged[0].cue, LineCue::Texture);
+    }
+
+    /// Where both cues see the same edge, the line kept is the brightness cue's unless the texture cue saw
+    /// the edge along clearly more of the band (a low-contrast band's weak step, found in a few columns).
+    #[test]
+    fn of_two_cues_seeing_one_edge_the_better_supported_is_kept() {
+        let texture = line(200.4, 0.5, 90, LineCue::Texture);
+        let merged = merge_cues(vec![line(201.0, -0.3, 46, LineCue::Brightness)], vec![texture], 512);
+        assert_eq!(merged.len(), 1);
+        assert_eq!(merged[0].cue, LineCue::Texture);
+        let merged = merge_cues(vec![line(201.0, -0.3, 70, LineCue::Brightness)], vec![texture], 512);
+        assert_eq!(merged.len(), 1);
+        assert_eq!(merged[0].cue, LineCue::Brightness);
     }
 
     #[test]
