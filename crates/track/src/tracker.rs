@@ -275,6 +275,9 @@ impl Tracker {
     /// Uses `line` as the surface instead of finding it.
     pub fn set_surface(&mut self, line: SurfaceLine) {
         self.surface = Some(line);
+        // A line given (or taken from another pass) is not replaced by one found in the frames.
+        self.surface_tries = SURFACE_TRIES;
+        self.surface_stack = Vec::new();
     }
 
     /// The surface line, once found.
@@ -729,6 +732,23 @@ mod tests {
         assert!((line.y0 - 180.4).abs() < 0.5, "{line:?}");
         assert!((line.tilt_deg() - 1.5).abs() < 3.0 * line.sigma_tilt_deg, "{line:?}");
         assert_eq!(line.cue, LineCue::Texture);
+    }
+
+    /// A line set on the tracker (the user's, or the forward pass's for the backward one) stays, however
+    /// clearly the frames show another.
+    #[test]
+    fn a_line_set_on_the_tracker_is_not_replaced_by_one_found() {
+        let given = SurfaceLine::given(127.5, 200.0, 0.0);
+        let mut tracker = Tracker::new(TrackOptions {
+            radius_px: Some((25.0, 35.0)),
+            ..TrackOptions::default()
+        });
+        tracker.set_surface(given);
+        for k in 0..40 {
+            let img = noisy_frame(k, 2.0);
+            tracker.observe(k, k as f64 * 1e-4, &Plane::new(&img, 256, 256));
+        }
+        assert_eq!(tracker.surface(), Some(&given));
     }
 
     /// In flight (every recent fix clear of the surface line) the prediction's acceleration is held to what
