@@ -5,7 +5,7 @@
 //! in memory beforehand. "track_frame_steady": following the ball once found and the surface line settled
 //! (prediction, one edge pass along 128 rays, the robust fit), frames 33–99. "track_first_33_frames": a
 //! clip's start, frames 0–32 from a fresh tracker: the cold start, then the frames while the surface line is
-//! looked for in the mean of the first 1, 8 and 32 frames. "cold_start_first_frame": the first frame of a
+//! looked for in the mean of the first 2 (the ball is known from the second frame), 8 and 32 frames. "cold_start_first_frame": the first frame of a
 //! clip without a track (Hough, refined candidates). "surface_line": one surface line search.
 //! "detect_full_frame": the Hough transform alone.
 
@@ -40,7 +40,7 @@ fn bench(c: &mut Criterion) {
         ..TrackOptions::default()
     };
     // A tracker through the clip's first 33 frames: the ball found on the first, the surface line looked for
-    // from the second (once the ball is known) in the mean of 1, 8 and 32 frames.
+    // from the second (once the ball is known) in the mean of 2, 8 and 32 frames.
     const START: usize = 33;
     let mut warm = Tracker::new(opts.clone());
     let first = warm.observe(0, 0.0, &Plane::new(&frames[0], 512, 512));

@@ -76,7 +76,7 @@ pub fn texture_lines<P: Pixel>(img: &Plane<P>) -> Vec<SurfaceLine> {
         }
     }
     let leans = vec![0.0; cands.len()];
-    lines_through(&cands, &leans, cols.len(), w, TOLERANCE_PX, MIN_STRENGTH, 0.0)
+    let mut lines: Vec<SurfaceLine> = lines_through(&cands, &leans, cols.len(), w, TOLERANCE_PX, MIN_STRENGTH, 0.0)
         .into_iter()
         .map(|line| robust_refit(&cands, line))
         .map(|line| SurfaceLine {
@@ -84,7 +84,10 @@ pub fn texture_lines<P: Pixel>(img: &Plane<P>) -> Vec<SurfaceLine> {
             cue: LineCue::Texture,
             ..line
         })
-        .collect()
+        .collect();
+    // The refit moves a line by up to a few px: topmost first again.
+    lines.sort_by(|a, b| a.y0.total_cmp(&b.y0));
+    lines
 }
 
 /// How far a column's edge may lie from a line, in robust scales of the edges' scatter, and still weigh in

@@ -183,6 +183,10 @@ pub struct Tracker {
     surface_stack: Vec<f32>,
     /// Frames summed in `surface_stack`.
     stacked: usize,
+    /// Leftmost and rightmost expected centre of the ball over the frames summed, px.
+    stack_span: Option<(f64, f64)>,
+    /// No more frames are summed: the ball has swept across a quarter of the frame.
+    stack_closed: bool,
     /// Frames summed at which the surface line is next looked for.
     next_surface_try: usize,
     warnings: Vec<String>,
@@ -259,6 +263,8 @@ impl Tracker {
             surface_tries: 0,
             surface_stack: Vec::new(),
             stacked: 0,
+            stack_span: None,
+            stack_closed: false,
             next_surface_try: 1,
             warnings: Vec::new(),
             last_innovation: 0.0,
@@ -340,7 +346,7 @@ impl Tracker {
     }
 
     /// Whether every fix the prediction is fitted to has the ball's whole disc clear of the surface line
-    /// (beyond the band's ragged reach and a pixel of margin); false while no line is known.
+    /// (by 2 px beyond the band's ragged reach); false while no line is known.
     fn in_flight(&self) -> bool {
         let (Some(line), Some(r)) = (self.surface.as_ref(), self.expected_radius()) else {
             return false;
@@ -377,47 +383,64 @@ impl Tracker {
     /// Looks for the surface line in the mean of the clip's first frames: the band does not move, so
     /// averaging `n` frames divides the sensor's noise by √n and leaves the band's edge and texture as they are
     /// (a grainy band at high noise is found in the mean of 8 frames where single frames miss it or tilt it by
-    /// degrees). Searches while the ball is known, first in one frame (the flight's acceleration is bounded
-    /// from the start), then in 8 and in [`SURFACE_STACK_MAX`] frames; a line found in more frames replaces
-    /// one found in fewer. Where the ball is expected, a line above it is not
-    /// the surface; until the ball is known (a tracker never seeded, before its first fix) no line is looked
-    /// for, as the rims of round things side by side can pass for the top of a band. Cost: one add per pixel
-    /// per summed frame, and a line search (≈ 3 ms for 512×512) per try, [`SURFACE_TRIES`] at most.
+    /// degrees). Frames stop being added once the ball's expected centre has moved across a quarter of the
+    /// frame's width: a ball sweeping sideways leaves a straight edge in the mean, which must not reach the
+    /// half of the columns a line needs. Searches while the ball is known: first in the frames summed by then
+    /// (one, for a tracker seeded with the ball), then in 8 and in [`SURFACE_STACK_MAX`] frames (or when the
+    /// frames stop being added); a line found in more frames replaces one found in fewer. Where the ball is
+    /// expected, a line above it is not the surface; until the ball is known (a tracker never seeded, before
+    /// its first fix) no line is looked for, as the rims of round things side by side can pass for the top of
+    /// a band. Cost: one add per pixel per summed frame, and a line search (≈ 3 ms for 512×512) per try,
+    /// [`SURFACE_TRIES`] at most.
     fn look_for_surface<P: Pixel>(&mut self, t_s: f64, img: &Plane<P>) {
         if self.surface_tries >= SURFACE_TRIES {
             return;
         }
+        let ball = self
+            .predict(t_s)
+            .zip(self.expected_radius())
+            .map(|((x, y), r)| (x, y, r));
         let n = img.width * img.height;
         if self.surface_stack.len() != n {
             self.surface_stack = vec![0.0; n];
             self.stacked = 0;
             self.next_surface_try = 1;
+            self.stack_span = None;
+            self.stack_closed = false;
         }
-        if self.stacked < SURFACE_STACK_MAX {
+        if let Some((x, _, _)) = ball {
+            let (lo, hi) = self.stack_span.unwrap_or((x, x));
+            let span = (lo.min(x), hi.max(x));
+            self.stack_closed |= span.1 - span.0 > 0.25 * img.width as f64;
+            self.stack_span = Some(span);
+        }
+        if self.stacked < SURFACE_STACK_MAX && !self.stack_closed {
             let gain = img.gain;
             for (v, p) in self.surface_stack.iter_mut().zip(img.data) {
                 *v += p.level() * gain;
             }
             self.stacked += 1;
         }
-        let ball = self
-            .predict(t_s)
-            .zip(self.expected_radius())
-            .map(|((x, y), r)| (x, y, r));
-        let due =
-            self.stacked >= self.next_surface_try || (self.surface.is_none() && self.stacked == SURFACE_STACK_MAX);
-        if !due || ball.is_none() {
+        let full = self.stacked == SURFACE_STACK_MAX || self.stack_closed;
+        let due = self.stacked >= self.next_surface_try
+            || (full && self.next_surface_try != usize::MAX)
+            || (full && self.surface.is_none());
+        if !due || ball.is_none() || self.stacked == 0 {
             return;
         }
         self.surface_tries += 1;
-        self.next_surface_try = if self.stacked == 1 { 8 } else { 4 * self.stacked };
+        self.next_surface_try = match self.stacked {
+            _ if full => usize::MAX,
+            1 => 8,
+            n => (4 * n).min(SURFACE_STACK_MAX),
+        };
         let scale = 1.0 / self.stacked as f32;
         let mean: Vec<f32> = self.surface_stack.iter().map(|v| v * scale).collect();
         if let Some(lines) = find_surface_lines(&Plane::new(&mean, img.width, img.height), ball) {
             self.surface = Some(lines.line);
             self.surface_alternatives = lines.alternatives;
         }
-        if self.next_surface_try > SURFACE_STACK_MAX && self.surface.is_some() {
+        if self.next_surface_try == usize::MAX && self.surface.is_some() {
             self.surface_tries = SURFACE_TRIES;
         }
         if self.surface_tries >= SURFACE_TRIES {
@@ -732,6 +755,36 @@ mod tests {
         assert!((line.y0 - 180.4).abs() < 0.5, "{line:?}");
         assert!((line.tilt_deg() - 1.5).abs() < 3.0 * line.sigma_tilt_deg, "{line:?}");
         assert_eq!(line.cue, LineCue::Texture);
+    }
+
+    /// A ball sweeping across the first frames leaves no edge in their mean (no band in this scene: no line
+    /// is found), since frames stop being summed once it has crossed a quarter of the frame.
+    #[test]
+    fn a_ball_sweeping_across_the_first_frames_is_not_taken_for_a_band() {
+        let at = |k: usize| (30.3 + 6.0 * k as f64, 100.4 + 0.05 * k as f64);
+        let frame = |k: usize| {
+            let (x, y) = at(k);
+            render(&Scene {
+                ball: (x, y, 30.0),
+                backdrop: (90.0, 90.0),
+                seed: k as u64,
+                ..Scene::default()
+            })
+        };
+        let mut tracker = Tracker::new(TrackOptions {
+            radius_px: Some((27.0, 33.0)),
+            max_jump_px: 20.0,
+            ..TrackOptions::default()
+        });
+        let (a, b) = (at(0), at(1));
+        tracker.seed((0.0, a.0, a.1), (1e-4, b.0, b.1));
+        for k in 0..34 {
+            let img = frame(k);
+            let fix = tracker.observe(k, k as f64 * 1e-4, &Plane::new(&img, 256, 256));
+            let (x, y) = at(k);
+            assert!((fix.x_px - x).hypot(fix.y_px - y) < 0.5, "frame {k}: {fix:?}");
+        }
+        assert!(tracker.surface().is_none(), "{:?}", tracker.surface());
     }
 
     /// A line set on the tracker (the user's, or the forward pass's for the backward one) stays, however
