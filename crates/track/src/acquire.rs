@@ -19,7 +19,7 @@
 use crate::ball_search::{BALL_CANDIDATES, MIN_BALL_RADIUS_PX, hint_window, radius_window};
 use crate::clip::{ClipTracking, TrackError, on_plane, with_plane};
 use crate::hough::{Circle, CircleDetection, detect_circles, radius_bands};
-use crate::plane::{Pixel, Plane};
+use crate::plane::{Pixel, Plane, median};
 use crate::refine::refine_candidates;
 use crate::tracker::CLEAN_QUALITY;
 use bouncelab_frames::{Clip, Frame};
@@ -597,11 +597,6 @@ fn disc_and_ring<P: Pixel>(img: &Plane<P>, x: f64, y: f64, r: f64) -> (Vec<f64>,
 fn ring_motion(moving: &Plane<f32>, c: &Circle, noise: f32) -> Option<f64> {
     let (_, mut ring) = disc_and_ring(moving, c.x, c.y, c.r);
     (ring.len() >= 16).then(|| median(&mut ring) / f64::from(noise.max(1.0)))
-}
-
-fn median(v: &mut [f64]) -> f64 {
-    let mid = v.len() / 2;
-    *v.select_nth_unstable_by(mid, f64::total_cmp).1
 }
 
 /// The correlation of two discs' looks (see [`disc_look`]) over the points both have: one ball seen twice

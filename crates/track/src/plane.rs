@@ -138,6 +138,16 @@ pub fn level_gain<P: Pixel>(img: &Plane<P>) -> f32 {
     }
 }
 
+/// The median of `v` (the upper of the two middle values for an even count; 0 when empty), reordering `v`.
+/// Cost: O(n).
+pub(crate) fn median(v: &mut [f64]) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    let mid = v.len() / 2;
+    *v.select_nth_unstable_by(mid, f64::total_cmp).1
+}
+
 /// Where a sampled peak lies between its samples: the vertex of the parabola through the values `a0`,
 /// `a1`, `a2` at offsets −1, 0, +1, as an offset from the middle one (clamped to ±0.5; 0 when the three do
 /// not bend down). The sub-sample step of every edge and vote peak in this crate.

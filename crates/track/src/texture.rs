@@ -11,7 +11,7 @@
 //! refitted with Tukey's biweight, since a ragged band's edges wander and spike. Cost ≈ 3 ms for 512×512
 //! (three filter passes over the frame).
 
-use crate::plane::{Pixel, Plane};
+use crate::plane::{Pixel, Plane, median};
 use crate::surface::{LineCue, SurfaceLine, definition_slope_var, lines_through};
 use imageproc::image::{ImageBuffer, Luma};
 
@@ -112,7 +112,7 @@ fn robust_refit(cands: &[(f64, f64, f64)], line: SurfaceLine) -> SurfaceLine {
             return line;
         }
         let res: Vec<f64> = pts.iter().map(|p| p.1 - (y0 + slope * p.0)).collect();
-        let scale = (1.4826 * median(res.iter().map(|r| r.abs()).collect())).max(0.25);
+        let scale = (1.4826 * median(&mut res.iter().map(|r| r.abs()).collect::<Vec<_>>())).max(0.25);
         let wts: Vec<f64> = res
             .iter()
             .map(|r| (1.0 - (r / (BIWEIGHT_C * scale)).powi(2)).max(0.0).powi(2))
@@ -190,11 +190,6 @@ fn autocorrelation_time(res: &[f64], wts: &[f64]) -> f64 {
     tau
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    let mid = v.len() / 2;
-    *v.select_nth_unstable_by(mid, f64::total_cmp).1
-}
-
 /// The strongest steps of a column's log-energy profile: `(row, strength)`, the edge lying between `row` and
 /// `row + 1`, strength = |mean of the `STEP_ROWS` rows below − mean of those at and above| over the
 /// profile's robust scatter of that difference (1.4826 × its median absolute deviation).
@@ -242,12 +237,12 @@ fn half_way_edge(profile: &[f32], y: usize) -> Option<f64> {
     if y < 9 || y + 10 > h {
         return None;
     }
-    let median = |a: usize, b: usize| {
+    let rows_median = |a: usize, b: usize| {
         let mut v: Vec<f32> = profile[a..b].to_vec();
         let mid = v.len() / 2;
         *v.select_nth_unstable_by(mid, f32::total_cmp).1
     };
-    let (above, below) = (median(y - 8, y - 1), median(y + 3, y + 10));
+    let (above, below) = (rows_median(y - 8, y - 1), rows_median(y + 3, y + 10));
     let half = 0.5 * (above.exp() + below.exp());
     let e = |k: usize| (profile[k].exp() - half) as f64;
     (0..4)

@@ -4,7 +4,7 @@
 use crate::ball_search::{BALL_CANDIDATES, MIN_BALL_RADIUS_PX, radius_window};
 use crate::hough::{Circle, CircleDetection};
 use crate::motion::fit_motion;
-use crate::plane::{Pixel, Plane};
+use crate::plane::{Pixel, Plane, median};
 use crate::refine::{
     EdgeSearch, Refined, RimShapeLearner, refine_circle_with_rays, refined_candidates, residuals_about, rim_residuals,
 };
@@ -606,7 +606,7 @@ impl Tracker {
     /// far beyond them ([`CHANGE_OF_MOTION_PX`]) the motion changed (a bounce seen in few frames): the fixes
     /// before it no longer describe the path, and a fit through them would lag behind it.
     fn note_innovation(&mut self, innovation: f64) {
-        if innovation > CHANGE_OF_MOTION_PX.max(4.0 * median(&self.innovations)) {
+        if innovation > CHANGE_OF_MOTION_PX.max(4.0 * median(&mut self.innovations.clone())) {
             let stale = self.history.len().saturating_sub(2);
             self.history.drain(..stale);
         }
@@ -622,7 +622,7 @@ impl Tracker {
         if self.qualities.len() < 5 {
             return true;
         }
-        f.visible_quality() >= QUALITY_DROP * median(&self.qualities)
+        f.visible_quality() >= QUALITY_DROP * median(&mut self.qualities.clone())
     }
 
     fn plausible(&self, f: &Refined, px: f64, py: f64, r: f64, max_jump: f64) -> bool {
@@ -698,16 +698,6 @@ impl Tracker {
             status,
         }
     }
-}
-
-/// The median of `v` (0 when empty).
-fn median(v: &[f64]) -> f64 {
-    if v.is_empty() {
-        return 0.0;
-    }
-    let mut v = v.to_vec();
-    let mid = v.len() / 2;
-    *v.select_nth_unstable_by(mid, f64::total_cmp).1
 }
 
 #[cfg(test)]
