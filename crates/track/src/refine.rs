@@ -377,27 +377,31 @@ impl RimEdges {
 
 /// Where a ray's search can run: the number of samples, or why it cannot.
 enum RaySpan {
-    /// Samples along the ray.
-    Samples(usize),
+    /// Samples along the ray: those of the search window, and in all (the window and, beyond its outer
+    /// end, up to [`LIMB_PX`] more where a band's outer side may lie).
+    Samples { window: usize, total: usize },
     /// The rim point is at or below the surface line, or too little of the ray lies above it.
     Hidden,
     /// The ray leaves the image.
     Outside,
 }
 
-/// The samples along the ray from `start` in direction (c, s) about (x, y) that can be searched.
+/// The samples along the ray from `start` in direction (c, s) about (x, y) that can be searched: `samples`
+/// in the window, up to `beyond` more outside it.
+#[allow(clippy::too_many_arguments)] // private; the ray's geometry and the window's two lengths
 fn ray_span<P: Pixel>(
     img: &Plane<P>,
     (x, y, r): (f64, f64, f64),
     (c, s): (f64, f64),
     start: f64,
     samples: usize,
+    beyond: usize,
     search: &EdgeSearch,
     surface: Option<&SurfaceLine>,
 ) -> RaySpan {
     // The search stops short of the surface line: below it is the band, whose own edge (and, on a ragged
     // band, its highest grains) must not be taken for the ball's rim.
-    let mut len = samples;
+    let mut len = samples + beyond;
     if let Some(line) = surface {
         let margin = search.surface_margin + line.ragged_reach_px();
         let (rx, ry) = (x + r * c, y + r * s);
@@ -408,23 +412,27 @@ fn ray_span<P: Pixel>(
         if towards > 1e-9 {
             let reach = (line.y_at(x) - margin - y) / towards;
             len = len.min(((reach - start) / search.step).floor().max(0.0) as usize + 1);
-            if len < samples / 2 + 3 {
+            if len.min(samples) < samples / 2 + 3 {
                 return RaySpan::Hidden;
             }
         }
     }
     // A straight segment is inside the image when both its ends are (with the smoothing's half pixel).
     let (wmax, hmax) = ((img.width - 1) as f64, (img.height - 1) as f64);
-    let end = start + (len - 1) as f64 * search.step;
+    let end = |len: usize| start + (len - 1) as f64 * search.step;
     let m = if search.smooth { 0.51 } else { 0.01 };
     let inside = |d: f64| {
         let (px, py) = (x + d * c, y + d * s);
         px >= m && py >= m && px < wmax - m && py < hmax - m
     };
-    if !inside(start) || !inside(end) {
+    let window = len.min(samples);
+    if !inside(start) || !inside(end(window)) {
         return RaySpan::Outside;
     }
-    RaySpan::Samples(len)
+    while len > window && !inside(end(len)) {
+        len -= 1;
+    }
+    RaySpan::Samples { window, total: len }
 }
 
 /// Fills `profile` with the image sampled along the ray from (x, y) + start·(c, s), `step` apart.
@@ -456,16 +464,19 @@ fn sample_ray<P: Pixel>(
 /// An edge on a ray's profile: (sample index, step per px on the 0–255 scale, sub-sample offset of the peak).
 type ProfileEdge = (usize, f32, f64);
 
-/// The ray's strongest brightness step, and the outer side of a thin band that step starts when there is
-/// one: a step of the other sign at least [`RIM_STEP_SHARE`] of the strongest's size within
-/// [`THIN_BAND_PX`] outside it (and so on outward). `None` when the strongest step is weaker than
-/// `search.min_contrast` or lies too near an end for the parabola; no band when its side does. Cost: one
-/// pass of central differences over the profile, and one over the band's reach.
-fn ray_edges(profile: &[f32], search: &EdgeSearch) -> Option<(ProfileEdge, Option<ProfileEdge>)> {
+/// The ray's strongest brightness step in the search window (the profile's first `window` samples), and
+/// the outer side of a band that step starts when there is one: a step of the other sign at least
+/// [`RIM_STEP_SHARE`] of the strongest's size within [`LIMB_PX`] outside it, and so on outward within
+/// [`THIN_BAND_PX`] of each. The band's side may lie beyond the window: a track sitting on a limb's inner
+/// side would otherwise never see the rim outside it. `None` when the strongest step is weaker than
+/// `search.min_contrast` or lies too near the window's ends for the parabola; no band when its side lies
+/// too near the profile's end. Cost: one pass of central differences over the window, and one over the
+/// band's reach.
+fn ray_edges(profile: &[f32], window: usize, search: &EdgeSearch) -> Option<(ProfileEdge, Option<ProfileEdge>)> {
     let len = profile.len();
     let d = |j: usize| profile[j + 1] - profile[j - 1];
     let (mut best, mut strongest) = (0.0f32, 0);
-    for (i, w) in profile.windows(3).enumerate() {
+    for (i, w) in profile[..window].windows(3).enumerate() {
         let a = (w[2] - w[0]).abs();
         if a > best {
             best = a;
@@ -476,7 +487,7 @@ fn ray_edges(profile: &[f32], search: &EdgeSearch) -> Option<(ProfileEdge, Optio
     if best * to_per_px < search.min_contrast {
         return None;
     }
-    let edge = |j: usize| -> Option<ProfileEdge> {
+    let edge = |j: usize, len: usize| -> Option<ProfileEdge> {
         if j < 2 || j + 3 > len {
             return None;
         }
@@ -484,15 +495,20 @@ fn ray_edges(profile: &[f32], search: &EdgeSearch) -> Option<(ProfileEdge, Optio
         let m = |j: usize| sign * d(j) as f64;
         Some((j, d(j).abs() * to_per_px, parabola_offset(m(j - 1), m(j), m(j + 1))))
     };
-    let reach = (THIN_BAND_PX / search.step).round() as usize;
     let mut j = strongest;
     loop {
+        let reach_px = if j == strongest { LIMB_PX } else { THIN_BAND_PX };
+        let reach = (reach_px / search.step).round() as usize;
         let other = -d(j).signum();
         let (mut k, mut size) = (j, RIM_STEP_SHARE * best);
         for (i, w) in profile[j..].windows(3).take(reach).enumerate() {
-            let a = other * (w[2] - w[0]);
-            if a >= size {
-                (k, size) = (j + 1 + i, a);
+            let (a, e) = (other * (w[2] - w[0]), j + 1 + i);
+            // A band's side is a change of level that lasts; a noise spike outside a faint rim returns.
+            let lasts = profile
+                .get(e + PERSIST_SAMPLES)
+                .is_some_and(|after| other * (after - profile[e - 1]) >= RIM_STEP_SHARE * best);
+            if a >= size && lasts {
+                (k, size) = (e, a);
             }
         }
         if k == j {
@@ -500,7 +516,10 @@ fn ray_edges(profile: &[f32], search: &EdgeSearch) -> Option<(ProfileEdge, Optio
         }
         j = k;
     }
-    Some((edge(strongest)?, if j > strongest { edge(j) } else { None }))
+    Some((
+        edge(strongest, window)?,
+        if j > strongest { edge(j, len) } else { None },
+    ))
 }
 
 /// How strong a step of the other sign just outside the strongest must be, as a share of it, to be the rim
@@ -509,8 +528,16 @@ fn ray_edges(profile: &[f32], search: &EdgeSearch) -> Option<(ProfileEdge, Optio
 /// inside the ball. A sharpened edge's undershoot is a step of the other sign too, but a small one.
 const RIM_STEP_SHARE: f32 = 0.5;
 
-/// How far outside the strongest step the band's outer side is looked for, px (the bands seen are ≤ 2.1 px
-/// wide).
+/// How far outside the strongest step a band's outer side is looked for, px. A limb darker than the
+/// backdrop spans up to about 6 px on a lit felt ball of 68 px radius (the `looks` preset's S017); a band
+/// under a bright limb, ≤ 2.1 px.
+const LIMB_PX: f64 = 6.0;
+
+/// How many samples past a band's side the level must still be changed by [`RIM_STEP_SHARE`] of the
+/// strongest step (2 px at the default step).
+const PERSIST_SAMPLES: usize = 4;
+
+/// How far outside one side of a band the next is looked for, px (the bands seen are ≤ 2.1 px wide).
 const THIN_BAND_PX: f64 = 3.0;
 
 /// How closely a ray within two of it must agree on a band's width for a ray to take its band's outer side,
@@ -555,7 +582,8 @@ fn rim_edges<P: Pixel>(
         .map(|s| &s.offsets_px[..])
         .filter(|o| o.len() == n);
     let samples = ((2.0 * half_width / search.step).round() as usize).max(4) + 1;
-    let mut profile = vec![0.0f32; samples];
+    let beyond = (LIMB_PX / search.step).round() as usize + 2;
+    let mut profile = vec![0.0f32; samples + beyond];
     let mut seen: Vec<RaySeen> = Vec::with_capacity(n);
     let mut edges = RimEdges {
         rays: n,
@@ -575,8 +603,8 @@ fn rim_edges<P: Pixel>(
         let (c0, s0) = (c, s);
         (c, s) = (c0 * dc - s0 * ds, s0 * dc + c0 * ds);
         let (c, s) = (c0, s0);
-        let len = match ray_span(img, (x, y, r), (c, s), start, samples, search, surface) {
-            RaySpan::Samples(len) => len,
+        let (window, len) = match ray_span(img, (x, y, r), (c, s), start, samples, beyond, search, surface) {
+            RaySpan::Samples { window, total } => (window, total),
             RaySpan::Hidden => {
                 edges.hidden += 1;
                 continue;
@@ -588,7 +616,7 @@ fn rim_edges<P: Pixel>(
         };
         let profile = &mut profile[..len];
         sample_ray(img, profile, (x, y), (c, s), start, search);
-        let Some((strongest, band)) = ray_edges(profile, search) else {
+        let Some((strongest, band)) = ray_edges(profile, window, search) else {
             continue;
         };
         let definition = |e: ProfileEdge| {
@@ -1001,6 +1029,41 @@ mod tests {
             let (centre, radius) = ((f.x - cx).hypot(f.y - cy), f.r - r);
             assert!(centre < 0.1 && radius.abs() < 0.1, "{look}: {f:?}");
         }
+    }
+
+    #[test]
+    fn a_search_sitting_on_a_wide_dark_limb_s_inner_side_finds_the_rim_outside_it() {
+        // A light ball whose limb, 5 px wide, is darker than the backdrop (the `looks` preset's S017): the
+        // limb's inner side is the stronger step. A track that settled there searches ±2 px about it, a
+        // window that does not reach the rim; the rim is still found outside it, and the circle moves out.
+        let (cx, cy, r) = (108.4, 104.7, 70.0);
+        let img = drawn(cx, cy, |d, _| match d {
+            d if d > r => 120.0,
+            d if d > r - 5.0 => 70.0,
+            _ => 150.0,
+        });
+        let plane = Plane::new(&img, SIZE, SIZE);
+        let search = EdgeSearch {
+            half_width: 2.0,
+            ..EdgeSearch::default()
+        };
+        let f = refine_circle(&plane, cx, cy, r - 5.0, &search, None).unwrap().fit;
+        let (centre, radius) = ((f.x - cx).hypot(f.y - cy), f.r - r);
+        assert!(centre < 0.1 && radius.abs() < 0.1, "{f:?}");
+    }
+
+    #[test]
+    fn a_noise_spike_outside_a_rim_is_not_a_band_s_side() {
+        // A single sample's spike of the other sign just outside the strongest step is as large as a band's
+        // side would be, but the level after it returns: it is not taken.
+        let mut profile = vec![100.0f32; 24];
+        for p in profile.iter_mut().skip(8) {
+            *p = 160.0;
+        }
+        profile[14] = 120.0;
+        let (strongest, band) = ray_edges(&profile, 12, &EdgeSearch::default()).unwrap();
+        assert_eq!(strongest.0, 7);
+        assert!(band.is_none(), "{band:?}");
     }
 
     #[test]
