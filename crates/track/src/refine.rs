@@ -36,6 +36,11 @@ pub struct EdgeSearch {
     /// noise a single noisy sample otherwise out-steps a soft rim (default false; the clip tracker turns it
     /// on when a frame's noise exceeds [`NOISY_SIGMA`]).
     pub smooth: bool,
+    /// Also sample each ray up to [`LIMB_PX`] beyond the window's outer end, where a band's outer side may
+    /// lie (default true). A search sitting on a wide limb's inner side sees the rim outside it only so; a
+    /// settled track, whose window already sits on the rim, turns it off (those samples cost about half a
+    /// frame's search).
+    pub beyond_window: bool,
 }
 
 /// Sensor noise σ (0–255 scale) above which rays are sampled smoothed: where the per-sample noise of a
@@ -53,6 +58,7 @@ impl Default for EdgeSearch {
             edge_definition: false,
             rim_shape: None,
             smooth: false,
+            beyond_window: true,
         }
     }
 }
@@ -504,9 +510,10 @@ fn ray_edges(profile: &[f32], window: usize, search: &EdgeSearch) -> Option<(Pro
         for (i, w) in profile[j..].windows(3).take(reach).enumerate() {
             let (a, e) = (other * (w[2] - w[0]), j + 1 + i);
             // A band's side is a change of level that lasts; a noise spike outside a faint rim returns.
+            // (Unchecked at the profile's end, where there is nothing after it.)
             let lasts = profile
                 .get(e + PERSIST_SAMPLES)
-                .is_some_and(|after| other * (after - profile[e - 1]) >= RIM_STEP_SHARE * best);
+                .is_none_or(|after| other * (after - profile[e - 1]) >= RIM_STEP_SHARE * best);
             if a >= size && lasts {
                 (k, size) = (e, a);
             }
@@ -582,7 +589,11 @@ fn rim_edges<P: Pixel>(
         .map(|s| &s.offsets_px[..])
         .filter(|o| o.len() == n);
     let samples = ((2.0 * half_width / search.step).round() as usize).max(4) + 1;
-    let beyond = (LIMB_PX / search.step).round() as usize + 2;
+    let beyond = if search.beyond_window {
+        (LIMB_PX / search.step).round() as usize + PERSIST_SAMPLES
+    } else {
+        0
+    };
     let mut profile = vec![0.0f32; samples + beyond];
     let mut seen: Vec<RaySeen> = Vec::with_capacity(n);
     let mut edges = RimEdges {
@@ -751,8 +762,11 @@ pub fn refine_candidates<P: Pixel>(
     surface: Option<&SurfaceLine>,
     min_quality: f64,
 ) -> Vec<(crate::Circle, Refined)> {
+    // Candidates are judged on the edges within their windows alone: in heavy noise, sides found beyond them
+    // let large circles of noise out-score the ball (a 147 px circle was taken for an 84 px ball at 20 DN).
     let wide = EdgeSearch {
         half_width: search.half_width.max(6.0),
+        beyond_window: false,
         ..search.clone()
     };
     let screen = EdgeSearch {
@@ -761,6 +775,7 @@ pub fn refine_candidates<P: Pixel>(
     };
     let settled = EdgeSearch {
         half_width: 0.5 * wide.half_width,
+        beyond_window: false,
         ..search.clone()
     };
     // A circle centred beyond the frame's edge is judged on the rim the frame can show.

@@ -461,9 +461,13 @@ impl Tracker {
                 .half_width
                 .max((2.0 * self.last_innovation + 2.0).min(12.0))
         };
+        // A settled track's window sits on the rim; until then (and after any jump) a band's outer side is
+        // also looked for beyond it, so that a track begun on a limb's inner side moves out to the rim.
+        let settled = confident && self.flight_radii.len() >= RIM_MIN_SAMPLES;
         let search = EdgeSearch {
             half_width,
             edge_definition: self.flight_edges.len() < EDGE_SAMPLES,
+            beyond_window: !settled && self.opts.search.beyond_window,
             ..self.opts.search.clone()
         };
         let max_jump = self.opts.max_jump_px.max(2.0 * self.last_innovation + 2.0);
