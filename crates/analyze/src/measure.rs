@@ -70,8 +70,9 @@ pub(crate) fn session_key(session: &Session) -> String {
 /// measured by an earlier build are measured again (2: estimates carry the surface line's σ; 3: the contact
 /// line's source, the local frame along the measured tilt, the gravity check; 4: a rejected line lends no
 /// tilt, an unmeasured tilt is in the errors, the surface's tilt setting; 5: the surface line from the mean
-/// of the first frames, its tilt error counting the edge's roughness, flight bounding the prediction).
-const MEASUREMENT_REVISION: u32 = 5;
+/// of the first frames, its tilt error counting the edge's roughness, flight bounding the prediction; 6: a
+/// band's outer side looked for beyond the search window while a track settles, a reversed down-slope named).
+const MEASUREMENT_REVISION: u32 = 6;
 
 /// Everything besides the frame files that changes a shot's track or estimate.
 fn settings_text(entry: &ClipEntry, gravity: f64) -> String {

@@ -158,6 +158,16 @@ pub struct GravityCheck {
 }
 
 impl GravityCheck {
+    /// True when the flights fall as gravity would with the down-slope direction the other way: the
+    /// along-surface part has gravity's size and the opposite sign (and is measured well enough to tell
+    /// them apart), the normal part agrees. A camera mirrored, or a clip whose `downslope` was not given.
+    pub fn downslope_reversed(&self, g: f64) -> bool {
+        let [at, an] = self.measured;
+        let [et, en] = self.expected;
+        let near = |m: &Measured, e: f64| (m.value - e).abs() <= 4.0 * m.se + 0.1 * g;
+        !self.inconclusive && near(&at, -et) && !near(&at, et) && near(&an, en)
+    }
+
     /// The angle from gravity's expected direction to the measured acceleration's, rad, with its standard
     /// error: how far the frame's axes are turned from the surface's, as the free fall alone tells it.
     pub fn frame_offset_rad(&self) -> Measured {
@@ -314,7 +324,7 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
     );
     flags.extend(saturation_flag(track));
     if let Some(g) = &gravity {
-        note_gravity(g, c.incline_deg, &mut flags, &mut notes);
+        note_gravity(g, c.incline_deg, c.gravity, &mut flags, &mut notes);
     }
     note_scatter(&fin, &fout, &mut notes);
     Ok(Estimate {
@@ -544,10 +554,15 @@ fn friction(vin: &[VelocityPart; 2], vout: &[VelocityPart; 2], level: &LevelErro
 
 /// A flag when the flights do not fall at gravity's rate on the `incline_deg` incline, a note when they are
 /// too short to tell.
-fn note_gravity(g: &GravityCheck, incline_deg: f64, flags: &mut Vec<String>, notes: &mut Vec<String>) {
+fn note_gravity(g: &GravityCheck, incline_deg: f64, gravity: f64, flags: &mut Vec<String>, notes: &mut Vec<String>) {
     if !g.consistent {
+        let why = if g.downslope_reversed(gravity) {
+            "the part along the surface has gravity's size but the other sign: the down-slope direction looks reversed (a mirrored camera?); set `downslope` under [camera] in the clip's clip.toml or the session.toml"
+        } else {
+            "a wrong frame rate, scale or incline, repeated frames, or not the ball"
+        };
         flags.push(format!(
-            "the ball's flight accelerates at ({:.2} ± {:.2}, {:.2} ± {:.2}) m/s² along and across the surface, not gravity's ({:.2}, {:.2}) on a {}° incline: a wrong frame rate, scale or incline, repeated frames, or not the ball",
+            "the ball's flight accelerates at ({:.2} ± {:.2}, {:.2} ± {:.2}) m/s² along and across the surface, not gravity's ({:.2}, {:.2}) on a {}° incline: {why}",
             g.measured[0].value,
             g.measured[0].se,
             g.measured[1].value,

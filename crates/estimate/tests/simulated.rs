@@ -396,3 +396,37 @@ fn a_wrong_frame_rate_is_flagged_by_gravity() {
     let e = estimate(&track, &conditions(0.0)).unwrap();
     assert!(e.gravity.unwrap().consistent && e.flags.is_empty(), "{:?}", e.gravity);
 }
+
+#[test]
+fn a_reversed_down_slope_is_named_by_gravity() {
+    let model = Model::paper(25_650.0, 14.0, 0.5);
+    // The camera mirrored: the ball falls along −x in the image while the clip says +x is down-slope.
+    let (mut track, _) = shot(&model, 20.0, 0.3, 0.02, 5);
+    for f in &mut track.fixes {
+        f.x_px = 300.0 - f.x_px;
+    }
+    let e = estimate(&track, &conditions(20.0)).unwrap();
+    let g = e.gravity.unwrap();
+    assert!(!g.consistent && g.downslope_reversed(9.81), "{g:?}");
+    assert!(
+        e.flags
+            .iter()
+            .any(|f| f.contains("down-slope direction looks reversed")),
+        "{:?}",
+        e.flags
+    );
+    // As filmed, no flag; and a wrong frame rate is not taken for a mirror.
+    let (track, _) = shot(&model, 20.0, 0.3, 0.02, 5);
+    let e = estimate(&track, &conditions(20.0)).unwrap();
+    assert!(
+        !e.gravity.unwrap().downslope_reversed(9.81) && e.flags.is_empty(),
+        "{:?}",
+        e.flags
+    );
+    let (mut track, _) = shot(&model, 20.0, 0.3, 0.02, 5);
+    for f in &mut track.fixes {
+        f.t_s *= 2.0;
+    }
+    let e = estimate(&track, &conditions(20.0)).unwrap();
+    assert!(!e.gravity.unwrap().downslope_reversed(9.81), "{:?}", e.flags);
+}
