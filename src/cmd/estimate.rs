@@ -2,7 +2,7 @@
 //! standard errors.
 
 use anyhow::Context;
-use bouncelab_estimate::{Conditions, Estimate, estimate_with_frames};
+use bouncelab_estimate::{Conditions, Estimate, estimate_finding_downslope, estimate_with_frames};
 use bouncelab_frames::{Clip, Downslope, Session};
 use bouncelab_track::{ClipTracking, track_clip};
 use std::path::{Path, PathBuf};
@@ -25,26 +25,18 @@ pub struct Args {
     json: bool,
 }
 
-/// What the session around the clip says: down-slope direction, and the clip's incline.
-fn from_session(clip_dir: &Path) -> (bool, Option<f64>) {
-    let Ok(dir) = clip_dir.canonicalize() else {
-        return (false, None);
-    };
-    let Some(parent) = dir.parent() else {
-        return (false, None);
-    };
+/// The incline of the clip's row in its session's clips.csv, when the clip sits in a session folder that
+/// lists it.
+fn session_angle(clip_dir: &Path) -> Option<f64> {
+    let dir = clip_dir.canonicalize().ok()?;
+    let parent = dir.parent()?;
     if !parent.join("session.toml").is_file() {
-        return (false, None);
+        return None;
     }
-    match Session::load(parent) {
-        Ok(s) => {
-            // The row whose folder or camera file this is (clips.csv may name a file without its extension).
-            let clip = s.clips.iter().find(|c| c.dir.canonicalize().is_ok_and(|p| p == dir));
-            let minus_x = clip.map(|c| c.downslope).unwrap_or(s.downslope) == Downslope::MinusX;
-            (minus_x, clip.map(|c| c.angle_deg))
-        }
-        Err(_) => (false, None),
-    }
+    let s = Session::load(parent).ok()?;
+    // The row whose folder or camera file this is (clips.csv may name a file without its extension).
+    let clip = s.clips.iter().find(|c| c.dir.canonicalize().is_ok_and(|p| p == dir))?;
+    Some(clip.angle_deg)
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
@@ -53,15 +45,15 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     for w in clip.warnings() {
         eprintln!("warning: {w}");
     }
-    let (minus_x, session_angle) = from_session(&a.clip_dir);
-    let Some(angle) = a.angle.or(session_angle) else {
+    let Some(angle) = a.angle.or_else(|| session_angle(&a.clip_dir)) else {
         anyhow::bail!(
             "{}: no incline known: give --angle, or put the clip in a session folder whose clips.csv lists it",
             a.clip_dir.display()
         );
     };
     let diameter = clip.settings().ball_diameter_m;
-    let opts = ClipTracking::for_settings(clip.settings(), minus_x);
+    let downslope = clip.settings().downslope;
+    let opts = ClipTracking::for_settings(clip.settings(), downslope == Some(Downslope::MinusX));
     let bar = super::progress_bar(clip.len() as u64, "tracking", "frames");
     let track = track_clip(&clip, &opts, |done, _| bar.set_position(done as u64))
         .with_context(|| format!("tracking {}", a.clip_dir.display()))?;
@@ -72,7 +64,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         ball_diameter_m: diameter,
         surface_tilt_deg: clip.settings().surface_tilt_deg,
     };
-    let e = estimate_with_frames(&track, &clip, &c).with_context(|| format!("estimating {}", a.clip_dir.display()))?;
+    // Without a down-slope direction given, the flights' fall is checked against the default.
+    let e = match downslope {
+        Some(_) => estimate_with_frames(&track, &clip, &c),
+        None => estimate_finding_downslope(&track, &clip, &c),
+    }
+    .with_context(|| format!("estimating {}", a.clip_dir.display()))?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&e)?);
     } else {

@@ -1,7 +1,7 @@
 //! `bouncelab track`: one clip (a folder of frames or a camera file) → its trajectory CSV.
 
 use anyhow::Context;
-use bouncelab_frames::{Clip, Downslope, Session};
+use bouncelab_frames::{Clip, Downslope};
 use bouncelab_track::{ClipTracking, Track, track_clip};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -36,24 +36,6 @@ enum Detector {
     Opencv,
 }
 
-/// Down-slope direction from the session folder above the clip, if there is one.
-fn session_minus_x(clip_dir: &Path) -> bool {
-    let Some(parent) = clip_dir
-        .canonicalize()
-        .ok()
-        .and_then(|p| p.parent().map(Path::to_path_buf))
-    else {
-        return false;
-    };
-    if !parent.join("session.toml").is_file() {
-        return false;
-    }
-    match Session::load(&parent) {
-        Ok(s) => s.downslope == Downslope::MinusX,
-        Err(_) => false,
-    }
-}
-
 /// Opens the clip and tracks it as `bouncelab track` does (warnings printed, a progress bar on a terminal).
 pub fn track_clip_dir(clip_dir: &Path, a: &Tracking) -> anyhow::Result<(Clip, Track)> {
     let options = a.settings.clip_options();
@@ -64,7 +46,7 @@ pub fn track_clip_dir(clip_dir: &Path, a: &Tracking) -> anyhow::Result<(Clip, Tr
     if !clip.gaps().is_empty() {
         eprintln!("warning: {} dropped frame(s) in {}", clip.dropped(), clip_dir.display());
     }
-    let minus_x = session_minus_x(clip_dir);
+    let minus_x = clip.settings().downslope == Some(Downslope::MinusX);
     let opts = ClipTracking::for_settings(clip.settings(), minus_x);
     let bar = super::progress_bar(clip.len() as u64, "tracking", "frames");
     let progress = |done: usize, _| bar.set_position(done as u64);

@@ -5,7 +5,7 @@
 
 #![allow(dead_code)]
 
-use bouncelab_estimate::{Conditions, estimate_with_frames};
+use bouncelab_estimate::{Conditions, estimate_finding_downslope, estimate_with_frames};
 use bouncelab_frames::Session;
 use bouncelab_track::{ClipTracking, Status, track_clip};
 use std::collections::BTreeMap;
@@ -155,7 +155,13 @@ fn evaluate_clip(
         ball_diameter_m: session.ball.diameter_m,
         surface_tilt_deg: None,
     };
-    match estimate_with_frames(&track, &clip, &conditions) {
+    // As `analyze` does: without a down-slope given, the flights' fall is checked against the default.
+    let estimate = if entry.downslope_given {
+        estimate_with_frames(&track, &clip, &conditions)
+    } else {
+        estimate_finding_downslope(&track, &clip, &conditions)
+    };
+    match estimate {
         Ok(e) => {
             if let Some(line) = e.contact_line {
                 // The truth's surface line is given at the image's centre column.

@@ -6,7 +6,7 @@
 //! run killed at any instant leaves each shot complete or absent and the next run resumes.
 
 use crate::{AnalyzeError, Progress, Stage};
-use bouncelab_estimate::{Conditions, Estimate, estimate_with_frames, saturation_flag};
+use bouncelab_estimate::{Conditions, Estimate, estimate_finding_downslope, estimate_with_frames, saturation_flag};
 use bouncelab_frames::{ClipEntry, Downslope, ReadOptions, Session};
 use bouncelab_store::{
     ClipFingerprint, EstimateRecord, Fingerprint, SessionRecord, ShotRecord, Store, TrackRecord, ValueSe,
@@ -277,7 +277,12 @@ fn measure_clip(entry: &ClipEntry, gravity: f64) -> Measured {
         ball_diameter_m: settings.ball_diameter_m,
         surface_tilt_deg: settings.surface_tilt_deg,
     };
-    let estimate = estimate_with_frames(&track, &clip, &conditions);
+    // Without a down-slope direction given, the flights' fall is checked against the default.
+    let estimate = if entry.downslope_given {
+        estimate_with_frames(&track, &clip, &conditions)
+    } else {
+        estimate_finding_downslope(&track, &clip, &conditions)
+    };
     // The trajectory in the estimate's local frame (on the contact line it chose, along its tilt), else in
     // the frame of the line the tracker found.
     let frame = estimate.as_ref().ok().and_then(|e| e.frame);

@@ -26,4 +26,4 @@ pub use shot::{
     estimate, saturation_flag,
 };
 pub use spin::{Rotation, Spin, SpinImage, SpinOptions, measure_spin, rotation_between, spin_from_frames};
-pub use with_frames::estimate_with_frames;
+pub use with_frames::{estimate_finding_downslope, estimate_with_frames};

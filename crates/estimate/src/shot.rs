@@ -157,15 +157,22 @@ pub struct GravityCheck {
     pub inconclusive: bool,
 }
 
+/// How many standard errors of the measured along-surface acceleration gravity's along-surface component
+/// must span for its sign to tell the down-slope direction ([`GravityCheck::downslope_reversed`]).
+pub const DOWNSLOPE_SIGMAS: f64 = 4.0;
+
 impl GravityCheck {
     /// True when the flights fall as gravity would with the down-slope direction the other way: the
-    /// along-surface part has gravity's size and the opposite sign (and is measured well enough to tell
-    /// them apart), the normal part agrees. A camera mirrored, or a clip whose `downslope` was not given.
+    /// along-surface part has the other sign and gravity's size, the normal part agrees, and either the
+    /// component is measured to [`DOWNSLOPE_SIGMAS`] of itself or better or the down-slope as set fails the
+    /// check (so noise alone flips it on fewer than 1 shot in 10,000). A camera mirrored, or a clip whose
+    /// `downslope` was not given.
     pub fn downslope_reversed(&self, g: f64) -> bool {
         let [at, an] = self.measured;
         let [et, en] = self.expected;
         let near = |m: &Measured, e: f64| (m.value - e).abs() <= 4.0 * m.se + 0.1 * g;
-        !self.inconclusive && near(&at, -et) && !near(&at, et) && near(&an, en)
+        let told = et.abs() >= DOWNSLOPE_SIGMAS * at.se || !near(&at, et);
+        !self.inconclusive && at.value * et < 0.0 && near(&at, -et) && near(&an, en) && told
     }
 
     /// The angle from gravity's expected direction to the measured acceleration's, rad, with its standard
@@ -555,8 +562,9 @@ fn friction(vin: &[VelocityPart; 2], vout: &[VelocityPart; 2], level: &LevelErro
 /// A flag when the flights do not fall at gravity's rate on the `incline_deg` incline, a note when they are
 /// too short to tell.
 fn note_gravity(g: &GravityCheck, incline_deg: f64, gravity: f64, flags: &mut Vec<String>, notes: &mut Vec<String>) {
-    if !g.consistent {
-        let why = if g.downslope_reversed(gravity) {
+    let reversed = g.downslope_reversed(gravity);
+    if !g.consistent || reversed {
+        let why = if reversed {
             "the part along the surface has gravity's size but the other sign: the down-slope direction looks reversed (a mirrored camera?); set `downslope` under [camera] in the clip's clip.toml or the session.toml"
         } else {
             "a wrong frame rate, scale or incline, repeated frames, or not the ball"

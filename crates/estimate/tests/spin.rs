@@ -1,9 +1,9 @@
 //! Spin from the texture's rotation, on clips rendered by `bouncelab-render` with known spin.
 
-use bouncelab_estimate::{Conditions, estimate_with_frames};
+use bouncelab_estimate::{Conditions, estimate_finding_downslope, estimate_with_frames};
 use bouncelab_frames::Clip;
 use bouncelab_render::{Scenario, render};
-use bouncelab_track::{ClipTracking, track_clip};
+use bouncelab_track::{ClipTracking, Track, track_clip};
 use std::path::Path;
 
 fn scenario(camera: &str) -> String {
@@ -121,4 +121,42 @@ fn spin_matches_the_rendered_truth() {
 #[test]
 fn spin_is_in_the_local_frame_when_the_image_is_mirrored_and_16_bit() {
     check("downslope = \"-x\"\nbit_depth = 16", true);
+}
+
+/// A mirrored camera whose `downslope` nobody gave: the flights, long enough to tell gravity's pull along
+/// the incline, set the down-slope, and the shot measures as with the key set; a level shot keeps the default.
+#[test]
+fn an_unset_down_slope_is_taken_from_the_flights() {
+    let text = scenario("downslope = \"-x\"")
+        .replace("pre_contact_ms = 6", "pre_contact_ms = 25")
+        .replace("post_separation_ms = 6", "post_separation_ms = 25");
+    let s = Scenario::parse(&text, "down-slope test").unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let rendered = render(&s, dir.path()).unwrap();
+    for shot in rendered.shots.iter().filter(|s| s.angle_deg != 15.0) {
+        let clip = Clip::open(rendered.session_dir.join(&shot.clip)).unwrap();
+        let c = Conditions {
+            incline_deg: shot.angle_deg,
+            ..Conditions::default()
+        };
+        // Tracked as a clip without the key would be (+x), and as one with it.
+        let unset = track_clip(&clip, &ClipTracking::default(), |_, _| {}).unwrap();
+        let set = Track {
+            downslope_negative_x: true,
+            ..unset.clone()
+        };
+        let found = estimate_finding_downslope(&unset, &clip, &c).unwrap();
+        let given = estimate_with_frames(&set, &clip, &c).unwrap();
+        let taken = found.notes.iter().any(|n| n.contains("so -x is taken as down-slope"));
+        if shot.angle_deg == 0.0 {
+            assert!(!taken, "{}: {:?}", shot.clip, found.notes);
+            continue;
+        }
+        assert!(taken, "{}: {:?} {:?}", shot.clip, found.gravity, found.notes);
+        assert!(found.flags.is_empty(), "{}: {:?}", shot.clip, found.flags);
+        assert!((found.mu.value - given.mu.value).abs() < 1e-9, "{}", shot.clip);
+        // Without the flip the flights' fits pull μ well away.
+        let kept = estimate_with_frames(&unset, &clip, &c).unwrap();
+        assert!((kept.mu.value - given.mu.value).abs() > 0.02, "{}", shot.clip);
+    }
 }

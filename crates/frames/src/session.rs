@@ -42,6 +42,9 @@ pub struct ClipEntry {
     pub fps_source: FpsSource,
     /// Down-slope image direction: `clip.toml` > `session.toml` > `+x`.
     pub downslope: Downslope,
+    /// Whether `clip.toml` or `session.toml` gave the down-slope direction (else `+x` is a default, which
+    /// the estimator checks against the way the flights fall).
+    pub downslope_given: bool,
     /// The other columns of the row, as (header, value), in header order.
     pub metadata: Vec<(String, String)>,
     /// The row's 1-based line in `clips.csv`.
@@ -185,6 +188,16 @@ impl Session {
                 Err(u) => unusable.push(u),
             }
         }
+        let unset = clips
+            .iter()
+            .filter(|c| !c.downslope_given && c.angle_deg.abs() >= 1.0)
+            .count();
+        if unset > 0 {
+            warnings.push(Warning::DefaultDownslope {
+                session: toml_path.clone(),
+                clips: unset,
+            });
+        }
         Ok(Self {
             dir,
             ball,
@@ -260,9 +273,8 @@ fn entry(
         Some(session_keys),
         warnings,
     );
-    let downslope = own
-        .and_then(|(_, k)| k.downslope)
-        .unwrap_or(session_keys.1.downslope.unwrap_or_default());
+    let given = settings.downslope;
+    let downslope = given.unwrap_or_default();
     Ok(ClipEntry {
         name: row.name,
         dir: clip_dir,
@@ -272,6 +284,7 @@ fn entry(
         fps,
         fps_source,
         downslope,
+        downslope_given: given.is_some(),
         metadata: row.metadata,
         line: row.line,
         settings,

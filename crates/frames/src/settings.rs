@@ -37,12 +37,14 @@ pub const DIAMETER_RANGE_M: (f64, f64) = (1e-4, 1.0);
 pub const MAX_LINE_TILT_DEG: f64 = 45.0;
 
 /// Which image direction is down the slope (`docs/session.md`, conventions).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum Downslope {
     /// Down-slope is +x_px (to the right in the image); the default. Written `"+x"`.
     #[default]
+    #[serde(rename = "+x")]
     PlusX,
     /// Down-slope is −x_px (to the left). Written `"-x"`.
+    #[serde(rename = "-x")]
     MinusX,
 }
 
@@ -82,6 +84,14 @@ pub enum Warning {
         /// The diameter assumed, in metres.
         diameter_m: f64,
     },
+    /// Clips on an incline whose down-slope direction neither their `clip.toml` nor `session.toml` gives:
+    /// `+x` is assumed unless a shot's flights tell otherwise.
+    DefaultDownslope {
+        /// The session's `session.toml`.
+        session: PathBuf,
+        /// How many such clips (incline of 1° or more).
+        clips: usize,
+    },
     /// The camera stored pixel codes that are not linear in the light (Phantom's 10-bit packed P10
     /// format is log-encoded); they are passed on as they are, monotonic but not linear.
     NonLinearPixels {
@@ -104,6 +114,11 @@ impl std::fmt::Display for Warning {
                 f,
                 "{}: no ball diameter given (command line, clip.toml or session.toml [ball] diameter_m); assuming {diameter_m} m",
                 clip.display()
+            ),
+            Self::DefaultDownslope { session, clips } => write!(
+                f,
+                "{}: {clips} clip(s) on an incline give no down-slope direction ([camera] downslope, \"+x\" or \"-x\", in clip.toml or session.toml); +x is assumed unless a shot's flights clearly fall the other way, and friction and spin depend on it",
+                session.display()
             ),
             Self::NonLinearPixels { path, detail } => write!(f, "{}: {detail}", path.display()),
         }
@@ -210,6 +225,13 @@ pub struct ClipSettings {
     pub surface_tilt_deg: Option<f64>,
     /// Where that tilt came from, when given.
     pub surface_tilt_source: Option<SettingSource>,
+    /// Which image direction is down the slope (`[camera] downslope`); `None`: not given, `+x` is assumed and
+    /// the estimator checks it against the way the flights fall.
+    #[serde(default)]
+    pub downslope: Option<Downslope>,
+    /// Where the down-slope direction came from, when given.
+    #[serde(default)]
+    pub downslope_source: Option<SettingSource>,
 }
 
 impl Default for ClipSettings {
@@ -225,6 +247,8 @@ impl Default for ClipSettings {
             contact_line_source: None,
             surface_tilt_deg: None,
             surface_tilt_source: None,
+            downslope: None,
+            downslope_source: None,
         }
     }
 }
@@ -571,6 +595,7 @@ pub(crate) fn choose_settings(
     let roi = pick(overrides.roi, own, session, |k| k.roi);
     let line = pick(overrides.contact_line, own, session, |k| k.contact_line);
     let tilt = pick(overrides.surface_tilt_deg, own, session, |k| k.surface_tilt_deg);
+    let downslope = pick(None, own, session, |k| k.downslope);
     let (ball_diameter_m, ball_diameter_source) = diameter.unwrap_or_else(|| {
         warnings.push(Warning::DefaultDiameter {
             clip: clip.into(),
@@ -588,6 +613,7 @@ pub(crate) fn choose_settings(
     let (roi, roi_source) = split(roi);
     let (contact_line, contact_line_source) = split(line);
     let (surface_tilt_deg, surface_tilt_source) = split(tilt);
+    let (downslope, downslope_source) = split(downslope);
     ClipSettings {
         scale_m_per_px,
         scale_source,
@@ -599,6 +625,8 @@ pub(crate) fn choose_settings(
         contact_line_source,
         surface_tilt_deg,
         surface_tilt_source,
+        downslope,
+        downslope_source,
     }
 }
 

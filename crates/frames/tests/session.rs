@@ -62,8 +62,33 @@ fn no_fps_anywhere_means_default_with_a_warning() {
     );
     let s = s.unwrap();
     assert_eq!(s.clips[0].fps, 10_000.0);
-    assert_eq!(s.warnings.len(), 2);
+    // Two clips without an fps, and shot_02 (20°) without a down-slope direction.
+    assert_eq!(s.warnings.len(), 3, "{:?}", s.warnings);
     assert!(matches!(&s.warnings[0], Warning::DefaultFps { clip, .. } if clip.ends_with("shot_01")));
+    assert!(matches!(&s.warnings[2], Warning::DefaultDownslope { clips: 1, .. }));
+}
+
+#[test]
+fn an_incline_without_a_down_slope_direction_is_warned_once() {
+    let toml = "[ball]\ndiameter_m = 0.067\nmass_kg = 0.0567\n[camera]\nfps = 5000\n";
+    let (_t, s) = session_with(toml, CSV, &["shot_01", "shot_02"]);
+    let s = s.unwrap();
+    assert!(!s.clips[1].downslope_given && s.clips[1].downslope == Downslope::PlusX);
+    let w: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].contains("1 clip(s) on an incline give no down-slope direction"),
+        "{w:?}"
+    );
+    // Given in session.toml, nothing to say; the level shot never needs it.
+    let (_t, s) = session_with(&format!("{toml}downslope = \"-x\"\n"), CSV, &["shot_01", "shot_02"]);
+    let s = s.unwrap();
+    assert!(
+        s.warnings.is_empty() && s.clips.iter().all(|c| c.downslope_given),
+        "{:?}",
+        s.warnings
+    );
+    assert_eq!(s.clips[1].settings.downslope, Some(Downslope::MinusX));
 }
 
 #[test]
@@ -253,8 +278,10 @@ fn camera_files_are_clips_by_exact_name_or_by_name_without_extension() {
     assert_eq!((by("p1").fps, by("c1.cine").fps), (30_000.0, 25_000.0));
     assert!(matches!(by("p1").fps_source, FpsSource::Header(_)));
     assert_eq!(by("t1").dir, d.join("t1.tif"));
-    // Neither the stack nor the folder has a header; nothing else gives an fps.
-    assert_eq!(s.warnings.len(), 2, "{:?}", s.warnings);
+    // Neither the stack nor the folder has a header; nothing else gives an fps. (And c1.cine, at 10°, has no
+    // down-slope direction.)
+    let fps_warnings = s.warnings.iter().filter(|w| matches!(w, Warning::DefaultFps { .. }));
+    assert_eq!(fps_warnings.count(), 2, "{:?}", s.warnings);
     for (name, frames) in [("p1", 3), ("c1.cine", 4), ("t1", 5), ("folder1", 2)] {
         assert_eq!(by(name).open().unwrap().len(), frames, "{name}");
     }
