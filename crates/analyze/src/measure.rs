@@ -77,11 +77,12 @@ const MEASUREMENT_REVISION: u32 = 6;
 /// Everything besides the frame files that changes a shot's track or estimate.
 fn settings_text(entry: &ClipEntry, gravity: f64) -> String {
     format!(
-        "bouncelab {} rev {MEASUREMENT_REVISION} | fps {} ({:?}) | downslope {:?} | diameter {} | scale {:?} | roi {:?} | line {:?} | tilt {:?} | angle {} | gravity {} | tracker {:?}",
+        "bouncelab {} rev {MEASUREMENT_REVISION} | fps {} ({:?}) | downslope {:?} (given {}) | diameter {} | scale {:?} | roi {:?} | line {:?} | tilt {:?} | angle {} | gravity {} | tracker {:?}",
         env!("CARGO_PKG_VERSION"),
         entry.fps,
         entry.fps_source,
         entry.downslope,
+        entry.downslope_given,
         entry.settings.ball_diameter_m,
         entry.settings.scale_m_per_px,
         entry.settings.roi,

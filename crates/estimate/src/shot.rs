@@ -155,24 +155,45 @@ pub struct GravityCheck {
     pub consistent: bool,
     /// True if the error is too large for the check to say anything (over half of g).
     pub inconclusive: bool,
+    /// Standard error of the tilt of the frame the acceleration is measured in, rad: a frame turned by δ
+    /// moves the along-surface part by about g·δ.
+    #[serde(default)]
+    pub sigma_frame_rad: f64,
 }
 
-/// How many standard errors of the measured along-surface acceleration gravity's along-surface component
-/// must span for its sign to tell the down-slope direction ([`GravityCheck::downslope_reversed`]).
+/// How many standard errors of the measured along-surface acceleration (the fit's and the frame tilt's)
+/// gravity's along-surface component must span for its sign to tell the down-slope direction
+/// ([`GravityCheck::downslope_evidence`]).
 pub const DOWNSLOPE_SIGMAS: f64 = 4.0;
 
 impl GravityCheck {
-    /// True when the flights fall as gravity would with the down-slope direction the other way: the
-    /// along-surface part has the other sign and gravity's size, the normal part agrees, and either the
-    /// component is measured to [`DOWNSLOPE_SIGMAS`] of itself or better or the down-slope as set fails the
-    /// check (so noise alone flips it on fewer than 1 shot in 10,000). A camera mirrored, or a clip whose
-    /// `downslope` was not given.
-    pub fn downslope_reversed(&self, g: f64) -> bool {
+    /// What the flights say of the down-slope direction the frame was built with: `Some(true)` when they
+    /// fall as gravity would with it the other way (a camera mirrored, or a clip whose `downslope` was not
+    /// given), `Some(false)` when they confirm it, `None` when they cannot tell. Either answer needs the
+    /// normal part to agree and the along-surface part to have gravity's size and that sign, resolved:
+    /// gravity's component spans [`DOWNSLOPE_SIGMAS`] of its error (the fit's, and the frame's tilt times
+    /// g), or, for `Some(true)`, the direction as set fails the check. Noise alone answers wrongly on
+    /// fewer than 1 shot in 10,000.
+    pub fn downslope_evidence(&self, g: f64) -> Option<bool> {
         let [at, an] = self.measured;
         let [et, en] = self.expected;
         let near = |m: &Measured, e: f64| (m.value - e).abs() <= 4.0 * m.se + 0.1 * g;
-        let told = et.abs() >= DOWNSLOPE_SIGMAS * at.se || !near(&at, et);
-        !self.inconclusive && at.value * et < 0.0 && near(&at, -et) && near(&an, en) && told
+        if self.inconclusive || et == 0.0 || !near(&an, en) {
+            return None;
+        }
+        let resolved = et.abs() >= DOWNSLOPE_SIGMAS * at.se.hypot(g * self.sigma_frame_rad);
+        if at.value * et < 0.0 && near(&at, -et) && (resolved || !near(&at, et)) {
+            Some(true)
+        } else if at.value * et > 0.0 && near(&at, et) && resolved {
+            Some(false)
+        } else {
+            None
+        }
+    }
+
+    /// [`Self::downslope_evidence`] says the down-slope is the other way.
+    pub fn downslope_reversed(&self, g: f64) -> bool {
+        self.downslope_evidence(g) == Some(true)
     }
 
     /// The angle from gravity's expected direction to the measured acceleration's, rad, with its standard
@@ -307,6 +328,10 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
     {
         level.sigma_theta = unmeasured_tilt(g, &mut notes);
     }
+    let gravity = gravity.map(|g| GravityCheck {
+        sigma_frame_rad: level.sigma_theta,
+        ..g
+    });
     // The level's error is common to both crossings, so it is carried as a derivative and propagated
     // coherently into the contact time, COR and μ, not added to each crossing separately.
     let touch = crossing(&fin, radius, points[first].t);
@@ -691,6 +716,7 @@ fn gravity_check(incoming: &[&Point], outgoing: &[&Point], expected: [f64; 2], g
         expected,
         consistent: consistent || inconclusive,
         inconclusive,
+        sigma_frame_rad: 0.0,
     })
 }
 

@@ -17,16 +17,20 @@ pub fn estimate_with_frames(track: &Track, clip: &Clip, c: &Conditions) -> Resul
 }
 
 /// [`estimate_with_frames`] for a clip whose down-slope direction nobody gave (the track's is a default):
-/// when the flights fall along the surface clearly the other way ([`crate::GravityCheck::downslope_reversed`]),
-/// the shot is measured with the down-slope they show, and a note says so. A shot whose flights cannot
-/// tell (a level surface, short flights) keeps the default.
+/// when an inclined shot's flights fall along the surface clearly the other way
+/// ([`crate::GravityCheck::downslope_evidence`]), the shot is measured with the down-slope they show, and
+/// a note says so. An inclined shot whose flights cannot tell keeps the default with a note; one whose
+/// flights confirm it, or a level one, keeps it silently.
 pub fn estimate_finding_downslope(track: &Track, clip: &Clip, c: &Conditions) -> Result<Estimate, EstimateError> {
     let first = estimate(track, c)?;
-    if !first.gravity.as_ref().is_some_and(|g| g.downslope_reversed(c.gravity)) {
+    // Below 1° the direction hardly matters and gravity's pull along the surface is too small to tell it.
+    let inclined = c.incline_deg.abs() >= 1.0;
+    let evidence = first.gravity.as_ref().and_then(|g| g.downslope_evidence(c.gravity));
+    if !inclined || evidence != Some(true) {
         let mut e = estimate_with_frames(track, clip, c)?;
         // On an incline the down-slope sets the sign of gravity's pull along the surface in the flights'
         // fits, and so the velocities at the contact: μ moved by 0.05–0.17 on the looks sweep's inclines.
-        if c.incline_deg.abs() >= 1.0 {
+        if inclined && evidence.is_none() {
             let side = if track.downslope_negative_x { "-x" } else { "+x" };
             let fall = first.gravity.as_ref().map_or(String::new(), |g| {
                 format!(

@@ -534,7 +534,11 @@ pub fn clip_toml_path(clip: &Path) -> PathBuf {
 
 /// The `session.toml` that applies to a clip: the one in the folder holding the clip.
 pub(crate) fn session_toml_path(clip: &Path) -> Option<PathBuf> {
-    clip.parent().map(|p| p.join("session.toml"))
+    match clip.parent() {
+        // `track .` names the clip by a path with no parent in it: the folder holding it is found on disk.
+        Some(p) if !p.as_os_str().is_empty() => Some(p.join("session.toml")),
+        _ => clip.canonicalize().ok()?.parent().map(|p| p.join("session.toml")),
+    }
 }
 
 /// The fps precedence (`docs/session.md`): override > `clip.toml` > the camera file's header >

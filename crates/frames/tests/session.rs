@@ -71,13 +71,14 @@ fn no_fps_anywhere_means_default_with_a_warning() {
 #[test]
 fn an_incline_without_a_down_slope_direction_is_warned_once() {
     let toml = "[ball]\ndiameter_m = 0.067\nmass_kg = 0.0567\n[camera]\nfps = 5000\n";
-    let (_t, s) = session_with(toml, CSV, &["shot_01", "shot_02"]);
+    let csv = "clip,surface,angle_deg,drop_height_m\nshot_01,clay,0,1.2\nshot_02,tape,20,0.8\nshot_03,clay,15,0.5\n";
+    let (_t, s) = session_with(toml, csv, &["shot_01", "shot_02", "shot_03"]);
     let s = s.unwrap();
     assert!(!s.clips[1].downslope_given && s.clips[1].downslope == Downslope::PlusX);
     let w: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
     assert_eq!(w.len(), 1, "{w:?}");
     assert!(
-        w[0].contains("1 clip(s) on an incline give no down-slope direction"),
+        w[0].contains("2 clip(s) on an incline give no down-slope direction"),
         "{w:?}"
     );
     // Given in session.toml, nothing to say; the level shot never needs it.

@@ -5,8 +5,8 @@
 //! bright limb) when the neighbouring rays see the same band, located to a fraction of a pixel by a parabola
 //! through the derivative's peak. Rays whose rim point lies at or below the surface line are skipped (that
 //! part of the ball is pressed into or hidden by the surface), and so are rays leaving the image. The edge
-//! points then go to the robust circle fit. Cost: rays × samples bilinear reads (128 × 17 ≈ 2,200, ≈ 10 µs)
-//! plus the fit.
+//! points then go to the robust circle fit. Cost: rays × samples bilinear reads (128 × 17 ≈ 2,200, ≈ 10 µs,
+//! for the default ±4 px; 16 more a ray with [`EdgeSearch::beyond_window`]) plus the fit.
 
 use crate::circle_fit::{CircleFit, fit_circle};
 use crate::plane::{Pixel, Plane, parabola_offset};
@@ -36,10 +36,11 @@ pub struct EdgeSearch {
     /// noise a single noisy sample otherwise out-steps a soft rim (default false; the clip tracker turns it
     /// on when a frame's noise exceeds [`NOISY_SIGMA`]).
     pub smooth: bool,
-    /// Also sample each ray up to [`LIMB_PX`] beyond the window's outer end, where a band's outer side may
-    /// lie (default true). A search sitting on a wide limb's inner side sees the rim outside it only so; a
-    /// settled track, whose window already sits on the rim, turns it off (those samples cost about half a
-    /// frame's search).
+    /// Also sample each ray 8 px beyond the window's outer end, so that a band's outer side within
+    /// [`LIMB_PX`] of the strongest step, and the level 2 px past it, are seen there too (default true). A
+    /// search sitting on a wide limb's inner side sees the rim outside it only so; a settled track, whose
+    /// window already sits on the rim, turns it off (sampled in every frame, they cost +80 % on the track
+    /// bench's steady case).
     pub beyond_window: bool,
 }
 
@@ -383,8 +384,8 @@ impl RimEdges {
 
 /// Where a ray's search can run: the number of samples, or why it cannot.
 enum RaySpan {
-    /// Samples along the ray: those of the search window, and in all (the window and, beyond its outer
-    /// end, up to [`LIMB_PX`] more where a band's outer side may lie).
+    /// Samples along the ray: those of the search window, and in all (the window and the samples beyond
+    /// its outer end where a band's outer side may lie, see [`EdgeSearch::beyond_window`]).
     Samples { window: usize, total: usize },
     /// The rim point is at or below the surface line, or too little of the ray lies above it.
     Hidden,
@@ -630,7 +631,8 @@ fn rim_edges<P: Pixel>(
         let Some((strongest, band)) = ray_edges(profile, window, search) else {
             continue;
         };
-        let definition = |e: ProfileEdge| {
+        // The strongest step's definition on the window alone, as without the samples beyond it.
+        let definition = |e: ProfileEdge, profile: &[f32]| {
             let o = search
                 .edge_definition
                 .then(|| half_level_offset(profile, e.0, e.0 as f64 + e.2));
@@ -639,8 +641,8 @@ fn rim_edges<P: Pixel>(
         seen.push(RaySeen {
             ray,
             dir: (c, s),
-            strongest: definition(strongest),
-            band: band.map(definition),
+            strongest: definition(strongest, &profile[..window]),
+            band: band.map(|b| definition(b, profile)),
         });
     }
     // Rays in ray order with gaps: a neighbour is found by its ray number.

@@ -461,8 +461,9 @@ impl Tracker {
                 .half_width
                 .max((2.0 * self.last_innovation + 2.0).min(12.0))
         };
-        // A settled track's window sits on the rim; until then (and after any jump) a band's outer side is
-        // also looked for beyond it, so that a track begun on a limb's inner side moves out to the rim.
+        // A settled track's window sits on the rim; until then (16 clean flight radii, and the last fix
+        // within half a pixel of its prediction) a band's outer side is also looked for beyond it, so that
+        // a track begun on a limb's inner side moves out to the rim.
         let settled = confident && self.flight_radii.len() >= RIM_MIN_SAMPLES;
         let search = EdgeSearch {
             half_width,
