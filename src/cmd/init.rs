@@ -16,9 +16,10 @@ pub struct Args {
     /// Ball mass, kg (otherwise session.toml leaves it for you to fill).
     #[arg(long)]
     mass: Option<f64>,
-    /// Which image direction is down the slope: "+x" (right) or "-x" (left).
-    #[arg(long, default_value = "+x", allow_hyphen_values = true, value_parser = ["+x", "-x"])]
-    downslope: String,
+    /// Which image direction is down the slope: "+x" (right) or "-x" (left) [default: left unset; +x is
+    /// assumed unless a shot's flights clearly fall the other way]
+    #[arg(long, allow_hyphen_values = true, value_parser = ["+x", "-x"])]
+    downslope: Option<String>,
     /// Overwrite an existing session.toml and clips.csv.
     #[arg(long)]
     force: bool,
@@ -34,11 +35,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     let mut o = InitOptions::default();
     (o.diameter_m, o.mass_kg, o.force) = (a.diameter, a.mass, a.force);
-    o.downslope = if a.downslope == "-x" {
-        Downslope::MinusX
-    } else {
-        Downslope::PlusX
-    };
+    o.downslope = a
+        .downslope
+        .map(|d| if d == "-x" { Downslope::MinusX } else { Downslope::PlusX });
     let written = draft.write(&o)?;
     println!("{} clip(s) in {}:", draft.clips.len(), a.dir.display());
     let cell = |x: Option<f64>| x.map_or_else(|| "?".to_string(), |v| v.to_string());

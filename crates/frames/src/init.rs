@@ -111,8 +111,9 @@ pub struct InitOptions {
     pub diameter_m: Option<f64>,
     /// Ball mass, in kilograms; `None` likewise.
     pub mass_kg: Option<f64>,
-    /// Which image direction is down the slope.
-    pub downslope: Downslope,
+    /// Which image direction is down the slope; `None` writes the key commented out, so that each shot's
+    /// flights are checked against `+x` and, where they clearly fall the other way, tell it.
+    pub downslope: Option<Downslope>,
     /// Overwrite an existing `session.toml` or `clips.csv`.
     pub force: bool,
 }
@@ -269,13 +270,16 @@ impl Draft {
                 );
             }
         }
-        t += &format!(
-            "downslope = \"{}\"   # which image direction is down the slope: \"+x\" (right) or \"-x\" (left)\n",
-            match o.downslope {
-                Downslope::PlusX => "+x",
-                Downslope::MinusX => "-x",
-            }
-        );
+        t += &match o.downslope {
+            Some(d) => format!(
+                "downslope = \"{}\"   # which image direction is down the slope: \"+x\" (right) or \"-x\" (left)\n",
+                match d {
+                    Downslope::PlusX => "+x",
+                    Downslope::MinusX => "-x",
+                }
+            ),
+            None => "# downslope = \"+x\"   # which image direction is down the slope: \"+x\" (right) or \"-x\" (left); unset, +x is assumed unless a shot's flights clearly fall the other way (docs/session.md)\n".to_string(),
+        };
         t
     }
 

@@ -502,14 +502,26 @@ fn init_then_load_on_a_folder_of_camera_files() {
     let filled = csv
         .replace("broken.cine,,,\n", "")
         .replace("shot_03,,,", "shot_03,clay,0,1");
-    std::fs::write(d.join("clips.csv"), filled).unwrap();
+    std::fs::write(d.join("clips.csv"), &filled).unwrap();
     let s = Session::load(d).unwrap();
     assert_eq!(s.clips.len(), 3);
     assert_eq!(s.clip("tape_0deg_1.2m.cine").unwrap().open().unwrap().len(), 4);
     assert_eq!(s.clip("clay_15deg_550mm.cihx").unwrap().fps, 30_000.0);
+    // No down-slope asked for: the key is written commented out, so the inclined clip's flights may tell it.
+    assert!(!s.clip("clay_15deg_550mm.cihx").unwrap().downslope_given);
+    assert!(
+        s.warnings
+            .iter()
+            .any(|w| matches!(w, Warning::DefaultDownslope { clips: 1, .. }))
+    );
     let mut forced = o.clone();
     forced.force = true;
+    forced.downslope = Some(Downslope::MinusX);
     draft.write(&forced).unwrap();
+    std::fs::write(d.join("clips.csv"), &filled).unwrap();
+    let s = Session::load(d).unwrap();
+    let c = s.clip("clay_15deg_550mm.cihx").unwrap();
+    assert!(c.downslope_given && c.downslope == Downslope::MinusX);
     // Without a ball, the keys are left for a person to fill and loading names them.
     let mut bare = InitOptions::default();
     bare.force = true;
