@@ -43,7 +43,7 @@ pub fn estimate_finding_downslope(track: &Track, clip: &Clip, c: &Conditions) ->
             e.notes.insert(
                 0,
                 format!(
-                    "down-slope not given and the flights too short to tell it{fall}: {side} assumed; friction and spin depend on it (set `downslope` under [camera])"
+                    "down-slope not given and the flights do not tell it{fall}: {side} assumed; friction and spin depend on it (set `downslope` under [camera])"
                 ),
             );
         }
