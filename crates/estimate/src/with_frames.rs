@@ -8,12 +8,16 @@ use bouncelab_track::Track;
 /// [`estimate`] plus the spin before and after the impact, measured from the clip's frames
 /// ([`measure_spin`] with default options); a phase whose spin cannot be measured gets `None` and a note.
 pub fn estimate_with_frames(track: &Track, clip: &Clip, c: &Conditions) -> Result<Estimate, EstimateError> {
-    let mut e = estimate(track, c)?;
+    Ok(with_spin(estimate(track, c)?, track, clip))
+}
+
+/// The estimate `e` of `track` with its spin measured from the clip's frames.
+fn with_spin(mut e: Estimate, track: &Track, clip: &Clip) -> Estimate {
     let spin = measure_spin(clip, track, &e.phases, &SpinOptions::default());
     e.spin_in = spin.spin_in;
     e.spin_out = spin.spin_out;
     e.notes.extend(spin.notes);
-    Ok(e)
+    e
 }
 
 /// [`estimate_with_frames`] for a clip whose down-slope direction nobody gave (the track's is a default):
@@ -22,14 +26,14 @@ pub fn estimate_with_frames(track: &Track, clip: &Clip, c: &Conditions) -> Resul
 /// a note says so. An inclined shot whose flights cannot tell keeps the default with a note; one whose
 /// flights confirm it, or a level one, keeps it silently.
 pub fn estimate_finding_downslope(track: &Track, clip: &Clip, c: &Conditions) -> Result<Estimate, EstimateError> {
-    let first = estimate(track, c)?;
+    let mut first = estimate(track, c)?;
     // Below 1° the direction hardly matters and gravity's pull along the surface is too small to tell it.
     let inclined = c.incline_deg.abs() >= 1.0;
     let evidence = first.gravity.as_ref().and_then(|g| g.downslope_evidence(c.gravity));
     if !inclined || evidence != Some(true) {
-        let mut e = estimate_with_frames(track, clip, c)?;
         // On an incline the down-slope sets the sign of gravity's pull along the surface in the flights'
-        // fits, and so the velocities at the contact: μ moved by 0.05–0.17 on the looks sweep's inclines.
+        // fits, and so the velocities at the contact: μ moved by 0.05–0.17 on the looks sweep's inclines of
+        // 7° or more.
         if inclined && evidence.is_none() {
             let side = if track.downslope_negative_x { "-x" } else { "+x" };
             let fall = first.gravity.as_ref().map_or(String::new(), |g| {
@@ -40,14 +44,14 @@ pub fn estimate_finding_downslope(track: &Track, clip: &Clip, c: &Conditions) ->
                     g.expected[0].abs()
                 )
             });
-            e.notes.insert(
+            first.notes.insert(
                 0,
                 format!(
                     "down-slope not given and the flights do not tell it{fall}: {side} assumed; friction and spin depend on it (set `downslope` under [camera])"
                 ),
             );
         }
-        return Ok(e);
+        return Ok(with_spin(first, track, clip));
     }
     let flipped = Track {
         downslope_negative_x: !track.downslope_negative_x,
