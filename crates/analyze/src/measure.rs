@@ -71,8 +71,10 @@ pub(crate) fn session_key(session: &Session) -> String {
 /// line's source, the local frame along the measured tilt, the gravity check; 4: a rejected line lends no
 /// tilt, an unmeasured tilt is in the errors, the surface's tilt setting; 5: the surface line from the mean
 /// of the first frames, its tilt error counting the edge's roughness, flight bounding the prediction; 6: a
-/// band's outer side looked for beyond the search window while a track settles, a reversed down-slope named).
-const MEASUREMENT_REVISION: u32 = 6;
+/// band's outer side looked for beyond the search window while a track settles, a reversed down-slope named;
+/// 7: a ball first sighted late followed back from its sighting, a doubtful circle giving way to a clearer one
+/// inside it).
+const MEASUREMENT_REVISION: u32 = 7;
 
 /// Everything besides the frame files that changes a shot's track or estimate.
 fn settings_text(entry: &ClipEntry, gravity: f64) -> String {

@@ -32,6 +32,8 @@ pub(crate) type Sighting = (f64, f64, f64);
 pub(crate) struct Acquired {
     pub radius: (f64, f64),
     pub seed: (Sighting, Sighting),
+    /// The file (position in the clip) of the first sighting.
+    pub file: usize,
     /// Another moving ball-like circle seen at acquisition: (frame index, x, y) px.
     pub second: Option<(usize, f64, f64)>,
 }
@@ -62,7 +64,8 @@ enum Voters {
 
 /// The ball's radius range and two sightings (see the module's description). Clean circles (quality above
 /// [`CLEAN_QUALITY`]) are tried first over the whole search, then circles down to [`CANDIDATE_QUALITY`] (a ball
-/// crossing a ruler, or in heavy noise); moving votes before the frame's own. When nothing moves, the error
+/// crossing a ruler, or in heavy noise; there a doubtful circle gives way to a clearer one inside it, see
+/// [`PairSearch::clearer_inside`]); moving votes before the frame's own. When nothing moves, the error
 /// lists the static circles seen. With a scale hint only radii within ±20 % of the ball's are searched.
 pub(crate) fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32, noise: f32) -> Result<Acquired, TrackError> {
     let (w, h) = opts.roi.map_or(clip.dimensions(), |r| (r.width, r.height));
@@ -111,7 +114,7 @@ pub(crate) fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32, noise: f32) -
                     votes,
                     voters,
                 };
-                if let Some(found) = search.through_clip(&pass)? {
+                if let Some(found) = search.through_clip(&pass, &bands)? {
                     return Ok(found);
                 }
             }
@@ -123,6 +126,7 @@ pub(crate) fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32, noise: f32) -
 /// One pass of the search: the least quality of a sighting, the radius band (its index and range, px), whether
 /// centres inside the frame or beyond its edges are looked for (see [`CircleDetection::beyond_edge`]), where
 /// the votes come from and which edges vote.
+#[derive(Clone, Copy)]
 struct Pass {
     threshold: f64,
     band: usize,
@@ -171,17 +175,72 @@ impl PairSearch<'_> {
     }
 
     /// Pairs of files `gap` apart through the first half of the clip, in this pass: the first moving pair
-    /// ([`moving_pair`]) as the ball, else `None`. The clean frame pass also notes the circles that stayed.
-    fn through_clip(&mut self, pass: &Pass) -> Result<Option<Acquired>, TrackError> {
+    /// ([`moving_pair`]) as the ball, else `None`; in a doubtful pass, a clearer one inside it in a smaller
+    /// band of `bands` takes its place ([`Self::clearer_inside`]). The clean frame pass also notes the
+    /// circles that stayed.
+    fn through_clip(&mut self, pass: &Pass, bands: &[(f64, f64)]) -> Result<Option<Acquired>, TrackError> {
         let (n, gap) = (self.clip.len(), self.gap);
         let mut k = 0;
         while k + gap < n && k <= n / 2 {
             if let Some(pair) = self.pair_at(k, pass)? {
+                let pair = if pass.threshold < CLEAN_QUALITY {
+                    self.clearer_inside(k, pass, pair, bands)?
+                } else {
+                    pair
+                };
                 return Ok(Some(self.acquired(k, &pair)));
             }
             k += gap;
         }
         Ok(None)
+    }
+
+    /// The clearest moving pair at files `k` and `k + gap` in the bands of `bands` smaller than `pass`'s whose
+    /// first circle lies inside `found`'s, is clearer (its weaker sighting's quality above `found`'s by
+    /// [`CLEARER_BY`]) and stands out from its surroundings at least as much ([`disc_contrast`]); else
+    /// `found`. Largest first is right for a clean ball, whose rim comes before the seam's lobes drawn on it,
+    /// but in heavy noise a doubtful circle twice the ball's size, pulled along by part of its rim, moves
+    /// with it too: the ball inside is the clearer circle and the clearer disc, a lobe is neither.
+    fn clearer_inside(
+        &mut self,
+        k: usize,
+        pass: &Pass,
+        found: MovingPair,
+        bands: &[(f64, f64)],
+    ) -> Result<MovingPair, TrackError> {
+        let clarity = |p: &MovingPair| p.a.support.min(p.b.support);
+        let outer_contrast = self.contrast_of(k, pass, &found.a)?;
+        let mut best: Option<MovingPair> = None;
+        for (band, &radii) in bands.iter().enumerate().skip(pass.band + 1) {
+            for (voters, votes) in self.sources() {
+                let inner = Pass {
+                    band,
+                    radii,
+                    votes,
+                    voters,
+                    ..*pass
+                };
+                let Some(pair) = self.pair_at(k, &inner)? else {
+                    continue;
+                };
+                let inside = (pair.a.x - found.a.x).hypot(pair.a.y - found.a.y) < found.a.r;
+                let clearer = clarity(&pair) > clarity(&found) + CLEARER_BY
+                    && best.as_ref().is_none_or(|b| clarity(&pair) > clarity(b));
+                if inside && clearer && self.contrast_of(k, &inner, &pair.a)? >= outer_contrast {
+                    best = Some(pair);
+                }
+            }
+        }
+        Ok(best.unwrap_or(found))
+    }
+
+    /// The [`disc_contrast`] of circle `c` as seen in file `k` in this pass (0 if it is not one of them).
+    fn contrast_of(&mut self, k: usize, pass: &Pass, c: &Circle) -> Result<f64, TrackError> {
+        let seen = self.circles(k, pass)?;
+        Ok(seen
+            .iter()
+            .find(|s| s.circle.x == c.x && s.circle.y == c.y && s.circle.r == c.r)
+            .map_or(0.0, |s| s.contrast))
     }
 
     /// The ball moving cleanly near the clip's start, the common case, found without going through the clip
@@ -359,6 +418,7 @@ impl PairSearch<'_> {
         Acquired {
             radius: radius_window(r),
             seed: ((t(k), pair.a.x, pair.a.y), (t(k + self.gap), pair.b.x, pair.b.y)),
+            file: k,
             second: pair.other.map(|o| (clip.files()[k].index as usize, o.x, o.y)),
         }
     }
@@ -406,6 +466,10 @@ const EARLY_PAIRS: usize = 8;
 /// The most [`ring_motion`] round a circle standing on still ground: a few times the ≈ 0.7 σ of noise alone,
 /// well under the tens of gray levels between a ball and its backdrop.
 const STILL_RING_SIGMAS: f64 = 3.0;
+
+/// How much clearer (in quality) a moving circle inside a doubtful one must be to take its place (see
+/// [`PairSearch::clearer_inside`]): more than the ±0.04 or so that refining the same rim from two starts gives.
+const CLEARER_BY: f64 = 0.05;
 
 /// The least distance between a pair's two sightings for it to count as moving, px.
 const MIN_PAIR_MOVE_PX: f64 = 1.5;

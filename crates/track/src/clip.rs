@@ -6,6 +6,7 @@
 //! round things (screw heads, fixtures, a second ball at rest) by its motion: it is the circle that moved
 //! between two frames.
 
+use crate::acquire::Sighting;
 use crate::local::SurfaceFrame;
 use crate::plane::{Pixel, Plane};
 use crate::refine::{EdgeSearch, NOISY_SIGMA};
@@ -225,25 +226,47 @@ pub fn track_clip(
             "the frames use little of their gray scale: levels stretched {gain:.1}× for the ball and line searches"
         ));
     }
-    let crate::acquire::Acquired { radius, seed, second } = crate::acquire::acquire(clip, opts, gain, noise)?;
+    let crate::acquire::Acquired {
+        radius,
+        seed,
+        file: seed_file,
+        second,
+    } = crate::acquire::acquire(clip, opts, gain, noise)?;
     if let Some((frame, x, y)) = second {
         warnings.push(format!(
             "a second moving ball-like circle at ({x:.0}, {y:.0}) in frame {frame}: tracking the clearer one, at ({:.0}, {:.0}) then (crop with --roi if that is the wrong one)",
             seed.0.1, seed.0.2
         ));
     }
+    // A ball first seen after the clip's first frames is followed back to its start from there: the
+    // forward track then begins from where it was, not from its sightings extrapolated back.
+    let mut backward = Backward {
+        clip,
+        opts,
+        gain,
+        radius,
+        surface: given_line(clip, opts),
+    };
+    let early = backward.before_seed(seed, seed_file)?;
     let mut tracker = Tracker::new(TrackOptions {
         radius_px: Some(radius),
         ..opts.tracker.clone()
     });
-    tracker.seed(seed.0, seed.1);
+    let (a, b) = forward_seed(&early, seed);
+    tracker.seed(a, b);
     if let Some(line) = given_line(clip, opts) {
         tracker.set_surface(line);
     }
     let forward = track_forward(frames, clip.len(), opts.roi, gain, &mut tracker, &mut progress)?;
     warnings.extend(tracker.warnings().iter().cloned());
     let mut fixes = forward.fixes;
-    retrack_backward(clip, opts, gain, radius, &tracker, &mut fixes, &mut warnings)?;
+    for (fix, old) in early.into_iter().zip(fixes.iter_mut()) {
+        if fix.status.measured() && clearer(&fix, old) {
+            *old = fix;
+        }
+    }
+    backward.surface = tracker.surface().copied();
+    backward.retrack_start(&mut fixes, &mut warnings)?;
     let measured = fixes.iter().filter(|f| f.status.measured()).count();
     if forward.saturated > 0 {
         warnings.push(format!(
@@ -389,53 +412,89 @@ fn track_forward(
     })
 }
 
-/// Tracks the frames before the forward track first settled again, backward from there ([`retrack_start`]),
-/// with a fresh tracker on the forward one's surface line; when fixes are replaced, the forward pass's
-/// warnings about those frames are dropped and the re-measurement is said.
-fn retrack_backward(
-    clip: &Clip,
-    opts: &ClipTracking,
+/// What the passes tracking backward in time share: each runs a fresh tracker over files in reverse order,
+/// on `surface` (the line given, before the forward track; the forward track's after it).
+struct Backward<'a> {
+    clip: &'a Clip,
+    opts: &'a ClipTracking,
     gain: f32,
     radius: (f64, f64),
-    forward: &Tracker,
-    fixes: &mut [BallFix],
-    warnings: &mut Vec<String>,
-) -> Result<(), TrackError> {
-    let mut back = Tracker::new(TrackOptions {
-        radius_px: Some(radius),
-        ..opts.tracker.clone()
-    });
-    if let Some(line) = forward.surface() {
-        back.set_surface(*line);
+    surface: Option<SurfaceLine>,
+}
+
+impl Backward<'_> {
+    /// A fresh tracker for the ball's radius range, on `surface` when there is one.
+    fn tracker(&self) -> Tracker {
+        let mut back = Tracker::new(TrackOptions {
+            radius_px: Some(self.radius),
+            ..self.opts.tracker.clone()
+        });
+        if let Some(line) = self.surface {
+            back.set_surface(line);
+        }
+        back
     }
-    let retracked = retrack_start(fixes, &mut back, |tr, k, frame, t_back| {
+
+    /// Measures file `k` (frame index `frame`) with `tracker` at time `t_back` (negated time).
+    fn measure(&self, tracker: &mut Tracker, k: usize, frame: usize, t_back: f64) -> Result<BallFix, TrackError> {
         let image = in_region(
-            clip.read(k, opts.read.png_decoder).expect("index in range")?,
-            opts.roi.as_ref(),
+            self.clip.read(k, self.opts.read.png_decoder).expect("index in range")?,
+            self.opts.roi.as_ref(),
         );
         Ok(with_plane(
             &image.pixels,
-            gain,
-            |p| on_plane!(p, p => observe(tr, frame, t_back, &p)),
+            self.gain,
+            |p| on_plane!(p, p => observe(tracker, frame, t_back, &p)),
         ))
-    })?;
-    if let Some((settled, replaced)) = retracked
-        && replaced > 0
-    {
-        // What the forward pass said of the frames now measured again no longer describes the track.
-        let first = fixes[settled].frame;
-        warnings.retain(|w| {
-            w.strip_prefix("frame ")
-                .and_then(|rest| rest.split(':').next())
-                .and_then(|n| n.parse::<usize>().ok())
-                .is_none_or(|n| n >= first)
-        });
-        warnings.push(format!(
-            "the track settled at frame {}: {replaced} of the {settled} frames before it re-measured by tracking backward from there",
-            fixes[settled].frame
-        ));
     }
-    Ok(())
+
+    /// The files before the ball's first sighting (file `start`), tracked backward from its two sightings
+    /// `seed` (absent where the ball was not found).
+    fn before_seed(&self, seed: (Sighting, Sighting), start: usize) -> Result<Vec<BallFix>, TrackError> {
+        let mut fixes: Vec<BallFix> = self.clip.files()[..start]
+            .iter()
+            .map(|f| BallFix::absent(f.index as usize, self.clip.time_of(f.index), Status::Absent))
+            .collect();
+        if start == 0 {
+            return Ok(fixes);
+        }
+        let mut back = self.tracker();
+        let ((ta, xa, ya), (tb, xb, yb)) = seed;
+        back.seed((-tb, xb, yb), (-ta, xa, ya));
+        track_back(
+            &mut fixes,
+            &mut back,
+            start,
+            |tr, k, frame, t| self.measure(tr, k, frame, t),
+            |_, _| true,
+        )?;
+        Ok(fixes)
+    }
+
+    /// Tracks the frames before the forward track first settled again, backward from there
+    /// ([`retrack_start`]); when fixes are replaced, the forward pass's warnings about those frames are
+    /// dropped and the re-measurement is said.
+    fn retrack_start(&self, fixes: &mut [BallFix], warnings: &mut Vec<String>) -> Result<(), TrackError> {
+        let mut back = self.tracker();
+        let retracked = retrack_start(fixes, &mut back, |tr, k, frame, t| self.measure(tr, k, frame, t))?;
+        if let Some((settled, replaced)) = retracked
+            && replaced > 0
+        {
+            // What the forward pass said of the frames now measured again no longer describes the track.
+            let first = fixes[settled].frame;
+            warnings.retain(|w| {
+                w.strip_prefix("frame ")
+                    .and_then(|rest| rest.split(':').next())
+                    .and_then(|n| n.parse::<usize>().ok())
+                    .is_none_or(|n| n >= first)
+            });
+            warnings.push(format!(
+                "the track settled at frame {}: {replaced} of the {settled} frames before it re-measured by tracking backward from there",
+                fixes[settled].frame
+            ));
+        }
+        Ok(())
+    }
 }
 
 /// Share of the samples around a rim at the file's full scale above which the rim counts as saturated.
@@ -481,7 +540,7 @@ const SETTLED_RUN: usize = 5;
 fn retrack_start(
     fixes: &mut [BallFix],
     back: &mut Tracker,
-    mut measure: impl FnMut(&mut Tracker, usize, usize, f64) -> Result<BallFix, TrackError>,
+    measure: impl FnMut(&mut Tracker, usize, usize, f64) -> Result<BallFix, TrackError>,
 ) -> Result<Option<(usize, usize)>, TrackError> {
     let clean = |f: &BallFix| f.status == Status::Ok && f.quality >= CLEAN_QUALITY;
     let Some(settled) =
@@ -494,19 +553,52 @@ fn retrack_start(
     }
     let (a, b) = (fixes[settled + 1], fixes[settled]);
     back.seed((-a.t_s, a.x_px, a.y_px), (-b.t_s, b.x_px, b.y_px));
+    let replaced = track_back(fixes, back, settled, measure, clearer)?;
+    Ok(Some((settled, replaced)))
+}
+
+/// Whether a fix measured on another pass replaces `old`: `old` is not measured, or is a clearly weaker
+/// circle (quality lower by more than 0.1).
+fn clearer(fix: &BallFix, old: &BallFix) -> bool {
+    !old.status.measured() || fix.quality > old.quality + 0.1
+}
+
+/// Where the forward track starts: from the two earliest fixes of the backward pass over the frames before
+/// the ball's first sighting ([`Backward::before_seed`]), the second at least the sightings' gap after the
+/// first (else the first sighting itself); from the sightings `seed` when that pass measured nothing.
+fn forward_seed(early: &[BallFix], seed: (Sighting, Sighting)) -> (Sighting, Sighting) {
+    let measured: Vec<&BallFix> = early.iter().filter(|f| f.status.measured()).collect();
+    let Some(a) = measured.first() else {
+        return seed;
+    };
+    let gap = seed.1.0 - seed.0.0;
+    let b = measured
+        .iter()
+        .find(|f| f.t_s - a.t_s >= 0.999 * gap)
+        .map_or(seed.0, |f| (f.t_s, f.x_px, f.y_px));
+    ((a.t_s, a.x_px, a.y_px), b)
+}
+
+/// Files `start − 1` down to 0 measured by `back` (already seeded, in negated time) through
+/// `measure(back, k, frame, −t)`; a measured fix replaces the one in `fixes` where `takes(fix, old)`.
+/// Returns how many were replaced.
+fn track_back(
+    fixes: &mut [BallFix],
+    back: &mut Tracker,
+    start: usize,
+    mut measure: impl FnMut(&mut Tracker, usize, usize, f64) -> Result<BallFix, TrackError>,
+    takes: impl Fn(&BallFix, &BallFix) -> bool,
+) -> Result<usize, TrackError> {
     let mut replaced = 0;
-    for k in (0..settled).rev() {
-        let forward = fixes[k];
-        let fix = measure(back, k, forward.frame, -forward.t_s)?;
-        if fix.status.measured() && (!forward.status.measured() || fix.quality > forward.quality + 0.1) {
-            fixes[k] = BallFix {
-                t_s: forward.t_s,
-                ..fix
-            };
+    for k in (0..start).rev() {
+        let old = fixes[k];
+        let fix = measure(back, k, old.frame, -old.t_s)?;
+        if fix.status.measured() && takes(&fix, &old) {
+            fixes[k] = BallFix { t_s: old.t_s, ..fix };
             replaced += 1;
         }
     }
-    Ok(Some((settled, replaced)))
+    Ok(replaced)
 }
 
 /// Streams the `total` frames of `frames` in order through `fix_of`, reporting progress and timing how long
@@ -643,6 +735,51 @@ mod tests {
         // That part is named, for what is common to a session's clips.
         assert!((shaped.sigma_shape_m_per_px / shaped.m_per_px - 0.08 / 80.0).abs() < 1e-12);
         assert_eq!(plain.sigma_shape_m_per_px, 0.0);
+    }
+
+    /// A ball first sighted in frames 20 and 25 is measured in the frames before from there, backward, and the
+    /// forward track starts from the earliest of those fixes.
+    #[test]
+    fn frames_before_the_first_sighting_are_tracked_backward_from_it() {
+        let mut back = Tracker::new(TrackOptions {
+            radius_px: Some((34.0, 46.0)),
+            ..TrackOptions::default()
+        });
+        let sighting = |k: usize| (k as f64 * 1e-4, ball_at(k).0, ball_at(k).1);
+        let seed = (sighting(20), sighting(25));
+        back.seed((-seed.1.0, seed.1.1, seed.1.2), (-seed.0.0, seed.0.1, seed.0.2));
+        let mut early: Vec<BallFix> = (0..20)
+            .map(|k| BallFix::absent(k, k as f64 * 1e-4, Status::Absent))
+            .collect();
+        let replaced = track_back(
+            &mut early,
+            &mut back,
+            20,
+            |tr, k, frame_index, t| {
+                let img = frame(k);
+                Ok(tr.observe(frame_index, t, &Plane::new(&img, 256, 256)))
+            },
+            |_, _| true,
+        )
+        .unwrap();
+        assert_eq!(replaced, 20);
+        for (k, f) in early.iter().enumerate() {
+            let (x, y) = ball_at(k);
+            assert_eq!(f.t_s, k as f64 * 1e-4);
+            assert!(
+                (f.x_px - x).hypot(f.y_px - y) < 0.2,
+                "frame {k}: {f:?} against ({x}, {y})"
+            );
+        }
+        // The forward track starts at frame 0, its second position the sightings' gap (5 frames) later.
+        let (a, b) = forward_seed(&early, seed);
+        assert_eq!((a.1, a.2), (early[0].x_px, early[0].y_px));
+        assert_eq!((b.1, b.2), (early[5].x_px, early[5].y_px));
+        // Without a measured frame before them, the sightings themselves.
+        let none: Vec<BallFix> = (0..20)
+            .map(|k| BallFix::absent(k, k as f64 * 1e-4, Status::Absent))
+            .collect();
+        assert_eq!(forward_seed(&none, seed), seed);
     }
 
     #[test]
