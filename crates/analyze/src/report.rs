@@ -688,11 +688,36 @@ pub fn verdict_headline(d: &Diagnosis) -> String {
     let named = |e: &str| d.candidate(e).and_then(|c| c.evidence.as_ref().map(|ev| (c, ev)));
     match d.verdict.kind {
         VerdictKind::MissingEffect => match d.verdict.effect.as_deref().and_then(|e| named(e).map(|x| (e, x))) {
-            Some((e, (c, ev))) => format!(
-                "`{e}` is missing: held-out error {:.1} → {:.1} µm",
-                c.heldout_error_before * 1e6,
-                ev.heldout_error_after * 1e6
-            ),
+            Some((e, (c, ev))) => {
+                // A search that went on after its first effect names the rest in `then`; the error left is
+                // the last one's.
+                let mut names = vec![format!("`{e}`")];
+                let mut after = ev.heldout_error_after;
+                let mut next = d.then.as_deref();
+                while let Some(n) = next {
+                    if n.verdict.kind != VerdictKind::MissingEffect {
+                        break;
+                    }
+                    let Some((e2, ev2)) = n
+                        .verdict
+                        .effect
+                        .as_deref()
+                        .and_then(|e2| n.candidate(e2).and_then(|c2| c2.evidence.as_ref()).map(|ev2| (e2, ev2)))
+                    else {
+                        break;
+                    };
+                    names.push(format!("`{e2}`"));
+                    after = ev2.heldout_error_after;
+                    next = n.then.as_deref();
+                }
+                let verb = if names.len() > 1 { "are" } else { "is" };
+                format!(
+                    "{} {verb} missing: held-out error {:.1} → {:.1} µm",
+                    names.join(" and "),
+                    c.heldout_error_before * 1e6,
+                    after * 1e6
+                )
+            }
             None => "an effect is missing".into(),
         },
         VerdictKind::Ambiguous => {
@@ -1134,6 +1159,24 @@ mod tests {
     use bouncelab_fit::MeasuredFrame;
     use bouncelab_track::{LineCue, SurfaceLine};
     use serde::Serialize;
+
+    /// A search that went on after its first effect (`fixtures/diagnosis/two-effects.json`, a 16-shot
+    /// Hunt–Crossley + rolling-resistance session's diagnosis with the unnamed candidates left out) is
+    /// summed up with both effects and the error the second leaves.
+    #[test]
+    fn the_headline_names_every_effect_of_a_search_that_went_on() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/diagnosis/two-effects.json");
+        let mut d: Diagnosis = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+        assert_eq!(
+            verdict_headline(&d),
+            "`rolling_resistance` and `hunt_crossley` are missing: held-out error 181.1 → 8.2 µm"
+        );
+        d.then = None;
+        assert_eq!(
+            verdict_headline(&d),
+            "`rolling_resistance` is missing: held-out error 181.1 → 93.9 µm"
+        );
+    }
 
     #[test]
     fn shots_on_the_image_axes_are_named_when_the_lines_found_show_a_tilt() {
