@@ -65,9 +65,40 @@ fn num(row: &BTreeMap<String, String>, key: &str) -> f64 {
 
 /// Tracks and estimates every clip of the session at `session_dir` against `truth_dir`.
 pub fn evaluate(session_dir: &Path, truth_dir: &Path) -> Vec<ClipResult> {
+    evaluate_with(session_dir, truth_dir, GivenLine::None)
+}
+
+/// Which line, if any, each clip is given as its contact line, as a lab enters a line it measured.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub enum GivenLine {
+    /// None: the tracker finds it, as in `analyze`.
+    None,
+    /// The truth's surface plane: what the tracker and estimator reach with the line exactly right.
+    Plane,
+    /// The least-squares line through the band's edge as drawn (`truth/edges.csv`): the best any finder
+    /// looking at that edge can do, since a ragged edge's own line is not the plane it was drawn about.
+    DrawnEdge,
+}
+
+/// [`evaluate`] with each clip given `line` (see [`GivenLine`]).
+pub fn evaluate_with(session_dir: &Path, truth_dir: &Path, line: GivenLine) -> Vec<ClipResult> {
     let session = Session::load(session_dir).expect("session");
-    let shots = read_csv(&truth_dir.join("shots.csv"));
+    let mut shots = read_csv(&truth_dir.join("shots.csv"));
     let looks = read_csv(&truth_dir.join("looks.csv"));
+    if line == GivenLine::DrawnEdge {
+        let edges = read_csv(&truth_dir.join("edges.csv"));
+        for s in &mut shots {
+            let e = edges.iter().find(|e| e["clip"] == s["clip"]).expect("edges.csv row");
+            s.insert("given_y_px".into(), e["drawn_edge_y_px"].clone());
+            s.insert("given_tilt_deg".into(), e["drawn_edge_tilt_deg"].clone());
+        }
+    } else if line == GivenLine::Plane {
+        for s in &mut shots {
+            let (y, t) = (s["surface_y_px"].clone(), s["surface_tilt_deg"].clone());
+            s.insert("given_y_px".into(), y);
+            s.insert("given_tilt_deg".into(), t);
+        }
+    }
     let mut out = Vec::new();
     for truth in &shots {
         let name = &truth["clip"];
@@ -117,6 +148,13 @@ fn evaluate_clip(
     let opts = ClipTracking {
         ball_diameter_m: session.ball.diameter_m,
         downslope_negative_x: entry.downslope == bouncelab_frames::Downslope::MinusX,
+        contact_line: truth
+            .get("given_y_px")
+            .filter(|y| !y.is_empty())
+            .map(|_| bouncelab_frames::ContactLine {
+                y_px: num(truth, "given_y_px"),
+                tilt_deg: num(truth, "given_tilt_deg"),
+            }),
         ..ClipTracking::default()
     };
     let track = match track_clip(&clip, &opts, |_, _| {}) {

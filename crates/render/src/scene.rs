@@ -337,6 +337,43 @@ impl<'a> ShotRenderer<'a> {
         }
     }
 
+    /// The least-squares line through the band's top edge as drawn: per column, the first y (from the top)
+    /// where the band's coverage reaches one half, interpolated between rows; then y = y0 + m·(x − x_c)
+    /// fitted over every column that has one, x_c the centre column. Returns (y at x_c, px; tilt, degrees
+    /// counter-clockwise as seen, as [`crate::ShotTruth::surface_tilt_deg`]), or `None` for fewer than two
+    /// such columns. A ragged edge's own line differs from the plane it was drawn about (the truth's surface
+    /// line): that difference is what no line finder can undo. Cost: one pass over the coverage.
+    pub fn drawn_edge_line(&self) -> Option<(f64, f64)> {
+        let (w, h) = (self.w, self.h);
+        let xc = (w as f64 - 1.0) / 2.0;
+        let pts: Vec<(f64, f64)> = (0..w)
+            .filter_map(|x| {
+                let cov = |y: usize| self.front[y * w + x] as f64;
+                (1..h).find(|&y| cov(y) >= 0.5).map(|y| {
+                    let (a, b) = (cov(y - 1), cov(y));
+                    let f = if b > a {
+                        ((0.5 - a) / (b - a)).clamp(0.0, 1.0)
+                    } else {
+                        1.0
+                    };
+                    (x as f64 - xc, (y - 1) as f64 + f)
+                })
+            })
+            .collect();
+        if pts.len() < 2 {
+            return None;
+        }
+        let n = pts.len() as f64;
+        let (mx, my) = (
+            pts.iter().map(|p| p.0).sum::<f64>() / n,
+            pts.iter().map(|p| p.1).sum::<f64>() / n,
+        );
+        let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+        let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+        let m = sxy / sxx;
+        Some((my - m * mx, (-m).atan().to_degrees()))
+    }
+
     /// The composited static frame, the ball's texture (albedo `albedo` DN, with or without its seam) and
     /// the noise table.
     fn finish(&mut self, rng: &mut Rng, albedo: f64, seam: bool) {

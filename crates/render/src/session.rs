@@ -99,7 +99,7 @@ pub fn render_with(
     observer.planned(n, total);
     write_session_files(scenario, &session_dir, &plans)?;
     write_truth_files(scenario, &truth_dir, &plans)?;
-    let one = |p: &ShotPlan| -> Result<(), RenderError> {
+    let one = |p: &ShotPlan| -> Result<Option<(f64, f64)>, RenderError> {
         let dir = session_dir.join(&p.truth.clip);
         std::fs::create_dir_all(&dir).map_err(|e| RenderError::write(&dir, e))?;
         let r = p.renderer();
@@ -117,13 +117,22 @@ pub fn render_with(
             (0..p.frames.len()).try_for_each(write)?;
         }
         observer.shot_done(&p.truth);
-        Ok(())
+        Ok(r.drawn_edge_line())
     };
-    if opts.parallel {
-        plans.par_iter().try_for_each(one)?;
+    let edges: Vec<Option<(f64, f64)>> = if opts.parallel {
+        plans.par_iter().map(one).collect::<Result<_, _>>()?
     } else {
-        plans.iter().try_for_each(one)?;
-    }
+        plans.iter().map(one).collect::<Result<_, _>>()?
+    };
+    write_csv(
+        &truth_dir.join("edges.csv"),
+        EDGE_COLUMNS,
+        plans.iter().zip(&edges),
+        |(p, e)| {
+            let (y, tilt) = e.map_or((String::new(), String::new()), |(y, t)| (num(y), num(t)));
+            vec![p.truth.clip.clone(), y, tilt]
+        },
+    )?;
     Ok(Rendered {
         session_dir,
         truth_dir,
@@ -234,6 +243,11 @@ fn write_clips_csv(dir: &Path, plans: &[ShotPlan]) -> Result<(), RenderError> {
         },
     )
 }
+
+/// Columns of `truth/edges.csv`: the least-squares line through each shot's band edge as drawn
+/// ([`crate::ShotRenderer::drawn_edge_line`]; empty where the frame shows no band), at the centre column as the
+/// surface line of `shots.csv` is.
+pub const EDGE_COLUMNS: &[&str] = &["clip", "drawn_edge_y_px", "drawn_edge_tilt_deg"];
 
 /// Columns of `truth/shots.csv`.
 pub const SHOTS_COLUMNS: &[&str] = &[

@@ -396,6 +396,104 @@ ball_radius_px = 20
     }
 }
 
+/// The drawn edge's own line (`ShotRenderer::drawn_edge_line`, written to `truth/edges.csv`) is the
+/// least-squares line through the edge a frame shows: on a smooth edge it is the truth's plane; on a ragged
+/// one it is the line through the half-way crossings found in the frame's columns, and leans off the plane.
+#[test]
+fn the_drawn_edge_line_is_the_line_through_the_edge_the_frame_shows() {
+    let text = |roughness: f64| {
+        format!(
+            r#"
+seed = 4
+pre_contact_ms = 25
+post_separation_ms = 3
+[camera]
+fixed_pattern_noise = 0
+hot_pixel_fraction = 0
+flicker_amplitude = 0
+[surfaces.clay]
+texture = "clay"
+[grid]
+surfaces = ["clay"]
+drop_heights_m = [0.25, 0.3]
+angles_deg = [0]
+[look]
+balls = ["felt_seam"]
+backdrop_dn = 40
+band_offset_dn = 80
+texture_dn = 0.5
+lip_dn = 0
+edge_roughness_px = {roughness}
+edge_scale_px = [3, 8]
+gradient = 0
+vignetting = 0
+hot_spots = 0
+ruler = 0
+fixtures = 0
+screws = 0
+second_circle = 0
+hand = 0
+read_noise_dn = 0.5
+bit_depths = [16]
+roll_deg = [1.5, 1.5]
+width_px = 320
+height_px = 240
+ball_radius_px = 20
+"#
+        )
+    };
+    for roughness in [0.0, 3.0] {
+        let s = Scenario::parse(&text(roughness), "edge").unwrap();
+        for shot in 0..s.shots.len() {
+            let plan = ShotPlan::new(&s, shot).unwrap();
+            let t = &plan.truth;
+            let r = plan.renderer();
+            let (y_drawn, tilt_drawn) = r.drawn_edge_line().expect("a band in view");
+            let f = r.frame(0);
+            let (w, h) = (f.width as usize, f.height as usize);
+            let ball = &plan.frames[0];
+            let xc = (w as f64 - 1.0) / 2.0;
+            // The half-way crossing (80 DN between 40 and 120) down each column clear of the ball.
+            let v = |x: usize, y: usize| f.get(x as u32, y as u32);
+            let pts: Vec<(f64, f64)> = (0..w)
+                .filter(|&x| (x as f64 - ball.x_px).abs() > ball.r_px + 4.0)
+                .filter_map(|x| {
+                    (1..h).find(|&y| v(x, y) >= 80.0).map(|y| {
+                        (
+                            x as f64 - xc,
+                            y as f64 - 1.0 + (80.0 - v(x, y - 1)) / (v(x, y) - v(x, y - 1)),
+                        )
+                    })
+                })
+                .collect();
+            let n = pts.len() as f64;
+            let (mx, my) = pts.iter().fold((0.0, 0.0), |a, p| (a.0 + p.0 / n, a.1 + p.1 / n));
+            let m = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>()
+                / pts.iter().map(|p| (p.0 - mx).powi(2)).sum::<f64>();
+            let (y_seen, tilt_seen) = (my - m * mx, (-m).atan().to_degrees());
+            eprintln!(
+                "{} roughness {roughness}: drawn ({y_drawn:.3}, {tilt_drawn:.4}°), seen ({y_seen:.3}, {tilt_seen:.4}°), plane ({:.3}, {:.4}°)",
+                t.clip, t.surface_y_px, t.surface_tilt_deg
+            );
+            // The frame's columns behind the ball are left out, so the two fits see slightly different columns.
+            assert!((y_drawn - y_seen).abs() < 0.2 && (tilt_drawn - tilt_seen).abs() < 0.02);
+            if roughness == 0.0 {
+                assert!(
+                    (y_drawn - t.surface_y_px).abs() < 0.05,
+                    "{y_drawn} against {}",
+                    t.surface_y_px
+                );
+                assert!((tilt_drawn - t.surface_tilt_deg).abs() < 0.01);
+            } else {
+                assert!(
+                    (tilt_drawn - t.surface_tilt_deg).abs() > 1e-3,
+                    "a ragged edge leans off its plane"
+                );
+            }
+        }
+    }
+}
+
 #[test]
 fn a_look_session_gives_each_clip_its_camera_and_no_truth() {
     let text = tiny_look(6, "");
