@@ -46,7 +46,8 @@ impl BallisticFit {
 }
 
 /// Fits `points` (t s, x m, y m, σ m) with the known acceleration `a` (m/s²). Needs at least 3 points;
-/// the standard errors are inflated by √χ²_red when the scatter exceeds the given σ.
+/// the standard errors are inflated by √(χ²_red·(1+ρ)/(1−ρ)) when that exceeds 1, ρ the lag-1 correlation
+/// of the residuals in the points' order ([`ar1_factor`]).
 pub fn fit_ballistic(points: &[(f64, f64, f64, f64)], a: [f64; 2]) -> Option<BallisticFit> {
     if points.len() < 3 {
         return None;
@@ -92,7 +93,17 @@ pub fn fit_ballistic(points: &[(f64, f64, f64, f64)], a: [f64; 2]) -> Option<Bal
             .sum();
         let dof = (points.len() as f64 - 2.0).max(1.0);
         let chi2_red = chi2 / dof;
-        let inflate = chi2_red.max(1.0);
+        // Neighbouring residuals of a tracker drift together (the rim's look changes slowly from frame to
+        // frame): their scatter is counted as √(χ²_red·(1+ρ)/(1−ρ)), as in `fit_free_acceleration`.
+        let residuals: Vec<f64> = points
+            .iter()
+            .map(|p| {
+                let d = p.0 - t_ref;
+                let z = if k == 0 { p.1 } else { p.2 };
+                (z - (p0 + v0 * d + 0.5 * ak * d * d)) / p.3
+            })
+            .collect();
+        let inflate = (chi2_red * ar1_factor(&residuals)).max(1.0);
         fit.p0[k] = p0;
         fit.v0[k] = v0;
         fit.chi2_red[k] = chi2_red;
@@ -158,7 +169,7 @@ pub fn fit_free_acceleration(points: &[(f64, f64, f64, f64)]) -> Option<([f64; 2
 
 /// The variance factor (1+ρ)/(1−ρ) of a mean of AR(1) residuals with lag-1 correlation ρ (measured,
 /// held to 0–0.9: a negative ρ is not credited).
-fn ar1_factor(residuals: &[f64]) -> f64 {
+pub(crate) fn ar1_factor(residuals: &[f64]) -> f64 {
     let n = residuals.len() as f64;
     let m = residuals.iter().sum::<f64>() / n;
     let var: f64 = residuals.iter().map(|r| (r - m).powi(2)).sum();

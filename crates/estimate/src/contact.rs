@@ -6,8 +6,8 @@
 //! `A·τ² + B·τ³` above the arc, `A, B ≥ 0`, `τ` the time since the touch. So the touch time is found by
 //! fitting the arc and that onset together to the frames from the first one to half-way to the lowest centre,
 //! for every candidate touch time on a fine grid (a tenth of a frame), and taking the best; its standard error
-//! is where the profile χ² rises by one (scaled by the fit's reduced χ² when the scatter exceeds the tracker's
-//! σ). The centre's height on the arc at that time is the contact level. The same from the other side (time
+//! is where the profile χ² rises by one (scaled by the fit's reduced χ² times the variance factor of the
+//! early arc's residual correlation, (1+ρ)/(1−ρ), when that exceeds one). The centre's height on the arc at that time is the contact level. The same from the other side (time
 //! reversed) gives where the ball rejoins its outgoing arc; the two are combined when they agree. The
 //! lowest centre must lie below both.
 //!
@@ -120,6 +120,14 @@ pub fn trajectory_contact(
         .collect();
     let sep = onset(&reversed, lowest, a_px, radius_px);
     let mut notes = Vec::new();
+    for (side, o) in [("touch", Some(&touch)), ("separation", sep.as_ref())] {
+        if let Some(o) = o.filter(|o| o.bounded) {
+            notes.push(format!(
+                "the trajectory does not place the {side} (its best time lies at the edge of the frames searched): its level is uncertain by ± {:.2} px",
+                o.level_se
+            ));
+        }
+    }
     let (mut level, mut level_se) = (touch.level, touch.level_se);
     let mut consistent = true;
     let separation = sep.as_ref().map(|s| ((-s.t0, s.t0_se), (s.level, s.level_se)));
@@ -164,6 +172,8 @@ struct Onset {
     t0_se: f64,
     level: f64,
     level_se: f64,
+    /// The best onset lay at the first time searched (see [`onset`]): a bound, not a placement.
+    bounded: bool,
 }
 
 /// Grid step of candidate touch times, in frames.
@@ -232,14 +242,24 @@ fn onset(side: &[HeightPoint], _lowest: f64, a_px: f64, _radius_px: f64) -> Opti
         .collect();
     let best = profile.iter().min_by(|a, b| a.1.total_cmp(&b.1))?;
     let dof = (used.len() as f64 - 4.0).max(1.0);
-    let scale = (best.1 / dof).max(1.0);
+    // Neighbouring residuals of a tracker drift together: the fit's scatter counts as its variance factor
+    // (1+ρ)/(1−ρ) over independent ones (the same factor as the flights' fits), ρ measured on the best fit's
+    // residuals over the frames it used, in time order.
+    let correlated = crate::ballistic::ar1_factor(&onset_residuals(&used, a_px, &clock, best.0, &best.2));
+    let scale = (best.1 / dof * correlated).max(1.0);
     // The Δχ² = 1 interval (in units of the fit's own scatter), its half-width the standard error.
     let inside: Vec<f64> = profile.iter().filter(|p| p.1 - best.1 <= scale).map(|p| p.0).collect();
     let (lo, hi) = (
         inside.iter().cloned().fold(f64::INFINITY, f64::min),
         inside.iter().cloned().fold(f64::NEG_INFINITY, f64::max),
     );
-    let t0_se = (0.5 * (hi - lo)).max(0.5 * GRID_FRAMES * dt);
+    let mut t0_se = (0.5 * (hi - lo)).max(0.5 * GRID_FRAMES * dt);
+    // Best at the first time searched: the χ² still falls there, so the frames bound the onset (it lies that
+    // far back or further) but do not place it; its error is then the whole window searched.
+    let bounded = best.0 <= t_from + 0.5 * GRID_FRAMES * dt && t_dep > t_from;
+    if bounded {
+        t0_se = t0_se.max(t_dep - t_from);
+    }
     let (t0, c, cov) = (best.0, best.2, best.3);
     let u0 = clock.u(t0);
     let level = c[0] + c[1] * u0 + 0.5 * a_u * u0 * u0;
@@ -252,7 +272,22 @@ fn onset(side: &[HeightPoint], _lowest: f64, a_px: f64, _radius_px: f64) -> Opti
         t0_se,
         level,
         level_se,
+        bounded,
     })
+}
+
+/// The residuals (in units of each point's σ) of the onset `c` fitted with the touch at `t0` (see [`fit_onset`]).
+fn onset_residuals(points: &[HeightPoint], a_px: f64, clock: &Clock, t0: f64, c: &[f64; 4]) -> Vec<f64> {
+    let (a_u, u0) = (a_px * clock.dt * clock.dt, clock.u(t0));
+    points
+        .iter()
+        .map(|p| {
+            let u = clock.u(p.t);
+            let tau = (u - u0).max(0.0);
+            let model = c[0] + c[1] * u + 0.5 * a_u * u * u + c[2] * tau * tau + c[3] * tau * tau * tau;
+            (p.h - model) / p.sigma
+        })
+        .collect()
 }
 
 /// The median time between consecutive points, s.
@@ -458,6 +493,35 @@ mod tests {
             eprintln!("{phase}: {tc:?} (touch at {t_touch})");
             assert!((tc.level_px - 100.0).abs() < 0.3, "{tc:?}");
         }
+    }
+
+    /// A side whose centre creeps off its arc long before it is seen to (a lift growing as τ^1.5 from 20 ms, a
+    /// contact's τ³ from 3 ms later): the profile still falls at the first time searched, so the onset is
+    /// only bounded, and its level's error spans the frames searched instead of the profile's sharp edge.
+    #[test]
+    fn an_onset_the_frames_only_bound_gets_the_error_of_the_window_searched() {
+        let (dt, v, a) = (1e-4, 5000.0, -9.81 / 4e-4);
+        let t_start = 0.02;
+        let side: Vec<HeightPoint> = (0..=240)
+            .map(|i| {
+                let t = i as f64 * dt;
+                let tau = ((t - t_start) / dt).max(0.0);
+                let h = 200.0 - v * t + 0.5 * a * t * t + 0.001 * tau.powf(1.5) + 2e-4 * (tau - 30.0).max(0.0).powi(3);
+                HeightPoint { t, h, sigma: 0.05 }
+            })
+            .collect();
+        let low = (0..side.len())
+            .min_by(|&a, &b| side[a].h.total_cmp(&side[b].h))
+            .unwrap();
+        let o = onset(&side[..=low], side[low].h, a, 84.0).expect("an onset");
+        eprintln!(
+            "t0 {} ± {}, level ± {}, bounded {}",
+            o.t0, o.t0_se, o.level_se, o.bounded
+        );
+        assert!(o.bounded);
+        assert!(o.t0_se >= 11.0 * dt, "{}", o.t0_se);
+        // The level moves by v·t0_se over such a window: at least a pixel here.
+        assert!(o.level_se > 1.0, "{}", o.level_se);
     }
 
     #[test]

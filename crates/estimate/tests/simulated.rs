@@ -262,6 +262,34 @@ fn without_a_surface_line_the_trajectory_tells_the_contact() {
     assert!(rms < 2.5, "level RMS(error/σ) {rms} over {z_level:?}");
 }
 
+/// A tracker whose error drifts with the rim's look from frame to frame (an AR(1) wobble of 0.3 px,
+/// lag-1 correlation 0.9, while it states 0.05 px): the onset the trajectory gives is uncertain by far more
+/// than independent errors would say, so it does not overrule the line the ball lands on, and the flights'
+/// errors count the drift.
+#[test]
+fn a_drifting_track_keeps_the_line_it_lands_on_and_its_errors_count_the_drift() {
+    let model = Model::paper(31_000.0, 13.0, 0.75);
+    let mut z_cor = Vec::new();
+    for seed in 0..8u64 {
+        let (mut track, truth) = shot(&model, 22.5, 0.7, 0.02, 300 + seed);
+        let mut rng = Rng::new(seed ^ 0x5EED);
+        let (rho, sd) = (0.9f64, 0.3f64);
+        let (mut ex, mut ey) = (sd * rng.normal(), sd * rng.normal());
+        for f in &mut track.fixes {
+            ex = rho * ex + sd * (1.0 - rho * rho).sqrt() * rng.normal();
+            ey = rho * ey + sd * (1.0 - rho * rho).sqrt() * rng.normal();
+            f.x_px += ex;
+            f.y_px += ey;
+        }
+        let e = estimate(&track, &conditions(22.5)).unwrap();
+        let used = e.contact_line.unwrap();
+        assert_ne!(used.cue, LineCue::Trajectory, "seed {seed}: {:?}", e.notes);
+        z_cor.push((e.cor.value - truth.restitution) / e.cor.se);
+    }
+    let rms = (z_cor.iter().map(|z| z * z).sum::<f64>() / z_cor.len() as f64).sqrt();
+    assert!(rms < 2.0, "COR RMS(error/SE) {rms} over {z_cor:?}");
+}
+
 /// A line far from where the ball lands (a ruler's edge, a shadow) is not taken for the contact.
 #[test]
 fn a_line_the_ball_does_not_land_on_gives_way_to_the_trajectory() {
