@@ -725,9 +725,10 @@ pub fn verdict_headline(d: &Diagnosis) -> String {
             format!("these explain the misfit about equally well: {}", names.join(", "))
         }
         VerdictKind::NoMissingEffect => format!(
-            "the model fits to the noise (position RMS {:.1} µm, noise {:.1} µm)",
+            "the model fits within the measurement floor (position RMS {:.1} µm, noise {:.1} µm, floor {:.1} µm)",
             d.baseline.fit.rms_m * 1e6,
-            d.noise.noise_m * 1e6
+            d.noise.noise_m * 1e6,
+            d.floor.floor_m * 1e6
         ),
         VerdictKind::NoneExplains => format!(
             "no library effect explains the misfit (systematic {:.1} µm); see its signature{}",

@@ -143,5 +143,9 @@ pub fn measured_shot(
             .map(|t| t.se.to_radians())
             .filter(|s| s.is_finite() && *s > 0.0),
         spin_sigma_rad_s: e.spin_in.map(|s| s.se).filter(|s| s.is_finite() && *s > 0.0),
+        rim_change_m: e
+            .rim_change_px
+            .map(|c| [c.value * scale, c.se * scale])
+            .filter(|c| c.iter().all(|v| v.is_finite())),
     }
 }

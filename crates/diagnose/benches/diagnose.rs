@@ -53,6 +53,7 @@ fn session() -> Vec<MeasuredShot> {
                     surface_sigma_m: None,
                     frame_sigma_rad: None,
                     spin_sigma_rad_s: None,
+                    rim_change_m: None,
                 });
             }
         }

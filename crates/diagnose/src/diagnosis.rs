@@ -260,11 +260,20 @@ fn yes() -> bool {
 /// from the session's free flight (see `docs/diagnosis.md`).
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct Floor {
-    /// The floor the decisions use, m: `flight_systematic_m` and `contact_allowance_m` in quadrature.
+    /// The floor the decisions use, m: `flight_systematic_m`, `rim_change_m` and `contact_allowance_m` in
+    /// quadrature, plus [`FLOOR_MARGIN_SE`](crate::FLOOR_MARGIN_SE) of its standard errors (`floor_se_m`).
     pub floor_m: f64,
     /// Systematic part of the flight residuals after each arc's own fit (exact physics), pooled over every
     /// shot, m: the tracker's own structure; `None` when no arc was long enough or the floor was given.
     pub flight_systematic_m: Option<f64>,
+    /// The tracker's error that changes between a shot's two flights, which each arc's own fit hides, m:
+    /// from the change of the ball's measured radius between them (see `floor.rs`); `None` when no shot's
+    /// was measured or the floor was given.
+    #[serde(default)]
+    pub rim_change_m: Option<f64>,
+    /// Standard error of the learned parts of the floor, m (`floor_m` holds three of it).
+    #[serde(default)]
+    pub floor_se_m: f64,
     /// The tracker's extra error in contact, which the flight cannot show (the option `tolerance_m`), m.
     pub contact_allowance_m: f64,
     /// Per shot (input order): the systematic part of its flight residuals, m (`None`: no arc long enough).

@@ -423,6 +423,7 @@ mod tests {
                     surface_sigma_m: Some(20e-6),
                     frame_sigma_rad: None,
                     spin_sigma_rad_s: None,
+                    rim_change_m: None,
                 }
             })
             .collect()

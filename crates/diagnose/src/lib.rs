@@ -47,6 +47,7 @@ pub use diagnosis::{
 };
 pub use error::DiagnoseError;
 pub use evaluate::{FitSummary, FittedValue};
+pub use floor::FLOOR_MARGIN_SE;
 pub use model_file::add_effect_to_model_toml;
 pub use options::{SearchOptions, SearchProgress};
 pub use proposal::{ProposedTerm, TermProposal};

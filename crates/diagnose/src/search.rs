@@ -177,6 +177,7 @@ fn search(
         verdict.sentence = format!("{} {}", verdict.sentence, proposal::sentence(p));
     }
     search.announce(search.total, "done".into());
+    let thresholds = thresholds(options, &floor);
     Ok(Diagnosis {
         verdict,
         candidates,
@@ -186,7 +187,7 @@ fn search(
         floor,
         shots: shots.len(),
         folds: k,
-        thresholds: thresholds(options),
+        thresholds,
         proposal,
         then,
         seconds: clock.elapsed().as_secs_f64(),
@@ -206,14 +207,15 @@ fn baseline_of(base: &ModelRun, heldout_error_m: f64, noise_m: f64) -> Baseline 
     }
 }
 
-/// The thresholds the decisions used (the tolerance being the floor).
-fn thresholds(options: &SearchOptions) -> Thresholds {
+/// The thresholds the decisions used (the tolerance being the floor, the per-phase tolerance as
+/// `floor` raises it).
+fn thresholds(options: &SearchOptions, floor: &Floor) -> Thresholds {
     Thresholds {
         alpha: options.alpha,
         min_delta_bic: options.min_delta_bic,
         min_param_z: options.min_param_z,
         tolerance_m: options.tolerance_m,
-        phase_tolerance_m: options.phase_tolerance_m,
+        phase_tolerance_m: crate::verdict::phase_tolerance(options, floor),
         explained_fraction: options.explained_fraction,
     }
 }

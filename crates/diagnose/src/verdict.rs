@@ -32,15 +32,40 @@ fn um(m: f64) -> String {
 /// The floor in words: its value and where it comes from.
 fn floor_words(f: &Floor) -> String {
     match f.flight_systematic_m {
-        Some(s) => format!(
-            "the {} floor (the flight's own residual structure {} and {} allowed for tracking in contact, in quadrature)",
-            um(f.floor_m),
-            um(s),
-            um(f.contact_allowance_m)
-        ),
+        Some(s) => {
+            let rim = f.rim_change_m.map_or(String::new(), |r| {
+                format!(", the rim's change between the flights {}", um(r))
+            });
+            let margin = if f.floor_se_m > 0.0 {
+                format!(
+                    ", plus {} of its standard errors, {}",
+                    crate::FLOOR_MARGIN_SE,
+                    um(crate::FLOOR_MARGIN_SE * f.floor_se_m)
+                )
+            } else {
+                String::new()
+            };
+            format!(
+                "the {} floor (the flight's own residual structure {}{rim} and {} allowed for tracking in contact, in quadrature{margin})",
+                um(f.floor_m),
+                um(s),
+                um(f.contact_allowance_m)
+            )
+        }
         None => format!("the {} floor", um(f.floor_m)),
     }
 }
+
+/// How far a phase and component may misfit before it alone says the model misfits: the option
+/// `phase_tolerance_m`, or three floors when the session's tracking is that much worse (a phase holds a
+/// few of the frames, and the tracker's own error differs by phase).
+pub(crate) fn phase_tolerance(o: &SearchOptions, f: &Floor) -> f64 {
+    o.phase_tolerance_m.max(PHASE_FLOORS * f.floor_m)
+}
+
+/// Floors a phase's systematic residual may reach (see [`phase_tolerance`]): the default per-phase tolerance
+/// is about three times the floor of our clean rendered sessions.
+const PHASE_FLOORS: f64 = 3.0;
 
 fn num(v: f64) -> String {
     let a = v.abs();
@@ -139,15 +164,16 @@ fn misfit_reasons(baseline: &Baseline, signature: &Signature, inp: &Inputs<'_>) 
             floor_words(inp.floor)
         ));
     }
+    let phase_tol = phase_tolerance(o, inp.floor);
     for ph in &signature.phases {
-        if ph.systematic_m > o.phase_tolerance_m {
+        if ph.systematic_m > phase_tol {
             reasons.push(format!(
                 "{} {}: systematic residual {} (RMS {}), above the {} per-phase tolerance",
                 ph.component.name(),
                 ph.phase.words(),
                 um(ph.systematic_m),
                 um(ph.rms_m),
-                um(o.phase_tolerance_m)
+                um(phase_tol)
             ));
         }
     }

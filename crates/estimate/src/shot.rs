@@ -137,6 +137,12 @@ pub struct Estimate {
     /// The flights' acceleration, m/s² in the local frame (free fits of both arcs, weighted), against gravity's.
     #[serde(default)]
     pub gravity: Option<GravityCheck>,
+    /// How much the ball's measured radius changed from the incoming flight to the outgoing one, px (mean
+    /// outgoing − mean incoming, with its standard error): a rigid ball's radius does not, so this is the
+    /// tracker's rim-based estimate changing between the flights (a fuzzy rim turning, the light across the
+    /// frame), and its centre changes with it, which no flight fit can see ([`rim_change`]).
+    #[serde(default)]
+    pub rim_change_px: Option<Measured>,
     /// Why the shot's numbers are not to be trusted (it is kept out of the fit); empty when they are.
     #[serde(default)]
     pub flags: Vec<String>,
@@ -285,6 +291,8 @@ struct Point {
     y: f64,
     sigma: f64,
     clearance_px: f64,
+    /// The radius the tracker measured in this frame, px.
+    r_px: f64,
 }
 
 /// Measures one shot from its track.
@@ -359,6 +367,7 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
         note_gravity(g, c.incline_deg, c.gravity, &mut flags, &mut notes);
     }
     note_scatter(&fin, &fout, &mut notes);
+    let rim_change_px = rim_change(&incoming, &outgoing);
     Ok(Estimate {
         v_in: vin.map(|v| Measured::new(v.value, v.total)),
         v_out: vout.map(|v| Measured::new(v.value, v.total)),
@@ -388,9 +397,28 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
             .map(|l| Measured::new(l.tilt_deg(), l.sigma_tilt_deg)),
         trajectory_level_px: choice.trajectory_level_px,
         gravity,
+        rim_change_px,
         flags,
         notes,
     })
+}
+
+/// The change of the measured radius between the flights, px: mean outgoing − mean incoming, its standard
+/// error from each flight's scatter with the variance factor of its correlation ([`ar1_factor`]); `None`
+/// when a flight holds fewer than three radii.
+fn rim_change(incoming: &[&Point], outgoing: &[&Point]) -> Option<Measured> {
+    let mean_and_var = |set: &[&Point]| -> Option<(f64, f64)> {
+        let r: Vec<f64> = set.iter().map(|p| p.r_px).filter(|r| r.is_finite()).collect();
+        if r.len() < 3 {
+            return None;
+        }
+        let n = r.len() as f64;
+        let m = r.iter().sum::<f64>() / n;
+        let var = r.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0);
+        Some((m, var / n * crate::ballistic::ar1_factor(&r)))
+    };
+    let ((mi, vi), (mo, vo)) = (mean_and_var(incoming)?, mean_and_var(outgoing)?);
+    Some(Measured::new(mo - mi, (vi + vo).sqrt()))
 }
 
 /// The fixes a fit weighs ([`bouncelab_track::Status::fitted`] with a finite centre); an error when they
@@ -440,6 +468,7 @@ fn local_points(
                 y,
                 sigma: f.sigma_px.max(MIN_SIGMA_PX) * s,
                 clearance_px: y / s - scale.radius_px,
+                r_px: f.r_px,
             }
         })
         .collect();

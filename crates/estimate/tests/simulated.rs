@@ -290,6 +290,31 @@ fn a_drifting_track_keeps_the_line_it_lands_on_and_its_errors_count_the_drift() 
     assert!(rms < 2.0, "COR RMS(error/SE) {rms} over {z_cor:?}");
 }
 
+/// A rigid ball's radius does not change; a tracker that finds the rim 0.2 px further out after the bounce
+/// (a fuzzy rim turned, another light) is said to, with an error that covers a clean track's nothing.
+#[test]
+fn the_radius_s_change_between_the_flights_is_measured() {
+    let model = Model::paper(25_650.0, 14.0, 0.5);
+    let (mut track, _) = shot(&model, 15.0, 0.5, 0.02, 41);
+    let mut rng = Rng::new(77);
+    for f in &mut track.fixes {
+        f.r_px += 0.02 * rng.normal();
+    }
+    let clean = estimate(&track, &conditions(15.0)).unwrap().rim_change_px.unwrap();
+    assert!(clean.value.abs() < 3.0 * clean.se && clean.se < 0.01, "{clean:?}");
+    let t_low = track
+        .fixes
+        .iter()
+        .min_by(|a, b| b.y_px.total_cmp(&a.y_px))
+        .map(|f| f.t_s)
+        .unwrap();
+    for f in track.fixes.iter_mut().filter(|f| f.t_s > t_low) {
+        f.r_px += 0.2;
+    }
+    let moved = estimate(&track, &conditions(15.0)).unwrap().rim_change_px.unwrap();
+    assert!((moved.value - 0.2).abs() < 3.0 * moved.se, "{moved:?}");
+}
+
 /// A line far from where the ball lands (a ruler's edge, a shadow) is not taken for the contact.
 #[test]
 fn a_line_the_ball_does_not_land_on_gives_way_to_the_trajectory() {

@@ -104,6 +104,7 @@ mod tests {
             surface_sigma_m: None,
             frame_sigma_rad: None,
             spin_sigma_rad_s: None,
+            rim_change_m: None,
         };
         let model = Model::paper(25_650.0, 14.0, 0.5);
         let mut sim = simulate_drop(&model, 0.0, 0.2, &times, &SimOptions::default()).expect("a drop simulates");

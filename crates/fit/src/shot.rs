@@ -67,4 +67,10 @@ pub struct MeasuredShot {
     /// tangential flight; `None`: the spin is taken as exact.
     #[serde(default)]
     pub spin_sigma_rad_s: Option<f64>,
+    /// How much the ball's measured radius changed from the incoming flight to the outgoing one, m, with
+    /// its standard error (`[value, se]`; the estimator's `rim_change_px` times the scale). The fit does not
+    /// use it; the missing-effect search counts it in the tracker's floor: a rim measured differently in
+    /// the two flights moves the centre between them too. `None`: not measured.
+    #[serde(default)]
+    pub rim_change_m: Option<[f64; 2]>,
 }

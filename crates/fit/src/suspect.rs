@@ -147,6 +147,7 @@ mod tests {
             surface_sigma_m: None,
             frame_sigma_rad: None,
             spin_sigma_rad_s: None,
+            rim_change_m: None,
         };
         let clean = flight_structure_chi2(&shot(false), 0.0195, 0.0205, 3e-4);
         assert_eq!(clean.len(), 2);

@@ -167,6 +167,7 @@ fn session_of(
                 surface_sigma_m: None,
                 frame_sigma_rad: None,
                 spin_sigma_rad_s: None,
+                rim_change_m: None,
             });
         }
     }

@@ -42,6 +42,7 @@ pub fn synth_shot(
         surface_sigma_m: None,
         frame_sigma_rad: None,
         spin_sigma_rad_s: None,
+        rim_change_m: None,
     }
 }
 
