@@ -251,6 +251,40 @@ fn hertz_and_drag_on_long_flights(tracking: Tracking, options: SearchOptions) {
     assert_magnitudes(last, &[("hertz", "k_h", 600_000.0), ("drag", "cd", 1.5)]);
 }
 
+/// A tracker that finds the rim differently after the bounce (the centres of the outgoing flight moved by
+/// √2·Δr on each axis, Δr ~ 25 µm) leaves a misfit that each flight's own fit hides. Counted from the
+/// radius's change, it is the floor's, not a missing effect; without that count the same session is
+/// called a misfit. A real effect on top of it is still named.
+#[test]
+fn a_rim_found_differently_after_the_bounce_is_the_floor_s_not_a_missing_effect() {
+    let tracking = Tracking {
+        rim_jump_m: 25e-6,
+        ..Tracking::default()
+    };
+    let shots = session(&truth(None), 5, tracking);
+    let d = run("none, rim jumps", &shots, &SearchOptions::default());
+    assert_eq!(d.verdict.kind, VerdictKind::NoMissingEffect, "{}", d.verdict.sentence);
+    let rim = d.floor.rim_change_m.expect("the rim's change counted");
+    assert!(
+        rim > 5e-6 && d.verdict.sentence.contains("rim's change"),
+        "{rim}: {}",
+        d.verdict.sentence
+    );
+    let blind: Vec<MeasuredShot> = shots
+        .iter()
+        .cloned()
+        .map(|s| MeasuredShot {
+            rim_change_m: None,
+            ..s
+        })
+        .collect();
+    let d = run("none, rim jumps not counted", &blind, &SearchOptions::default());
+    assert!(d.baseline.misfit, "{}", d.verdict.sentence);
+    let shots = session(&truth(Some("hertz")), 5, tracking);
+    let d = run("hertz, rim jumps", &shots, &SearchOptions::default());
+    assert_eq!(d.verdict.effect.as_deref(), Some("hertz"), "{}", d.verdict.sentence);
+}
+
 #[test]
 fn no_hidden_effect_gives_no_missing_effect_on_three_seeds() {
     for seed in [1, 2, 3] {

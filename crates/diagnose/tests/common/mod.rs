@@ -4,8 +4,9 @@
 #![allow(dead_code)]
 
 use bouncelab_diagnose::{Diagnosis, SearchOptions, find_missing_effect};
+pub use bouncelab_fit::MeasuredShot;
 use bouncelab_fit::testutil::{FPS, Rng, simulate_shot};
-use bouncelab_fit::{MeasuredFrame, MeasuredShot, StartState};
+use bouncelab_fit::{MeasuredFrame, StartState};
 use bouncelab_model::{Model, ModelSpec, SimOptions, Simulation, State, builtin, simulate_drop};
 
 /// True tracking noise of the centre, m (0.03 px at 4e-4 m/px).
@@ -83,6 +84,10 @@ pub struct Tracking {
     /// Error of the surface line per shot, m: the whole measured frame (frames and start) is shifted up by
     /// a value drawn uniformly in ±this.
     pub surface_level_m: f64,
+    /// A rim found differently after the bounce (a fuzzy rim turned, another light), m: per shot the radius
+    /// changes by Δr drawn normal with this σ, and every centre from the separation on moves by √2·Δr on each
+    /// axis (random signs), as a circle fitted to that rim would; the shot's `rim_change_m` says Δr. 0: none.
+    pub rim_jump_m: f64,
 }
 
 impl Default for Tracking {
@@ -91,6 +96,7 @@ impl Default for Tracking {
             stated_over_true: 1.0,
             contact_bias_m: 0.0,
             surface_level_m: 0.0,
+            rim_jump_m: 0.0,
         }
     }
 }
@@ -132,6 +138,21 @@ fn session_of(
             let offset = 0.3 * (rng.uniform() - 0.5);
             let level = tracking.surface_level_m * (2.0 * rng.uniform() - 1.0);
             let (t_touch, t_sep) = (sim.impact.t_touch, sim.impact.t_separation);
+            // Drawn only when asked for, so that every other session stays as it was.
+            let rim = (tracking.rim_jump_m > 0.0).then(|| {
+                let dr = tracking.rim_jump_m * rng.normal();
+                let sign = |u: f64| if u < 0.5 { -1.0 } else { 1.0 };
+                let (sx, sy) = (sign(rng.uniform()), sign(rng.uniform()));
+                (
+                    dr,
+                    std::f64::consts::SQRT_2 * dr * sx,
+                    std::f64::consts::SQRT_2 * dr * sy,
+                )
+            });
+            let jump = |t: f64| match rim {
+                Some((_, jx, jy)) if t >= t_sep => (jx, jy),
+                _ => (0.0, 0.0),
+            };
             let frames = sim
                 .samples
                 .iter()
@@ -141,10 +162,11 @@ fn session_of(
                     } else {
                         0.0
                     };
+                    let (jx, jy) = jump(s.t);
                     MeasuredFrame {
                         t_s: s.t,
-                        x_m: s.observed.x + offset + SIGMA * rng.normal(),
-                        y_m: s.observed.y + level + bias + SIGMA * rng.normal(),
+                        x_m: s.observed.x + offset + jx + SIGMA * rng.normal(),
+                        y_m: s.observed.y + level + bias + jy + SIGMA * rng.normal(),
                         sigma_m: SIGMA * tracking.stated_over_true,
                     }
                 })
@@ -167,7 +189,7 @@ fn session_of(
                 surface_sigma_m: None,
                 frame_sigma_rad: None,
                 spin_sigma_rad_s: None,
-                rim_change_m: None,
+                rim_change_m: rim.map(|(dr, _, _)| [dr, 1e-7]),
             });
         }
     }
