@@ -316,11 +316,12 @@ fn a_looks_ball_is_where_the_truth_says() {
     }
 }
 
-#[test]
-fn the_surface_line_in_truth_is_the_mean_of_the_ragged_edge() {
-    // A clay band 80 DN above its backdrop with a faint texture and no lip: the edge is found in every
-    // column as the half-way crossing; the truth's line must be its mean and its RMS the look's roughness.
-    let text = r#"
+/// A level clay band 80 DN above a 40 DN backdrop, no lip, no clutter, 320 × 240 px, a 20 px ball: the edge
+/// is the half-way crossing (80 DN) in every column. `heights` are the drop heights, `look` the `[look]`
+/// keys that differ between the tests (roughness, texture, noise, bit depth, roll).
+fn edge_scenario(heights: &str, look: &str) -> Scenario {
+    let text = format!(
+        r#"
 seed = 4
 pre_contact_ms = 25
 post_separation_ms = 3
@@ -332,15 +333,13 @@ flicker_amplitude = 0
 texture = "clay"
 [grid]
 surfaces = ["clay"]
-drop_heights_m = [0.25, 0.3, 0.35]
+drop_heights_m = {heights}
 angles_deg = [0]
 [look]
 balls = ["felt_seam"]
 backdrop_dn = 40
 band_offset_dn = 80
-texture_dn = 2
 lip_dn = 0
-edge_roughness_px = 3
 edge_scale_px = [3, 8]
 gradient = 0
 vignetting = 0
@@ -350,13 +349,23 @@ fixtures = 0
 screws = 0
 second_circle = 0
 hand = 0
-read_noise_dn = 1
-bit_depths = [8]
 width_px = 320
 height_px = 240
 ball_radius_px = 20
-"#;
-    let s = Scenario::parse(text, "edge").unwrap();
+{look}
+"#
+    );
+    Scenario::parse(&text, "edge").unwrap()
+}
+
+#[test]
+fn the_surface_line_in_truth_is_the_mean_of_the_ragged_edge() {
+    // A faint texture: the edge is found in every column as the half-way crossing; the truth's line must
+    // be its mean and its RMS the look's roughness.
+    let s = edge_scenario(
+        "[0.25, 0.3, 0.35]",
+        "texture_dn = 2\nedge_roughness_px = 3\nread_noise_dn = 1\nbit_depths = [8]",
+    );
     for shot in 0..s.shots.len() {
         let plan = ShotPlan::new(&s, shot).unwrap();
         let t = &plan.truth;
@@ -401,49 +410,13 @@ ball_radius_px = 20
 /// one it is the line through the half-way crossings found in the frame's columns, and leans off the plane.
 #[test]
 fn the_drawn_edge_line_is_the_line_through_the_edge_the_frame_shows() {
-    let text = |roughness: f64| {
-        format!(
-            r#"
-seed = 4
-pre_contact_ms = 25
-post_separation_ms = 3
-[camera]
-fixed_pattern_noise = 0
-hot_pixel_fraction = 0
-flicker_amplitude = 0
-[surfaces.clay]
-texture = "clay"
-[grid]
-surfaces = ["clay"]
-drop_heights_m = [0.25, 0.3]
-angles_deg = [0]
-[look]
-balls = ["felt_seam"]
-backdrop_dn = 40
-band_offset_dn = 80
-texture_dn = 0.5
-lip_dn = 0
-edge_roughness_px = {roughness}
-edge_scale_px = [3, 8]
-gradient = 0
-vignetting = 0
-hot_spots = 0
-ruler = 0
-fixtures = 0
-screws = 0
-second_circle = 0
-hand = 0
-read_noise_dn = 0.5
-bit_depths = [16]
-roll_deg = [1.5, 1.5]
-width_px = 320
-height_px = 240
-ball_radius_px = 20
-"#
-        )
-    };
     for roughness in [0.0, 3.0] {
-        let s = Scenario::parse(&text(roughness), "edge").unwrap();
+        let s = edge_scenario(
+            "[0.25, 0.3]",
+            &format!(
+                "texture_dn = 0.5\nedge_roughness_px = {roughness}\nread_noise_dn = 0.5\nbit_depths = [16]\nroll_deg = [1.5, 1.5]"
+            ),
+        );
         for shot in 0..s.shots.len() {
             let plan = ShotPlan::new(&s, shot).unwrap();
             let t = &plan.truth;
