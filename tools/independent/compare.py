@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Compare bouncelab analyze output (OUT/estimates.csv, OUT/trajectories) with the independent truth.
-usage: compare.py TRUTH_DIR OUT_DIR [--clips N]"""
+usage: compare.py TRUTH_DIR OUT_DIR"""
 import csv, json, math, os, sys
 import numpy as np
 

@@ -688,25 +688,21 @@ pub fn verdict_headline(d: &Diagnosis) -> String {
     let named = |e: &str| d.candidate(e).and_then(|c| c.evidence.as_ref().map(|ev| (c, ev)));
     match d.verdict.kind {
         VerdictKind::MissingEffect => match d.verdict.effect.as_deref().and_then(|e| named(e).map(|x| (e, x))) {
-            Some((e, (c, ev))) => {
-                // A search that went on after its first effect names the rest in `then`; the error left is
-                // the last one's.
-                let mut names = vec![format!("`{e}`")];
+            Some((_, (c, ev))) => {
+                // The verdict's effects are the ones the search kept (a search that went on names the rest in
+                // `then`, which may hold an effect it did not keep); the error left is the last kept one's.
+                let names: Vec<String> = d.verdict.effects.iter().map(|e| format!("`{e}`")).collect();
                 let mut after = ev.heldout_error_after;
                 let mut next = d.then.as_deref();
                 while let Some(n) = next {
-                    if n.verdict.kind != VerdictKind::MissingEffect {
-                        break;
-                    }
-                    let Some((e2, ev2)) = n
+                    let kept = n
                         .verdict
                         .effect
                         .as_deref()
-                        .and_then(|e2| n.candidate(e2).and_then(|c2| c2.evidence.as_ref()).map(|ev2| (e2, ev2)))
-                    else {
+                        .filter(|e2| d.verdict.effects.iter().any(|k| k == e2));
+                    let Some(ev2) = kept.and_then(|e2| n.candidate(e2)).and_then(|c2| c2.evidence.as_ref()) else {
                         break;
                     };
-                    names.push(format!("`{e2}`"));
                     after = ev2.heldout_error_after;
                     next = n.then.as_deref();
                 }
@@ -1171,6 +1167,12 @@ mod tests {
         assert_eq!(
             verdict_headline(&d),
             "`rolling_resistance` and `hunt_crossley` are missing: held-out error 181.1 → 8.2 µm"
+        );
+        // A search that went on but whose second effect was not kept names the first alone.
+        d.verdict.effects.truncate(1);
+        assert_eq!(
+            verdict_headline(&d),
+            "`rolling_resistance` is missing: held-out error 181.1 → 93.9 µm"
         );
         d.then = None;
         assert_eq!(

@@ -201,8 +201,8 @@ pub struct Baseline {
     pub heldout_error_m: f64,
     /// Systematic part of the residual, `√max(0, RMS² − noise²)`, m.
     pub systematic_m: f64,
-    /// True if it misfits: systematic part above `tolerance_m`, a phase above `phase_tolerance_m`, or a
-    /// significant trend of an output error.
+    /// True if it misfits: systematic part above the floor, a phase above the per-phase tolerance (both in
+    /// [`Thresholds`]), or a significant trend of an output error.
     pub misfit: bool,
     /// Why it misfits, one phrase each.
     pub misfit_reasons: Vec<String>,
@@ -235,7 +235,8 @@ pub enum NoiseSource {
     Stated,
 }
 
-/// The thresholds the verdict used (copied from [`SearchOptions`](crate::SearchOptions)).
+/// The thresholds the verdict used: those of [`SearchOptions`](crate::SearchOptions), with the tolerance the
+/// floor and the per-phase tolerance as the floor raises it.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Thresholds {
     /// Significance level.

@@ -32,17 +32,19 @@ pub struct SearchOptions {
     /// The tracker's extra systematic error in contact, m (default 8e-6, 0.02 px at 4e-4 m/px), which the
     /// free flight cannot show: the ball flattened and partly hidden by the surface (about 5–9 µm per phase
     /// and component on a clean rendered session, against 2–3 µm in the incoming flight). With
-    /// [`SearchOptions::learn_floor`] the floor is the flight's measured structure and this in quadrature;
-    /// without, this is the floor. A model whose systematic residual is within the floor fits; a candidate
+    /// [`SearchOptions::learn_floor`] the floor is the flight's measured structure, the rim's change between
+    /// the flights and this in quadrature, plus a margin of their standard errors (see `floor.rs`); without,
+    /// this is the floor. A model whose systematic residual is within the floor fits; a candidate
     /// must remove at least the floor of held-out error; two candidates whose held-out errors differ by less
     /// cannot be told apart. Raise it when the tracking in contact is worse.
     pub tolerance_m: f64,
     /// Learn the floor from the session's free flight (default true): see `docs/diagnosis.md` and
     /// [`Floor`](crate::Floor).
     pub learn_floor: bool,
-    /// Systematic residual allowed in one phase and component, m (default 30e-6, 0.075 px): above it the
-    /// current model misfits there even if the total is within [`SearchOptions::tolerance_m`] (a
-    /// 0.05 px tracking error in contact stays below it).
+    /// Systematic residual allowed in one phase and component, m (default 30e-6, 0.075 px), or three times
+    /// the floor's estimate when the session's tracking is that much worse: above it the current model
+    /// misfits there even if the total is within [`SearchOptions::tolerance_m`] (a 0.05 px tracking error
+    /// in contact stays below it).
     pub phase_tolerance_m: f64,
     /// Least fraction of the current model's systematic held-out mean square (above the noise) that a
     /// candidate leaving more than [`SearchOptions::tolerance_m`] of systematic error must remove to be

@@ -52,15 +52,24 @@ fn floor_words(f: &Floor) -> String {
                 um(f.contact_allowance_m)
             )
         }
+        None if f.rim_change_m.is_some() => format!(
+            "the {} floor (the rim's change between the flights {} and {} allowed for tracking in contact, in quadrature, plus {} of its standard errors)",
+            um(f.floor_m),
+            um(f.rim_change_m.unwrap_or(0.0)),
+            um(f.contact_allowance_m),
+            crate::FLOOR_MARGIN_SE
+        ),
         None => format!("the {} floor", um(f.floor_m)),
     }
 }
 
 /// How far a phase and component may misfit before it alone says the model misfits: the option
-/// `phase_tolerance_m`, or three floors when the session's tracking is that much worse (a phase holds a
-/// few of the frames, and the tracker's own error differs by phase).
+/// `phase_tolerance_m`, or three times the floor's estimate (without its margin) when the session's
+/// tracking is that much worse (a phase holds a few of the frames, and the tracker's own error differs by
+/// phase).
 pub(crate) fn phase_tolerance(o: &SearchOptions, f: &Floor) -> f64 {
-    o.phase_tolerance_m.max(PHASE_FLOORS * f.floor_m)
+    let estimate = f.floor_m - crate::FLOOR_MARGIN_SE * f.floor_se_m;
+    o.phase_tolerance_m.max(PHASE_FLOORS * estimate)
 }
 
 /// Floors a phase's systematic residual may reach (see [`phase_tolerance`]): the default per-phase tolerance

@@ -47,7 +47,7 @@ impl BallisticFit {
 
 /// Fits `points` (t s, x m, y m, σ m) with the known acceleration `a` (m/s²). Needs at least 3 points;
 /// the standard errors are inflated by √(χ²_red·(1+ρ)/(1−ρ)) when that exceeds 1, ρ the lag-1 correlation
-/// of the residuals in the points' order ([`ar1_factor`]).
+/// of the residuals in the points' order (`ar1_factor`).
 pub fn fit_ballistic(points: &[(f64, f64, f64, f64)], a: [f64; 2]) -> Option<BallisticFit> {
     if points.len() < 3 {
         return None;

@@ -140,7 +140,7 @@ pub struct Estimate {
     /// How much the ball's measured radius changed from the incoming flight to the outgoing one, px (mean
     /// outgoing − mean incoming, with its standard error): a rigid ball's radius does not, so this is the
     /// tracker's rim-based estimate changing between the flights (a fuzzy rim turning, the light across the
-    /// frame), and its centre changes with it, which no flight fit can see ([`rim_change`]).
+    /// frame), and its centre changes with it, which no flight fit can see.
     #[serde(default)]
     pub rim_change_px: Option<Measured>,
     /// Why the shot's numbers are not to be trusted (it is kept out of the fit); empty when they are.
@@ -404,18 +404,33 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
 }
 
 /// The change of the measured radius between the flights, px: mean outgoing − mean incoming, its standard
-/// error from each flight's scatter with the variance factor of its correlation ([`ar1_factor`]); `None`
-/// when a flight holds fewer than three radii.
+/// error from each flight's scatter about a line in time, with the variance factor of that scatter's
+/// correlation (`ballistic::ar1_factor`; a drift along the flight is not counted as correlated noise);
+/// `None` when a flight holds fewer than four radii.
 fn rim_change(incoming: &[&Point], outgoing: &[&Point]) -> Option<Measured> {
     let mean_and_var = |set: &[&Point]| -> Option<(f64, f64)> {
-        let r: Vec<f64> = set.iter().map(|p| p.r_px).filter(|r| r.is_finite()).collect();
-        if r.len() < 3 {
+        let tr: Vec<(f64, f64)> = set
+            .iter()
+            .map(|p| (p.t, p.r_px))
+            .filter(|(t, r)| t.is_finite() && r.is_finite())
+            .collect();
+        if tr.len() < 4 {
             return None;
         }
-        let n = r.len() as f64;
-        let m = r.iter().sum::<f64>() / n;
-        let var = r.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0);
-        Some((m, var / n * crate::ballistic::ar1_factor(&r)))
+        let n = tr.len() as f64;
+        let (mt, mr) = (
+            tr.iter().map(|p| p.0).sum::<f64>() / n,
+            tr.iter().map(|p| p.1).sum::<f64>() / n,
+        );
+        let stt: f64 = tr.iter().map(|p| (p.0 - mt).powi(2)).sum();
+        let slope = if stt > 0.0 {
+            tr.iter().map(|p| (p.0 - mt) * (p.1 - mr)).sum::<f64>() / stt
+        } else {
+            0.0
+        };
+        let residuals: Vec<f64> = tr.iter().map(|p| p.1 - mr - slope * (p.0 - mt)).collect();
+        let var = residuals.iter().map(|x| x * x).sum::<f64>() / (n - 2.0);
+        Some((mr, var / n * crate::ballistic::ar1_factor(&residuals)))
     };
     let ((mi, vi), (mo, vo)) = (mean_and_var(incoming)?, mean_and_var(outgoing)?);
     Some(Measured::new(mo - mi, (vi + vo).sqrt()))

@@ -746,7 +746,7 @@ mod tests {
         assert!(out.params[2] <= 1.0);
     }
 
-    /// Two strongly correlated parameters, the first's best value (3) beyond its bound (1): the search
+    /// Two strongly correlated parameters, the first's unconstrained best (≈ 2.5) beyond its bound (1): the search
     /// holds it on the bound and solves for the other alone, reaching the constrained optimum in a few
     /// steps. A step solved with both free and then projected crept along the bound for the whole budget.
     #[test]

@@ -563,11 +563,14 @@ fn clearer(fix: &BallFix, old: &BallFix) -> bool {
     !old.status.measured() || fix.quality > old.quality + 0.1
 }
 
-/// Where the forward track starts: from the two earliest fixes of the backward pass over the frames before
-/// the ball's first sighting ([`Backward::before_seed`]), the second at least the sightings' gap after the
-/// first (else the first sighting itself); from the sightings `seed` when that pass measured nothing.
+/// Where the forward track starts: from the two earliest fixes of the unbroken run the backward pass over
+/// the frames before the ball's first sighting measured back from it ([`Backward::before_seed`]), the second
+/// at least the sightings' gap after the first (else the first sighting itself); from the sightings `seed`
+/// when that pass measured nothing next to them. A fix beyond a frame the pass lost is not trusted: its
+/// widened search may have caught something else.
 fn forward_seed(early: &[BallFix], seed: (Sighting, Sighting)) -> (Sighting, Sighting) {
-    let measured: Vec<&BallFix> = early.iter().filter(|f| f.status.measured()).collect();
+    let run = early.iter().rev().take_while(|f| f.status.measured()).count();
+    let measured: Vec<&BallFix> = early[early.len() - run..].iter().collect();
     let Some(a) = measured.first() else {
         return seed;
     };
@@ -780,6 +783,12 @@ mod tests {
             .map(|k| BallFix::absent(k, k as f64 * 1e-4, Status::Absent))
             .collect();
         assert_eq!(forward_seed(&none, seed), seed);
+        // A frame the backward pass lost breaks the run: fixes beyond it do not start the track.
+        let mut broken = early.clone();
+        broken[9] = BallFix::absent(9, 9e-4, Status::Absent);
+        let (a, b) = forward_seed(&broken, seed);
+        assert_eq!((a.1, a.2), (early[10].x_px, early[10].y_px));
+        assert_eq!((b.1, b.2), (early[15].x_px, early[15].y_px));
     }
 
     #[test]
