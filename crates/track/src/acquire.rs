@@ -68,6 +68,39 @@ enum Voters {
 /// [`PairSearch::clearer_inside`]); moving votes before the frame's own. When nothing moves, the error
 /// lists the static circles seen. With a scale hint only radii within ±20 % of the ball's are searched.
 pub(crate) fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32, noise: f32) -> Result<Acquired, TrackError> {
+    acquire_in(clip, opts, gain, noise, Order::Forward)
+}
+
+/// In which order acquisition goes through the clip's files.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub(crate) enum Order {
+    /// From the first file, in time.
+    Forward,
+    /// From the last file, in negated time: the sightings' times are −t and their first file is the later
+    /// one, so that a tracker seeded with them runs back through the clip.
+    Reversed,
+}
+
+impl Order {
+    /// The clip's file at search position `pos` of `n`.
+    fn file(self, pos: usize, n: usize) -> usize {
+        match self {
+            Order::Forward => pos,
+            Order::Reversed => n - 1 - pos,
+        }
+    }
+}
+
+/// [`acquire`] through the clip's files in `order`: with [`Order::Reversed`] the ball is looked for from the
+/// clip's end (where a track that lost it after the bounce can find it again), and [`Acquired`]'s times are
+/// negated and its `file` the clip's file of the later sighting.
+pub(crate) fn acquire_in(
+    clip: &Clip,
+    opts: &ClipTracking,
+    gain: f32,
+    noise: f32,
+    order: Order,
+) -> Result<Acquired, TrackError> {
     let (w, h) = opts.roi.map_or(clip.dimensions(), |r| (r.width, r.height));
     let (min_radius, max_radius) = match opts.scale_hint_m_per_px {
         Some(scale) => {
@@ -77,10 +110,11 @@ pub(crate) fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32, noise: f32) -
         None => (MIN_BALL_RADIUS_PX, w.min(h) as f64 / 2.0),
     };
     let bands = radius_bands(min_radius, max_radius);
-    let mut frames = FrameCache::new(clip, opts, gain);
+    let mut frames = FrameCache::new(clip, opts, gain, order);
     let background = frames.background()?;
     let mut search = PairSearch {
         clip,
+        order,
         width: w as f64,
         gap: sighting_gap(clip.fps(), clip.len()),
         noise,
@@ -139,6 +173,8 @@ struct Pass {
 /// The search for a moving pair of sightings, with the circles already found in each frame and pass.
 struct PairSearch<'a> {
     clip: &'a Clip,
+    /// The order of the files searched.
+    order: Order,
     /// The searched region's width, px.
     width: f64,
     /// Frames between the two sightings of a pair.
@@ -412,14 +448,17 @@ impl PairSearch<'_> {
     /// What acquisition learnt from the moving pair seen in files `k` and `k + gap`.
     fn acquired(&self, k: usize, pair: &MovingPair) -> Acquired {
         let r = 0.5 * (pair.a.r + pair.b.r);
-        // `k` counts files; time follows frame indices, which count dropped frames too.
-        let clip = self.clip;
-        let t = |pos: usize| clip.time_of(clip.files()[pos].index);
+        // `k` counts search positions; time follows frame indices, which count dropped frames too.
+        let (clip, order, n) = (self.clip, self.order, self.clip.len());
+        let sign = if order == Order::Reversed { -1.0 } else { 1.0 };
+        let t = |pos: usize| sign * clip.time_of(clip.files()[order.file(pos, n)].index);
         Acquired {
             radius: radius_window(r),
             seed: ((t(k), pair.a.x, pair.a.y), (t(k + self.gap), pair.b.x, pair.b.y)),
-            file: k,
-            second: pair.other.map(|o| (clip.files()[k].index as usize, o.x, o.y)),
+            file: order.file(k, n),
+            second: pair
+                .other
+                .map(|o| (clip.files()[order.file(k, n)].index as usize, o.x, o.y)),
         }
     }
 }
@@ -730,9 +769,11 @@ fn pixel_median(planes: &[Vec<f32>]) -> Vec<f32> {
     out
 }
 
-/// Frames decoded once each, by file position.
+/// Frames decoded once each, by search position.
 struct FrameCache<'a> {
     clip: &'a Clip,
+    /// Which file a search position reads.
+    order: Order,
     opts: &'a ClipTracking,
     gain: f32,
     frames: HashMap<usize, Frame>,
@@ -745,9 +786,10 @@ struct FrameCache<'a> {
 const MOVING_KEPT: usize = 8;
 
 impl<'a> FrameCache<'a> {
-    fn new(clip: &'a Clip, opts: &'a ClipTracking, gain: f32) -> Self {
+    fn new(clip: &'a Clip, opts: &'a ClipTracking, gain: f32, order: Order) -> Self {
         FrameCache {
             clip,
+            order,
             opts,
             gain,
             frames: HashMap::new(),
@@ -758,7 +800,9 @@ impl<'a> FrameCache<'a> {
     fn get(&mut self, k: usize) -> Result<&Frame, TrackError> {
         if !self.frames.contains_key(&k) {
             let f = crate::clip::in_region(
-                self.clip.read(k, self.opts.read.png_decoder).expect("index in range")?,
+                self.clip
+                    .read(self.order.file(k, self.clip.len()), self.opts.read.png_decoder)
+                    .expect("index in range")?,
                 self.opts.roi.as_ref(),
             );
             self.frames.insert(k, f);
@@ -882,6 +926,39 @@ mod tests {
 
     use super::*;
     use crate::testutil::{Scene, render};
+
+    /// Searched from the clip's end, the ball is sighted in its last frames: the later sighting first, at
+    /// negated times, and `file` the clip's file of that sighting; searched from its start, in its first.
+    #[test]
+    fn the_ball_is_found_from_the_clip_s_end_in_negated_time() {
+        let dir = tempfile::tempdir().unwrap();
+        let at = |i: usize| (60.0 + 2.5 * i as f64, 70.0 + 1.5 * i as f64);
+        for i in 0..40 {
+            let s = Scene {
+                ball: (at(i).0, at(i).1, 40.0),
+                seed: i as u64,
+                ..Scene::default()
+            };
+            let img = image::GrayImage::from_raw(256, 256, render(&s)).unwrap();
+            img.save(dir.path().join(format!("f{i:04}.png"))).unwrap();
+        }
+        let clip = Clip::open(dir.path()).unwrap();
+        let opts = ClipTracking::default();
+        let near = |s: Sighting, i: usize| (s.1 - at(i).0).hypot(s.2 - at(i).1) < 1.0;
+        let forward = acquire_in(&clip, &opts, 1.0, 2.0, Order::Forward).unwrap();
+        assert_eq!(forward.file, 0);
+        assert!(
+            near(forward.seed.0, 0) && near(forward.seed.1, 10),
+            "{:?}",
+            forward.seed
+        );
+        assert_eq!((forward.seed.0.0, forward.seed.1.0), (0.0, clip.time_of(10)));
+        let back = acquire_in(&clip, &opts, 1.0, 2.0, Order::Reversed).unwrap();
+        assert_eq!(back.file, 39);
+        assert!(near(back.seed.0, 39) && near(back.seed.1, 29), "{:?}", back.seed);
+        assert_eq!((back.seed.0.0, back.seed.1.0), (-clip.time_of(39), -clip.time_of(29)));
+        assert!((back.radius.0..=back.radius.1).contains(&40.0), "{:?}", back.radius);
+    }
 
     fn look_of(scene: &Scene, c: (f64, f64, f64)) -> Vec<f32> {
         let px = render(scene);

@@ -5,6 +5,12 @@
 //! tracking hides behind decoding. When the ball's size in pixels is not known, the ball is told from other
 //! round things (screw heads, fixtures, a second ball at rest) by its motion: it is the circle that moved
 //! between two frames.
+//!
+//! Tracking is symmetric in time, and one pass is no single point of failure: frames before the ball is
+//! first sighted, or before the track first settles, are tracked again backward from there; and a track that
+//! steps further than the ball can move (it left the ball for noise or texture, as after a bounce in heavy
+//! noise) is taken over by a pass tracked back from the clip's end, when that pass meets it on the ball
+//! before the step and holds the clearer circles after it.
 
 use crate::acquire::Sighting;
 use crate::local::SurfaceFrame;
@@ -267,6 +273,7 @@ pub fn track_clip(
     }
     backward.surface = tracker.surface().copied();
     backward.retrack_start(&mut fixes, &mut warnings)?;
+    backward.retrack_end(&mut fixes, noise, &mut warnings)?;
     let measured = fixes.iter().filter(|f| f.status.measured()).count();
     if forward.saturated > 0 {
         warnings.push(format!(
@@ -495,6 +502,205 @@ impl Backward<'_> {
         }
         Ok(())
     }
+
+    /// When the forward track leaves the ball ([`left_the_ball`]), the ball is looked for again from the
+    /// clip's end and tracked back through the clip ([`Self::track_from_end`]); that pass's fixes take the
+    /// place of the forward ones from where the forward track left, when they are the clearer circles there
+    /// ([`take_from_end`]). What happened is said either way. `noise` is the first frame's noise σ.
+    fn retrack_end(&self, fixes: &mut [BallFix], noise: f32, warnings: &mut Vec<String>) -> Result<(), TrackError> {
+        let Some(jump) = left_the_ball(fixes.iter(), 0.5 * (self.radius.0 + self.radius.1)) else {
+            return Ok(());
+        };
+        let off = fixes[jump.at].frame;
+        let said = format!(
+            "frame {off}: the track moved {:.1} px in {} frame(s), more than the ball can (≤ {:.1} px a frame from how it moved before)",
+            jump.moved_px, jump.frames, jump.limit_px
+        );
+        let Some(from_end) = self.track_from_end(noise)? else {
+            warnings.push(format!(
+                "{said}; the ball was not found again from the clip's end: frames from {off} on may not be the ball"
+            ));
+            return Ok(());
+        };
+        match take_from_end(fixes, &from_end, jump.at) {
+            Ok(replaced) => warnings.push(format!(
+                "{said}: the ball found again from the clip's end and tracked back, {replaced} frame(s) re-measured from there"
+            )),
+            Err(NotTaken::NeverMet) => warnings.push(format!(
+                "{said}; the circle found from the clip's end and tracked back never meets this track before frame {off} (another object, or this track was not on the ball): frames from {off} on may not be the ball"
+            )),
+            Err(NotTaken::NoClearer) => warnings.push(format!(
+                "{said}; tracked back from the clip's end, the ball was no clearer: frames from {off} on may not be the ball"
+            )),
+        }
+        Ok(())
+    }
+
+    /// Every file measured by a fresh tracker run back in time from the ball's sightings near the clip's end
+    /// (files up to the later sighting in reverse order, the files after it forward from it); `None` when
+    /// the ball is not found there.
+    fn track_from_end(&self, noise: f32) -> Result<Option<Vec<BallFix>>, TrackError> {
+        let found =
+            match crate::acquire::acquire_in(self.clip, self.opts, self.gain, noise, crate::acquire::Order::Reversed) {
+                Ok(a) => a,
+                Err(TrackError::NoBall { .. } | TrackError::NothingMoves { .. }) => return Ok(None),
+                Err(e) => return Err(e),
+            };
+        let mut fixes: Vec<BallFix> = self
+            .clip
+            .files()
+            .iter()
+            .map(|f| BallFix::absent(f.index as usize, self.clip.time_of(f.index), Status::Absent))
+            .collect();
+        let (a, b) = found.seed;
+        let mut back = self.tracker();
+        back.seed(a, b);
+        track_back(
+            &mut fixes,
+            &mut back,
+            found.file + 1,
+            |tr, k, frame, t| self.measure(tr, k, frame, t),
+            |_, _| true,
+        )?;
+        // Files after the later sighting (when it is not the last): forward in time from both sightings.
+        let mut ahead = self.tracker();
+        ahead.seed((-b.0, b.1, b.2), (-a.0, a.1, a.2));
+        for (k, old) in fixes.iter_mut().enumerate().skip(found.file + 1) {
+            let fix = self.measure(&mut ahead, k, old.frame, old.t_s)?;
+            if fix.status.measured() {
+                *old = fix;
+            }
+        }
+        Ok(Some(fixes))
+    }
+}
+
+/// A step of a track larger than the ball can make: at fix `at`, `moved_px` from the measured fix before,
+/// `frames` frames earlier, where the ball could have moved `limit_px` a frame at most.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Jump {
+    at: usize,
+    moved_px: f64,
+    frames: usize,
+    limit_px: f64,
+}
+
+/// How many of a track's first steps between measured fixes tell how fast its ball moves.
+const JUMP_REFERENCE_STEPS: usize = 8;
+
+/// How many times its typical step a ball's step may be ([`left_the_ball`]): it speeds up under gravity and
+/// may leave the surface faster along it than it came (spin), but not by this much within a clip.
+const JUMP_FACTOR: f64 = 3.0;
+
+/// The first step of a track (its measured fixes, in the order given) that the ball cannot have made: more
+/// than [`JUMP_FACTOR`] times the ball's typical step (the median per frame of the first
+/// [`JUMP_REFERENCE_STEPS`] steps, a third of the steps at most) plus a quarter of its `radius` px, per
+/// frame between the two fixes. A ball bounces off a passive surface no faster than it came in and its
+/// centre moves smoothly through the contact; a track that steps a quarter of a radius beyond that has
+/// left the ball for noise, texture or another object. `None` when fewer than 3 steps tell the typical
+/// one, or no step is that large.
+fn left_the_ball<'a>(fixes: impl Iterator<Item = &'a BallFix>, radius: f64) -> Option<Jump> {
+    let measured: Vec<(usize, &BallFix)> = fixes.enumerate().filter(|(_, f)| f.status.measured()).collect();
+    let steps: Vec<(usize, f64, usize)> = measured
+        .windows(2)
+        .map(|w| {
+            let (a, b) = (w[0].1, w[1].1);
+            (
+                w[1].0,
+                (b.x_px - a.x_px).hypot(b.y_px - a.y_px),
+                a.frame.abs_diff(b.frame).max(1),
+            )
+        })
+        .collect();
+    let reference = JUMP_REFERENCE_STEPS.min(steps.len() / 3);
+    if reference < 3 {
+        return None;
+    }
+    let mut per_frame: Vec<f64> = steps[..reference].iter().map(|s| s.1 / s.2 as f64).collect();
+    let limit = JUMP_FACTOR * crate::plane::median(&mut per_frame) + 0.25 * radius;
+    steps
+        .iter()
+        .find(|s| s.1 > limit * s.2 as f64)
+        .map(|&(at, moved_px, frames)| Jump {
+            at,
+            moved_px,
+            frames,
+            limit_px: limit,
+        })
+}
+
+/// How many of the forward track's last measured fixes before it left the ball the pass from the clip's end
+/// is compared with ([`passes_meet`]).
+const MEETING_FIXES: usize = 10;
+
+/// Whether two passes over the same files followed the same circle where they overlap: of the last
+/// [`MEETING_FIXES`] fixes that both measured (`forward`, `from_end`, file by file), at least half are the
+/// same circle (centres within a tenth of the radius, radii within 5 % and a pixel), and at least 3 are
+/// compared. A pass from the clip's end that started on a seam's lobe or another moving thing never meets
+/// the track that was on the ball.
+fn passes_meet(forward: &[BallFix], from_end: &[BallFix]) -> bool {
+    let both: Vec<(&BallFix, &BallFix)> = forward
+        .iter()
+        .zip(from_end)
+        .filter(|(a, b)| a.status.measured() && b.status.measured())
+        .collect();
+    let last = &both[both.len().saturating_sub(MEETING_FIXES)..];
+    let same = |(a, b): &&(&BallFix, &BallFix)| {
+        (a.x_px - b.x_px).hypot(a.y_px - b.y_px) <= 0.1 * a.r_px && (a.r_px - b.r_px).abs() <= 0.05 * a.r_px + 1.0
+    };
+    last.len() >= 3 && 2 * last.iter().filter(same).count() >= last.len()
+}
+
+/// Puts the fixes of the pass from the clip's end (`from_end`, one per file) in place of the forward ones
+/// from file `off` on, where the forward track left the ball, when the two passes met on the ball before
+/// `off` ([`passes_meet`]) and that pass holds the clearer circles from `off` on (the higher median quality
+/// over the files both measured). That pass is trusted back to where it left the
+/// ball itself ([`left_the_ball`], going back in time), if it did; before `off` (and where trusted) one of
+/// its fixes is taken where it is clearly the clearer ([`clearer`]). Returns how many fixes were replaced,
+/// or why the pass from the end is not taken.
+fn take_from_end(fixes: &mut [BallFix], from_end: &[BallFix], off: usize) -> Result<usize, NotTaken> {
+    let mut radii: Vec<f64> = from_end
+        .iter()
+        .filter(|f| f.status.measured())
+        .map(|f| f.r_px)
+        .collect();
+    if radii.is_empty() {
+        return Err(NotTaken::NeverMet);
+    }
+    let radius = crate::plane::median(&mut radii);
+    let trusted_from = left_the_ball(from_end.iter().rev(), radius).map_or(0, |j| from_end.len() - j.at);
+    if !passes_meet(&fixes[..off], &from_end[..off]) {
+        return Err(NotTaken::NeverMet);
+    }
+    let start = off.max(trusted_from);
+    let (mut qa, mut qb): (Vec<f64>, Vec<f64>) = fixes
+        .iter()
+        .zip(from_end)
+        .skip(start)
+        .filter(|(a, b)| a.status.measured() && b.status.measured())
+        .map(|(a, b)| (a.quality, b.quality))
+        .unzip();
+    if qa.is_empty() || crate::plane::median(&mut qb) <= crate::plane::median(&mut qa) {
+        return Err(NotTaken::NoClearer);
+    }
+    let mut replaced = 0;
+    for (k, (old, new)) in fixes.iter_mut().zip(from_end).enumerate() {
+        let takes = new.status.measured() && k >= trusted_from && (k >= start || clearer(new, old));
+        if takes {
+            *old = *new;
+            replaced += 1;
+        }
+    }
+    Ok(replaced)
+}
+
+/// Why the pass from the clip's end was not taken ([`take_from_end`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum NotTaken {
+    /// It never followed the same circle as the forward track before that left the ball.
+    NeverMet,
+    /// It was no clearer where the forward track left the ball.
+    NoClearer,
 }
 
 /// Share of the samples around a rim at the file's full scale above which the rim counts as saturated.
@@ -841,5 +1047,114 @@ mod tests {
             None
         );
         assert_eq!(fixes, before);
+    }
+
+    /// Fixes of a ball on the path `ball_at` (quality `q`), every frame measured.
+    fn on_the_ball(frames: std::ops::Range<usize>, q: f64) -> Vec<BallFix> {
+        frames
+            .map(|k| {
+                let (x, y) = ball_at(k);
+                BallFix {
+                    frame: k,
+                    t_s: k as f64 * 1e-4,
+                    x_px: x,
+                    y_px: y,
+                    r_px: 40.0,
+                    sigma_px: 0.05,
+                    sigma_r_px: 0.05,
+                    quality: q,
+                    status: Status::Ok,
+                }
+            })
+            .collect()
+    }
+
+    /// A track that moves as a ball does, through a bounce, has not left it; one that steps a quarter of a
+    /// radius beyond the ball's pace has, at that step, whichever way the fixes are read; a gap in the track
+    /// allows for the frames missed.
+    #[test]
+    fn a_track_that_jumps_further_than_the_ball_moves_has_left_it() {
+        let mut fixes = on_the_ball(0..30, 0.9);
+        // A bounce at frame 15: the vertical motion turns round at 1.1 px a frame.
+        for f in fixes.iter_mut().skip(15) {
+            f.y_px = ball_at(15).1 - (ball_at(f.frame).1 - ball_at(15).1);
+        }
+        assert_eq!(left_the_ball(fixes.iter(), 40.0), None);
+        assert_eq!(left_the_ball(fixes.iter().rev(), 40.0), None);
+        // From frame 20 on, a circle 22 px away: a step of 22 px where the ball moves 1.2–2.8 px a frame.
+        let mut off = fixes.clone();
+        for f in off.iter_mut().skip(20) {
+            f.x_px += 22.0;
+        }
+        let jump = left_the_ball(off.iter(), 40.0).expect("a jump");
+        assert_eq!(jump.at, 20);
+        assert!((jump.moved_px - 22.0).abs() < 1.5 && jump.frames == 1, "{jump:?}");
+        assert!(jump.limit_px > 10.0 && jump.limit_px < 20.0, "{jump:?}");
+        // Read back in time, the same step is found at the same frame (the 10th fix from the end).
+        assert_eq!(left_the_ball(off.iter().rev(), 40.0).map(|j| j.at), Some(10));
+        // Missing the five frames before it, the same circle is within reach of the ball: not a jump.
+        for f in off.iter_mut().take(20).skip(15) {
+            *f = BallFix::absent(f.frame, f.t_s, Status::Absent);
+        }
+        assert_eq!(left_the_ball(off.iter(), 40.0), None);
+    }
+
+    /// The pass from the clip's end takes the frames from where the forward track left the ball when it holds
+    /// clearer circles there; before that, only frames where it is clearly the clearer; and not at all when
+    /// it is the weaker.
+    #[test]
+    fn the_pass_from_the_end_takes_over_where_the_forward_track_left_the_ball() {
+        let truth = on_the_ball(0..30, 0.8);
+        let mut forward = truth.clone();
+        for f in forward.iter_mut().skip(20) {
+            f.x_px += 40.0;
+            f.quality = 0.4;
+        }
+        // Frame 5 is a weaker circle of the ball: the pass from the end, clearer by 0.15 there, replaces it.
+        forward[5].quality = 0.65;
+        let from_end = truth.clone();
+        let mut fixes = forward.clone();
+        assert_eq!(take_from_end(&mut fixes, &from_end, 20), Ok(11));
+        assert_eq!(fixes[20..], truth[20..]);
+        assert_eq!(fixes[5], truth[5]);
+        assert_eq!(fixes[..5], forward[..5]);
+        assert_eq!(fixes[6..20], forward[6..20]);
+        // A pass from the end no clearer than the forward track there leaves the forward track as it was.
+        let weaker: Vec<BallFix> = truth.iter().map(|f| BallFix { quality: 0.3, ..*f }).collect();
+        let mut fixes = forward.clone();
+        assert_eq!(take_from_end(&mut fixes, &weaker, 20), Err(NotTaken::NoClearer));
+        assert_eq!(fixes, forward);
+        // A pass from the end on another circle moving with the ball (a seam's lobe, 20 px off its centre and
+        // smaller) never met the forward track on the ball: not taken, however clear.
+        let lobe: Vec<BallFix> = truth
+            .iter()
+            .map(|f| BallFix {
+                x_px: f.x_px + 20.0,
+                r_px: 25.0,
+                quality: 0.95,
+                ..*f
+            })
+            .collect();
+        let mut fixes = forward.clone();
+        assert_eq!(take_from_end(&mut fixes, &lobe, 20), Err(NotTaken::NeverMet));
+        assert_eq!(fixes, forward);
+        // A pass from the end that itself left the ball (going back) at frame 8 is not taken before it: not at
+        // frame 5, where it would be the clearer.
+        let mut astray = truth.clone();
+        for f in astray.iter_mut().take(8) {
+            f.y_px -= 60.0;
+        }
+        let mut fixes = forward.clone();
+        assert_eq!(take_from_end(&mut fixes, &astray, 20), Ok(10));
+        assert_eq!(fixes[20..], truth[20..]);
+        assert_eq!(fixes[..20], forward[..20]);
+        // One that left it at frame 25, before reaching where the forward track left it, cannot meet it there.
+        let mut astray = truth.clone();
+        for f in astray.iter_mut().take(25) {
+            f.y_px -= 60.0;
+        }
+        let mut fixes = forward.clone();
+        assert_eq!(take_from_end(&mut fixes, &astray, 20), Err(NotTaken::NeverMet));
+        assert_eq!(fixes, forward);
     }
 }
