@@ -489,12 +489,7 @@ impl Backward<'_> {
         {
             // What the forward pass said of the frames now measured again no longer describes the track.
             let first = fixes[settled].frame;
-            warnings.retain(|w| {
-                w.strip_prefix("frame ")
-                    .and_then(|rest| rest.split(':').next())
-                    .and_then(|n| n.parse::<usize>().ok())
-                    .is_none_or(|n| n >= first)
-            });
+            warnings.retain(|w| frame_of_warning(w).is_none_or(|n| n >= first));
             warnings.push(format!(
                 "the track settled at frame {}: {replaced} of the {settled} frames before it re-measured by tracking backward from there",
                 fixes[settled].frame
@@ -505,8 +500,10 @@ impl Backward<'_> {
 
     /// When the forward track leaves the ball ([`left_the_ball`]), the ball is looked for again from the
     /// clip's end and tracked back through the clip ([`Self::track_from_end`]); that pass's fixes take the
-    /// place of the forward ones from where the forward track left, when they are the clearer circles there
-    /// ([`take_from_end`]). What happened is said either way. `noise` is the first frame's noise σ.
+    /// place of the forward ones from where the forward track left, when the two passes met before it and
+    /// that pass holds the clearer circles after it ([`take_from_end`]); the forward pass's warnings about
+    /// the frames it no longer measures are then dropped. What happened is said either way. `noise` is the
+    /// first frame's noise σ.
     fn retrack_end(&self, fixes: &mut [BallFix], noise: f32, warnings: &mut Vec<String>) -> Result<(), TrackError> {
         let Some(jump) = left_the_ball(fixes.iter(), 0.5 * (self.radius.0 + self.radius.1)) else {
             return Ok(());
@@ -523,9 +520,12 @@ impl Backward<'_> {
             return Ok(());
         };
         match take_from_end(fixes, &from_end, jump.at) {
-            Ok(replaced) => warnings.push(format!(
-                "{said}: the ball found again from the clip's end and tracked back, {replaced} frame(s) re-measured from there"
-            )),
+            Ok(replaced) => {
+                warnings.retain(|w| frame_of_warning(w).is_none_or(|n| n < off));
+                warnings.push(format!(
+                    "{said}: the ball found again from the clip's end and tracked back, {replaced} frame(s) re-measured from there"
+                ));
+            }
             Err(NotTaken::NeverMet) => warnings.push(format!(
                 "{said}; the circle found from the clip's end and tracked back never meets this track before frame {off} (another object, or this track was not on the ball): frames from {off} on may not be the ball"
             )),
@@ -573,6 +573,13 @@ impl Backward<'_> {
         }
         Ok(Some(fixes))
     }
+}
+
+/// The frame a tracker's warning is about (it starts "frame N: "), if any.
+fn frame_of_warning(w: &str) -> Option<usize> {
+    w.strip_prefix("frame ")
+        .and_then(|rest| rest.split(':').next())
+        .and_then(|n| n.parse::<usize>().ok())
 }
 
 /// A step of a track larger than the ball can make: at fix `at`, `moved_px` from the measured fix before,
@@ -654,10 +661,10 @@ fn passes_meet(forward: &[BallFix], from_end: &[BallFix]) -> bool {
 /// Puts the fixes of the pass from the clip's end (`from_end`, one per file) in place of the forward ones
 /// from file `off` on, where the forward track left the ball, when the two passes met on the ball before
 /// `off` ([`passes_meet`]) and that pass holds the clearer circles from `off` on (the higher median quality
-/// over the files both measured). That pass is trusted back to where it left the
-/// ball itself ([`left_the_ball`], going back in time), if it did; before `off` (and where trusted) one of
-/// its fixes is taken where it is clearly the clearer ([`clearer`]). Returns how many fixes were replaced,
-/// or why the pass from the end is not taken.
+/// over the files both measured). That pass is trusted back to where it left the ball itself
+/// ([`left_the_ball`], going back in time), if it did; before `off` (and where trusted) one of its fixes is
+/// taken where it is clearly the clearer ([`clearer`]). Returns how many fixes were replaced, or why the
+/// pass from the end is not taken.
 fn take_from_end(fixes: &mut [BallFix], from_end: &[BallFix], off: usize) -> Result<usize, NotTaken> {
     let mut radii: Vec<f64> = from_end
         .iter()
