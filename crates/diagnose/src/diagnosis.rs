@@ -235,8 +235,8 @@ pub enum NoiseSource {
     Stated,
 }
 
-/// The thresholds the verdict used: those of [`SearchOptions`](crate::SearchOptions), with the tolerance the
-/// floor and the per-phase tolerance as the floor raises it.
+/// The thresholds the verdict used: those of [`SearchOptions`](crate::SearchOptions), the per-phase
+/// tolerance as the learned floor raises it (the floor itself is [`Floor::floor_m`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Thresholds {
     /// Significance level.

@@ -52,14 +52,16 @@ fn floor_words(f: &Floor) -> String {
                 um(f.contact_allowance_m)
             )
         }
-        None if f.rim_change_m.is_some() => format!(
-            "the {} floor (the rim's change between the flights {} and {} allowed for tracking in contact, in quadrature, plus {} of its standard errors)",
-            um(f.floor_m),
-            um(f.rim_change_m.unwrap_or(0.0)),
-            um(f.contact_allowance_m),
-            crate::FLOOR_MARGIN_SE
-        ),
-        None => format!("the {} floor", um(f.floor_m)),
+        None => match f.rim_change_m {
+            Some(r) => format!(
+                "the {} floor (the rim's change between the flights {} and {} allowed for tracking in contact, in quadrature, plus {} of its standard errors)",
+                um(f.floor_m),
+                um(r),
+                um(f.contact_allowance_m),
+                crate::FLOOR_MARGIN_SE
+            ),
+            None => format!("the {} floor", um(f.floor_m)),
+        },
     }
 }
 

@@ -7,9 +7,9 @@
 //! fitting the arc and that onset together to the frames from the first one to half-way to the lowest centre,
 //! for every candidate touch time on a fine grid (a tenth of a frame), and taking the best; its standard error
 //! is where the profile χ² rises by one (scaled by the fit's reduced χ² times the variance factor of the
-//! early arc's residual correlation, (1+ρ)/(1−ρ), when that exceeds one). The centre's height on the arc at that time is the contact level. The same from the other side (time
-//! reversed) gives where the ball rejoins its outgoing arc; the two are combined when they agree. The
-//! lowest centre must lie below both.
+//! early arc's residual correlation, (1+ρ)/(1−ρ), when that exceeds one). The centre's height on the arc
+//! at that time is the contact level. The same from the other side (time reversed) gives where the ball
+//! rejoins its outgoing arc; the two are combined when they agree. The lowest centre must lie below both.
 //!
 //! This is model-free (any contact force that is positive and growing from the touch) but it is slow to
 //! see the first frames of contact, so its error is a few tenths of a pixel where a surface line's is a few
@@ -245,7 +245,7 @@ fn onset(side: &[HeightPoint], _lowest: f64, a_px: f64, _radius_px: f64) -> Opti
     // Neighbouring residuals of a tracker drift together: the fit's scatter counts as its variance factor
     // (1+ρ)/(1−ρ) over independent ones (the same factor as the flights' fits), ρ measured on the best fit's
     // residuals over the frames it used, in time order.
-    let correlated = crate::ballistic::ar1_factor(&onset_residuals(&used, a_px, &clock, best.0, &best.2));
+    let correlated = crate::ballistic::ar1_factor(&onset_residuals(&used, a_px, &clock, Some(best.0), &best.2));
     let scale = (best.1 / dof * correlated).max(1.0);
     // The Δχ² = 1 interval (in units of the fit's own scatter), its half-width the standard error.
     let inside: Vec<f64> = profile.iter().filter(|p| p.1 - best.1 <= scale).map(|p| p.0).collect();
@@ -276,15 +276,22 @@ fn onset(side: &[HeightPoint], _lowest: f64, a_px: f64, _radius_px: f64) -> Opti
     })
 }
 
-/// The residuals (in units of each point's σ) of the onset `c` fitted with the touch at `t0` (see [`fit_onset`]).
-fn onset_residuals(points: &[HeightPoint], a_px: f64, clock: &Clock, t0: f64, c: &[f64; 4]) -> Vec<f64> {
-    let (a_u, u0) = (a_px * clock.dt * clock.dt, clock.u(t0));
+/// The onset's terms at `p` (see [`fit_onset`]): its basis 1, u, τ², τ³ (τ the frames since the touch at
+/// `u0`, 0 before it or without one) and the arc's known part ½·a·u², `a_u` the acceleration per frame².
+fn onset_terms(p: &HeightPoint, clock: &Clock, a_u: f64, u0: Option<f64>) -> ([f64; 4], f64) {
+    let u = clock.u(p.t);
+    let tau = u0.map_or(0.0, |u0| (u - u0).max(0.0));
+    ([1.0, u, tau * tau, tau * tau * tau], 0.5 * a_u * u * u)
+}
+
+/// The residuals (in units of each point's σ) of the onset `c` with the touch at `t0` (none: the arc alone).
+fn onset_residuals(points: &[HeightPoint], a_px: f64, clock: &Clock, t0: Option<f64>, c: &[f64; 4]) -> Vec<f64> {
+    let (a_u, u0) = (a_px * clock.dt * clock.dt, t0.map(|t| clock.u(t)));
     points
         .iter()
         .map(|p| {
-            let u = clock.u(p.t);
-            let tau = (u - u0).max(0.0);
-            let model = c[0] + c[1] * u + 0.5 * a_u * u * u + c[2] * tau * tau + c[3] * tau * tau * tau;
+            let (b, known) = onset_terms(p, clock, a_u, u0);
+            let model = (0..4).map(|k| c[k] * b[k]).sum::<f64>() + known;
             (p.h - model) / p.sigma
         })
         .collect()
@@ -330,15 +337,8 @@ fn fit_onset(
 ) -> Option<([f64; 4], [[f64; 4]; 4], f64)> {
     let a_u = a_px * clock.dt * clock.dt;
     let u0 = t0.map(|t| clock.u(t));
-    let basis = |p: &HeightPoint| {
-        let u = clock.u(p.t);
-        let tau = u0.map_or(0.0, |u0| (u - u0).max(0.0));
-        [1.0, u, tau * tau, tau * tau * tau]
-    };
-    let known = |p: &HeightPoint| {
-        let u = clock.u(p.t);
-        0.5 * a_u * u * u
-    };
+    let basis = |p: &HeightPoint| onset_terms(p, clock, a_u, u0).0;
+    let known = |p: &HeightPoint| onset_terms(p, clock, a_u, u0).1;
     let subsets: &[&[usize]] = if t0.is_some() {
         &[&[0, 1, 2, 3], &[0, 1, 2], &[0, 1, 3], &[0, 1]]
     } else {
@@ -352,14 +352,7 @@ fn fit_onset(
         if c[2] < 0.0 || c[3] < 0.0 {
             continue;
         }
-        let chi2: f64 = points
-            .iter()
-            .map(|p| {
-                let b = basis(p);
-                let model = (0..4).map(|k| c[k] * b[k]).sum::<f64>() + known(p);
-                ((p.h - model) / p.sigma).powi(2)
-            })
-            .sum();
+        let chi2: f64 = onset_residuals(points, a_px, clock, t0, &c).iter().map(|r| r * r).sum();
         if best.as_ref().is_none_or(|b| chi2 < b.2) {
             best = Some((c, cov, chi2));
         }
@@ -514,10 +507,6 @@ mod tests {
             .min_by(|&a, &b| side[a].h.total_cmp(&side[b].h))
             .unwrap();
         let o = onset(&side[..=low], side[low].h, a, 84.0).expect("an onset");
-        eprintln!(
-            "t0 {} ± {}, level ± {}, bounded {}",
-            o.t0, o.t0_se, o.level_se, o.bounded
-        );
         assert!(o.bounded);
         assert!(o.t0_se >= 11.0 * dt, "{}", o.t0_se);
         // The level moves by v·t0_se over such a window: at least a pixel here.

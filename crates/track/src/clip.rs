@@ -442,6 +442,14 @@ impl Backward<'_> {
         back
     }
 
+    /// The clip's first `files` files, none measured yet (absent fixes at their frames' times).
+    fn unmeasured(&self, files: usize) -> Vec<BallFix> {
+        self.clip.files()[..files]
+            .iter()
+            .map(|f| BallFix::absent(f.index as usize, self.clip.time_of(f.index), Status::Absent))
+            .collect()
+    }
+
     /// Measures file `k` (frame index `frame`) with `tracker` at time `t_back` (negated time).
     fn measure(&self, tracker: &mut Tracker, k: usize, frame: usize, t_back: f64) -> Result<BallFix, TrackError> {
         let image = in_region(
@@ -458,10 +466,7 @@ impl Backward<'_> {
     /// The files before the ball's first sighting (file `start`), tracked backward from its two sightings
     /// `seed` (absent where the ball was not found).
     fn before_seed(&self, seed: (Sighting, Sighting), start: usize) -> Result<Vec<BallFix>, TrackError> {
-        let mut fixes: Vec<BallFix> = self.clip.files()[..start]
-            .iter()
-            .map(|f| BallFix::absent(f.index as usize, self.clip.time_of(f.index), Status::Absent))
-            .collect();
+        let mut fixes = self.unmeasured(start);
         if start == 0 {
             return Ok(fixes);
         }
@@ -546,12 +551,7 @@ impl Backward<'_> {
                 Err(TrackError::NoBall { .. } | TrackError::NothingMoves { .. }) => return Ok(None),
                 Err(e) => return Err(e),
             };
-        let mut fixes: Vec<BallFix> = self
-            .clip
-            .files()
-            .iter()
-            .map(|f| BallFix::absent(f.index as usize, self.clip.time_of(f.index), Status::Absent))
-            .collect();
+        let mut fixes = self.unmeasured(self.clip.len());
         let (a, b) = found.seed;
         let mut back = self.tracker();
         back.seed(a, b);
