@@ -5,8 +5,10 @@
 //! circles are voted for on that difference, so clay grains, rulers, screws, fixtures and a second ball at rest
 //! cast no votes, then measured on the frame itself. A circle counts as the ball when it moved between two
 //! frames 1 ms apart (ten at 10,000 fps, see `SIGHTING_GAP_S`), is found again half-way between where its
-//! path puts it, and is not one of the circles that stayed put. When the difference holds no such circle (a
-//! ball too large or slow for the median to forget it), the frames themselves are searched the same way.
+//! path puts it, and did not stay put: its rim's pixels changed between the two frames by more than their
+//! noise (a still circle the other frame's search missed is still all the same). When the difference holds
+//! no such circle (a ball too large or slow for the median to forget it), the frames themselves are searched
+//! the same way.
 //! Clean circles centred beyond the frame's edges (a ball mostly out of view) are looked for after clean ones
 //! inside it and before doubtful ones, so that a seam's lobe on the visible cap of a ball whose centre is out
 //! of view is not taken for the ball.
@@ -64,8 +66,8 @@ enum Voters {
 
 /// The ball's radius range and two sightings (see the module's description). Clean circles (quality above
 /// [`CLEAN_QUALITY`]) are tried first over the whole search, then circles down to [`CANDIDATE_QUALITY`] (a ball
-/// crossing a ruler, or in heavy noise; there a doubtful circle gives way to a clearer one inside it, see
-/// [`PairSearch::clearer_inside`]); moving votes before the frame's own. When nothing moves, the error
+/// crossing a ruler, or in heavy noise; there the clearest pair is taken, see [`PairSearch::doubtful`]);
+/// moving votes before the frame's own. When nothing moves, the error
 /// lists the static circles seen. With a scale hint only radii within ±20 % of the ball's are searched.
 pub(crate) fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32, noise: f32) -> Result<Acquired, TrackError> {
     acquire_in(clip, opts, gain, noise, Order::Forward)
@@ -133,26 +135,25 @@ pub(crate) fn acquire_in(
     // rim comes before the smaller circles drawn on it (the lobes, which move with it); then the strongest
     // voters before all significant ones (cheaper, and what a clear ball needs), moving votes before the
     // frame's; then pairs of frames through the first half of the clip.
-    for (threshold, beyond_edge) in [
-        (CLEAN_QUALITY, false),
-        (CLEAN_QUALITY, true),
-        (CANDIDATE_QUALITY, false),
-    ] {
+    for beyond_edge in [false, true] {
         for (band, &radii) in bands.iter().enumerate() {
             for (voters, votes) in search.sources() {
                 let pass = Pass {
-                    threshold,
+                    threshold: CLEAN_QUALITY,
                     band,
                     radii,
                     beyond_edge,
                     votes,
                     voters,
                 };
-                if let Some(found) = search.through_clip(&pass, &bands)? {
+                if let Some(found) = search.through_clip(&pass)? {
                     return Ok(found);
                 }
             }
         }
+    }
+    if let Some(found) = search.doubtful(&bands)? {
+        return Ok(found);
     }
     Err(nothing_moved(clip, search.still, min_radius, max_radius))
 }
@@ -210,25 +211,85 @@ impl PairSearch<'_> {
         Ok(c)
     }
 
-    /// Pairs of files `gap` apart through the first half of the clip, in this pass: the first moving pair
-    /// ([`moving_pair`]) as the ball, else `None`; in a doubtful pass, a clearer one inside it in a smaller
-    /// band of `bands` takes its place ([`Self::clearer_inside`]). The clean frame pass also notes the
-    /// circles that stayed.
-    fn through_clip(&mut self, pass: &Pass, bands: &[(f64, f64)]) -> Result<Option<Acquired>, TrackError> {
+    /// Pairs of files `gap` apart through the first half of the clip, in this (clean) pass: the first moving
+    /// pair ([`moving_pair`]) as the ball, else `None`. The clean frame pass also notes the circles that
+    /// stayed.
+    fn through_clip(&mut self, pass: &Pass) -> Result<Option<Acquired>, TrackError> {
         let (n, gap) = (self.clip.len(), self.gap);
         let mut k = 0;
         while k + gap < n && k <= n / 2 {
             if let Some(pair) = self.pair_at(k, pass)? {
-                let pair = if pass.threshold < CLEAN_QUALITY {
-                    self.clearer_inside(k, pass, pair, bands)?
-                } else {
-                    pair
-                };
                 return Ok(Some(self.acquired(k, &pair)));
             }
             k += gap;
         }
         Ok(None)
+    }
+
+    /// The doubtful pass, after the clean ones found nothing: in each radius band of `bands`, the clearest
+    /// pair (its weaker sighting's quality) any vote source sees at any pair of files through the first half
+    /// of the clip ([`Self::clearest_in_band`]). A smaller band's pair takes the place of a larger band's only
+    /// when clearer by [`CLEARER_BY`] and standing out from its surroundings at least as much
+    /// ([`disc_contrast`]), as in [`Self::clearer_inside`]: largest first is right for a ball whose rim is
+    /// about as clear as the seam's lobes drawn on it, and a lobe has felt on both sides, where a ball in
+    /// noise stands out from it and a circle of noise does not. The pair taken may yet give way to a clearer one inside it
+    /// ([`Self::clearer_inside`]). In heavy noise circles of noise pulled along by part of the ball's rim
+    /// move with it, in its band and in larger ones; the first such pair found is not the ball as often as
+    /// the clearest is. The clean passes have searched the same files and bands, so their circles are known.
+    fn doubtful(&mut self, bands: &[(f64, f64)]) -> Result<Option<Acquired>, TrackError> {
+        let mut best: Option<(usize, MovingPair, Pass)> = None;
+        for (band, &radii) in bands.iter().enumerate() {
+            let Some(found) = self.clearest_in_band(band, radii)? else {
+                continue;
+            };
+            let takes_over = match &best {
+                None => true,
+                Some(b) => {
+                    clarity(&found.1) > clarity(&b.1) + CLEARER_BY
+                        && self.contrast_of(found.0, &found.2, &found.1.a)? >= self.contrast_of(b.0, &b.2, &b.1.a)?
+                }
+            };
+            if takes_over {
+                best = Some(found);
+            }
+        }
+        let Some((k, pair, pass)) = best else {
+            return Ok(None);
+        };
+        let pair = self.clearer_inside(k, &pass, pair, bands)?;
+        Ok(Some(self.acquired(k, &pair)))
+    }
+
+    /// The clearest moving pair at [`CANDIDATE_QUALITY`] in radius band `band` (its range `radii`, px) that
+    /// any vote source sees at any pair of files through the first half of the clip: the search position of
+    /// its first file, the pair and the pass that saw it.
+    fn clearest_in_band(
+        &mut self,
+        band: usize,
+        radii: (f64, f64),
+    ) -> Result<Option<(usize, MovingPair, Pass)>, TrackError> {
+        let (n, gap) = (self.clip.len(), self.gap);
+        let mut best: Option<(usize, MovingPair, Pass)> = None;
+        let mut k = 0;
+        while k + gap < n && k <= n / 2 {
+            for (voters, votes) in self.sources() {
+                let pass = Pass {
+                    threshold: CANDIDATE_QUALITY,
+                    band,
+                    radii,
+                    beyond_edge: false,
+                    votes,
+                    voters,
+                };
+                if let Some(pair) = self.pair_at(k, &pass)?
+                    && best.as_ref().is_none_or(|b| clarity(&pair) > clarity(&b.1))
+                {
+                    best = Some((k, pair, pass));
+                }
+            }
+            k += gap;
+        }
+        Ok(best)
     }
 
     /// The clearest moving pair at files `k` and `k + gap` in the bands of `bands` smaller than `pass`'s whose
@@ -244,7 +305,6 @@ impl PairSearch<'_> {
         found: MovingPair,
         bands: &[(f64, f64)],
     ) -> Result<MovingPair, TrackError> {
-        let clarity = |p: &MovingPair| p.a.support.min(p.b.support);
         let outer_contrast = self.contrast_of(k, pass, &found.a)?;
         let mut best: Option<MovingPair> = None;
         for (band, &radii) in bands.iter().enumerate().skip(pass.band + 1) {
@@ -412,13 +472,15 @@ impl PairSearch<'_> {
             return Ok(None);
         }
         let b: Vec<Seen> = self.circles(k + gap, pass)?.into_iter().filter(good).collect();
-        let (a_moved, a_static) = split_static(&a, &b);
-        let (b_moved, _) = split_static(&b, &a);
+        // A circle whose pixels did not change between the two files is still, whether or not the other
+        // file's search found it again.
+        let (a_moved, a_static) = self.frames.split_still(k, k + gap, &a, &b)?;
+        let (b_moved, _) = self.frames.split_still(k, k + gap, &b, &a)?;
         let loose = |s: &Seen| s.circle.support > CANDIDATE_QUALITY;
         let a_all: Vec<Seen> = self.circles(k, pass)?.into_iter().filter(loose).collect();
         let b_all: Vec<Seen> = self.circles(k + gap, pass)?.into_iter().filter(loose).collect();
-        let (a_loose, _) = split_static(&a_all, &b_all);
-        let (b_loose, _) = split_static(&b_all, &a_all);
+        let (a_loose, _) = self.frames.split_still(k, k + gap, &a_all, &b_all)?;
+        let (b_loose, _) = self.frames.split_still(k, k + gap, &b_all, &a_all)?;
         if pass.threshold == CLEAN_QUALITY
             && !pass.beyond_edge
             && pass.votes == Votes::Frame
@@ -591,6 +653,11 @@ fn first_found(
         }
     }
     Ok(None)
+}
+
+/// How clear a pair is: its weaker sighting's quality.
+fn clarity(p: &MovingPair) -> f64 {
+    p.a.support.min(p.b.support)
 }
 
 /// The ball's two sightings, and a second moving ball-like circle (its first sighting) when there is one.
@@ -779,6 +846,84 @@ struct FrameCache<'a> {
     frames: HashMap<usize, Frame>,
     /// Frames' differences from the background (see [`FrameCache::keep_moving`]).
     moving: HashMap<usize, Vec<f32>>,
+    /// The last difference between two files asked for, with their search positions (see
+    /// [`FrameCache::change`]).
+    change: Option<((usize, usize), Vec<f32>)>,
+}
+
+/// The share of a difference's squared values [`local_variance`] averages: the smallest 80 %, so that what
+/// moved near a circle does not count as noise, and an average, not a median, so that 8-bit levels' few
+/// distinct squares do not bias it.
+const CHI2_1_KEPT: f64 = 0.8;
+
+/// The mean of the smallest [`CHI2_1_KEPT`] of χ² with one degree of freedom: E[Z² | |Z| < a] for a standard
+/// normal Z with P(|Z| < a) = 0.8 (a = 1.2816), (0.8 − 2 a φ(a)) / 0.8.
+const CHI2_1_KEPT_MEAN: f64 = 0.4377;
+
+/// The least noise variance of a difference between two files, (0–255 scale)²: a quantisation step's,
+/// so that noiseless frames (synthetic or 8-bit with most pixels equal) do not make every change significant.
+const MIN_CHANGE_VARIANCE: f64 = 1.0 / 6.0;
+
+/// The half-width of the band about a rim that [`rim_change`] watches, as a share of the radius (at least
+/// 2 px): narrow, so that a rim that moved a pixel and a half changes much of it.
+const RIM_BAND: f64 = 0.05;
+
+/// The least [`rim_change`] of an object that moved: a still rim's is 0 ± 1 in sensor noise, a ball's that
+/// moved a pixel and a half tens to thousands.
+const STILL_CHANGE_Z: f64 = 4.0;
+
+/// How far the band r ± [`RIM_BAND`] r (at least ±2 px) about circle `c` changed between two files (their
+/// difference `diff`), in standard errors of noise alone: (mean diff² over the band / the noise variance
+/// − 1) / √(2 / n) for the band's n pixels, the noise variance taken about the circle ([`local_variance`]:
+/// sensor noise grows with brightness). A still object's rim changes by noise alone; a moving one sweeps its
+/// edge across the band. Pixels outside the image are skipped; `None` when fewer than 16 remain. Cost: O(r²)
+/// pixel reads.
+fn rim_change(diff: &Plane<f32>, c: &Circle) -> Option<f64> {
+    let half = (RIM_BAND * c.r).max(2.0);
+    let (inner, outer) = ((c.r - half).max(0.0), c.r + half);
+    let (mut sum, mut n) = (0.0, 0usize);
+    square_grid(diff, c.x, c.y, outer, 1.0, |d, v| {
+        if (inner..=outer).contains(&d) {
+            sum += f64::from(v).powi(2);
+            n += 1;
+        }
+    });
+    let variance = local_variance(diff, c)?;
+    (n >= 16).then(|| (sum / n as f64 / variance - 1.0) / (2.0 / n as f64).sqrt())
+}
+
+/// The noise variance of a difference between two files about circle `c`, (0–255 scale)²: the mean of the
+/// smallest [`CHI2_1_KEPT`] of `diff`² over the square of side 4 r about it (most of which stays still),
+/// over that share's mean for noise alone ([`CHI2_1_KEPT_MEAN`]), at least [`MIN_CHANGE_VARIANCE`]. `None`
+/// when fewer than 16 pixels are in view. Cost: about 1,000 pixel reads (a grid of step r / 8) and a
+/// selection.
+fn local_variance(diff: &Plane<f32>, c: &Circle) -> Option<f64> {
+    let mut squares = Vec::new();
+    square_grid(diff, c.x, c.y, 2.0 * c.r, (c.r / 8.0).max(1.0), |_, v| {
+        squares.push(f64::from(v).powi(2))
+    });
+    if squares.len() < 16 {
+        return None;
+    }
+    let kept = (squares.len() as f64 * CHI2_1_KEPT).round() as usize;
+    squares.select_nth_unstable_by(kept, f64::total_cmp);
+    let mean = squares[..kept].iter().sum::<f64>() / kept as f64;
+    Some((mean / CHI2_1_KEPT_MEAN).max(MIN_CHANGE_VARIANCE))
+}
+
+/// Calls `f(distance from (x, y), value)` for the pixels of `plane` nearest a grid of step `step` (px, at
+/// least 1) over the square of half-side `half` about (x, y); pixels outside the plane are skipped.
+fn square_grid(plane: &Plane<f32>, x: f64, y: f64, half: f64, step: f64, mut f: impl FnMut(f64, f32)) {
+    let n = (half / step).ceil() as i64;
+    for j in -n..=n {
+        for i in -n..=n {
+            let (px, py) = ((x + i as f64 * step).round(), (y + j as f64 * step).round());
+            if px < 0.0 || py < 0.0 || px >= plane.width as f64 || py >= plane.height as f64 {
+                continue;
+            }
+            f((px - x).hypot(py - y), plane.at(px as usize, py as usize));
+        }
+    }
 }
 
 /// Frames' differences from the background kept at once: the pairs and half-way frames being compared (a
@@ -794,6 +939,7 @@ impl<'a> FrameCache<'a> {
             gain,
             frames: HashMap::new(),
             moving: HashMap::new(),
+            change: None,
         }
     }
 
@@ -858,6 +1004,54 @@ impl<'a> FrameCache<'a> {
             self.frames.remove(&k);
         }
         Ok(Some(out))
+    }
+
+    /// The difference between files `k1` and `k2` (levels, 0–255 scale), row-major, the second scaled to
+    /// the first's mean level (lamps flicker; a ball moving across the frame hardly changes its mean). The
+    /// last pair asked is kept. Cost: two frames' levels.
+    fn change(&mut self, k1: usize, k2: usize) -> Result<&[f32], TrackError> {
+        if self.change.as_ref().is_none_or(|c| c.0 != (k1, k2)) {
+            let (a, b) = (self.levels(k1)?, self.levels(k2)?);
+            let sum = |v: &[f32]| v.iter().map(|&x| f64::from(x)).sum::<f64>();
+            let (sa, sb) = (sum(&a), sum(&b));
+            let scale = if sa > 0.0 && sb > 0.0 { (sa / sb) as f32 } else { 1.0 };
+            self.change = Some(((k1, k2), a.iter().zip(&b).map(|(p, q)| p - scale * q).collect()));
+        }
+        Ok(&self.change.as_ref().expect("just set").1)
+    }
+
+    /// `here` (circles seen in file `k1` or `k2`) split into those that moved between the two files and those
+    /// that stayed still: by their pixels where the rim can be measured ([`rim_change`] below
+    /// [`STILL_CHANGE_Z`]: a still object, which a search of the other file may have missed or found a
+    /// little elsewhere in heavy noise), else by `there` (the other file's circles) holding one at the same
+    /// place and size ([`split_static`]). Pixels settle it both ways: in heavy noise a slow ball's sides,
+    /// which hardly move, can make a circle where it was.
+    fn split_still(
+        &mut self,
+        k1: usize,
+        k2: usize,
+        here: &[Seen],
+        there: &[Seen],
+    ) -> Result<(Vec<Seen>, Vec<Seen>), TrackError> {
+        if here.is_empty() {
+            return Ok((Vec::new(), Vec::new()));
+        }
+        let (w, h) = self.size();
+        let diff = Plane::new(self.change(k1, k2)?, w, h);
+        let (mut moved, mut still) = (Vec::new(), Vec::new());
+        for s in here {
+            let z = rim_change(&diff, &s.circle);
+            let is_still = match z {
+                Some(z) => z < STILL_CHANGE_Z,
+                None => !split_static(std::slice::from_ref(s), there).1.is_empty(),
+            };
+            if is_still {
+                still.push(s.clone())
+            } else {
+                moved.push(s.clone())
+            }
+        }
+        Ok((moved, still))
     }
 
     /// Circle candidates in frame `k`: vote peaks from `votes`, each measured on the frame itself.
@@ -1054,6 +1248,76 @@ mod tests {
         };
         let mark = ring_motion(&moving, &mark, noise as f32).unwrap();
         assert!(mark > 3.0 * STILL_RING_SIGMAS, "mark {mark}");
+    }
+
+    /// A still disc's rim changes between two frames by their noise alone, whatever its size, level or the
+    /// noise; a ball's that moved a pixel and a half sweeps its edge across the band.
+    #[test]
+    fn a_still_rim_changes_by_noise_alone_and_a_moving_one_does_not() {
+        let (mut still_worst, mut moved_least) = (f64::NEG_INFINITY, f64::INFINITY);
+        for seed in 0..24u64 {
+            let noise = [0.0, 2.0, 6.0, 12.0][seed as usize % 4];
+            let r = [9.0, 16.0, 30.0][seed as usize % 3];
+            let level = [40.0, 200.0][seed as usize % 2];
+            let scene = |ball: (f64, f64, f64), seed: u64| Scene {
+                ball,
+                ball_level: 170.0,
+                noise,
+                seed,
+                distractors: vec![(190.0, 60.0, r, level), (60.0, 200.0, 0.7 * r, 255.0 - level)],
+                ..Scene::default()
+            };
+            let (a, b) = (
+                render(&scene((100.3, 110.2, 40.0), 2 * seed)),
+                render(&scene((101.2, 111.4, 40.0), 2 * seed + 1)),
+            );
+            let diff: Vec<f32> = a.iter().zip(&b).map(|(&p, &q)| f32::from(p) - f32::from(q)).collect();
+            let diff = Plane::new(&diff, 256, 256);
+            let circle = |x, y, r| Circle { x, y, r, support: 1.0 };
+            for c in [circle(190.0, 60.0, r), circle(60.0, 200.0, 0.7 * r)] {
+                still_worst = still_worst.max(rim_change(&diff, &c).unwrap());
+            }
+            moved_least = moved_least.min(rim_change(&diff, &circle(100.3, 110.2, 40.0)).unwrap());
+        }
+        assert!(still_worst < STILL_CHANGE_Z, "a still rim changed by {still_worst}");
+        assert!(
+            moved_least > 3.0 * STILL_CHANGE_Z,
+            "a moving rim changed by only {moved_least}"
+        );
+    }
+
+    /// Whether a circle stayed put is told by the pixels: a still disc the other frame's search missed is
+    /// still, and a slowly moving ball is not held still by a circle of noise where it was.
+    #[test]
+    fn pixels_tell_a_still_circle_from_a_slow_ball() {
+        let dir = tempfile::tempdir().unwrap();
+        let disc = (190.0, 60.0, 14.0, 60.0);
+        for (i, ball) in [(100.0, 100.0, 40.0), (101.0, 102.5, 40.0)].into_iter().enumerate() {
+            let s = Scene {
+                ball,
+                noise: 12.0,
+                seed: i as u64,
+                distractors: vec![disc],
+                ..Scene::default()
+            };
+            let img = image::GrayImage::from_raw(256, 256, render(&s)).unwrap();
+            img.save(dir.path().join(format!("f{i:04}.png"))).unwrap();
+        }
+        let clip = Clip::open(dir.path()).unwrap();
+        let opts = ClipTracking::default();
+        let mut frames = FrameCache::new(&clip, &opts, 1.0, Order::Forward);
+        let seen = |x, y, r| Seen {
+            circle: Circle { x, y, r, support: 0.9 },
+            look: Vec::new(),
+            contrast: 0.0,
+        };
+        let here = [seen(100.0, 100.0, 40.0), seen(disc.0, disc.1, disc.2)];
+        // The second frame's search: a ghost where the ball was, and the disc missed.
+        let there = [seen(100.2, 100.1, 40.1)];
+        let (moved, still) = frames.split_still(0, 1, &here, &there).unwrap();
+        let centres = |v: &[Seen]| v.iter().map(|s| (s.circle.x, s.circle.y)).collect::<Vec<_>>();
+        assert_eq!(centres(&moved), vec![(100.0, 100.0)]);
+        assert_eq!(centres(&still), vec![(disc.0, disc.1)]);
     }
 
     #[test]
