@@ -67,8 +67,8 @@ enum Voters {
 /// The ball's radius range and two sightings (see the module's description). Clean circles (quality above
 /// [`CLEAN_QUALITY`]) are tried first over the whole search, then circles down to [`CANDIDATE_QUALITY`] (a ball
 /// crossing a ruler, or in heavy noise; there the clearest pair is taken, see [`PairSearch::doubtful`]);
-/// moving votes before the frame's own. When nothing moves, the error
-/// lists the static circles seen. With a scale hint only radii within ±20 % of the ball's are searched.
+/// moving votes before the frame's own. When nothing moves, the error lists the static circles seen. With a
+/// scale hint only radii within ±20 % of the ball's are searched.
 pub(crate) fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32, noise: f32) -> Result<Acquired, TrackError> {
     acquire_in(clip, opts, gain, noise, Order::Forward)
 }
@@ -131,10 +131,10 @@ pub(crate) fn acquire_in(
     // Clean circles centred in the frame, then clean circles centred beyond its edges (a ball mostly out of
     // view: a third of a rim lines up by chance more easily than a whole one, so only clean ones count, and
     // before doubtful circles in the frame, which on such a ball are the seam's lobes on its visible cap),
-    // then doubtful circles in the frame. In each, an octave of radii at a time, largest first, so the ball's
-    // rim comes before the smaller circles drawn on it (the lobes, which move with it); then the strongest
-    // voters before all significant ones (cheaper, and what a clear ball needs), moving votes before the
-    // frame's; then pairs of frames through the first half of the clip.
+    // then doubtful circles in the frame (see `PairSearch::doubtful`). In the clean passes, an octave of radii
+    // at a time, largest first, so the ball's rim comes before the smaller circles drawn on it (the lobes,
+    // which move with it); then the strongest voters before all significant ones (cheaper, and what a clear
+    // ball needs), moving votes before the frame's; then pairs of frames through the first half of the clip.
     for beyond_edge in [false, true] {
         for (band, &radii) in bands.iter().enumerate() {
             for (voters, votes) in search.sources() {
@@ -230,12 +230,12 @@ impl PairSearch<'_> {
     /// pair (its weaker sighting's quality) any vote source sees at any pair of files through the first half
     /// of the clip ([`Self::clearest_in_band`]). A smaller band's pair takes the place of a larger band's only
     /// when clearer by [`CLEARER_BY`] and standing out from its surroundings at least as much
-    /// ([`disc_contrast`]), as in [`Self::clearer_inside`]: largest first is right for a ball whose rim is
-    /// about as clear as the seam's lobes drawn on it, and a lobe has felt on both sides, where a ball in
-    /// noise stands out from it and a circle of noise does not. The pair taken may yet give way to a clearer one inside it
-    /// ([`Self::clearer_inside`]). In heavy noise circles of noise pulled along by part of the ball's rim
-    /// move with it, in its band and in larger ones; the first such pair found is not the ball as often as
-    /// the clearest is. The clean passes have searched the same files and bands, so their circles are known.
+    /// ([`disc_contrast`]), as in [`Self::clearer_inside`]: a seam's lobe on a ball, which can be clearer than
+    /// a doubtful rim, has felt on both sides, while the ball stands out from its backdrop and a circle of
+    /// noise does not. The pair taken may yet give way to a clearer one inside it ([`Self::clearer_inside`]).
+    /// In heavy noise circles of noise pulled along by part of the ball's rim move with it, in its band and
+    /// in larger ones; the first such pair found is not the ball as often as the clearest is. The clean
+    /// passes have searched the same files and bands, so their circles are known.
     fn doubtful(&mut self, bands: &[(f64, f64)]) -> Result<Option<Acquired>, TrackError> {
         let mut best: Option<(usize, MovingPair, Pass)> = None;
         for (band, &radii) in bands.iter().enumerate() {
