@@ -670,11 +670,13 @@ struct MovingPair {
 /// The sightings of `here` that are not in `there` at the same place and size (within a pixel and a half or
 /// 5 % of the radius), and those that are (static things).
 fn split_static(here: &[Seen], there: &[Seen]) -> (Vec<Seen>, Vec<Seen>) {
-    here.iter().cloned().partition(|s| {
-        let c = &s.circle;
-        !there.iter().map(|o| &o.circle).any(|o| {
-            (o.x - c.x).hypot(o.y - c.y) <= MIN_PAIR_MOVE_PX.max(0.05 * c.r) && (o.r - c.r).abs() <= 0.05 * c.r + 1.0
-        })
+    here.iter().cloned().partition(|s| !seen_in_place(&s.circle, there))
+}
+
+/// Whether `there` holds a circle where `c` is, of its size (see [`split_static`]).
+fn seen_in_place(c: &Circle, there: &[Seen]) -> bool {
+    there.iter().map(|o| &o.circle).any(|o| {
+        (o.x - c.x).hypot(o.y - c.y) <= MIN_PAIR_MOVE_PX.max(0.05 * c.r) && (o.r - c.r).abs() <= 0.05 * c.r + 1.0
     })
 }
 
@@ -737,26 +739,16 @@ fn disc_contrast<P: Pixel>(img: &Plane<P>, x: f64, y: f64, r: f64) -> f64 {
 /// The image's levels on a grid of step r / 12 (at least a pixel) within 0.8 r of (x, y), and on the ring
 /// 1.2 r … 1.6 r around it; pixels outside the image skipped. Cost: O(r²) pixel reads.
 fn disc_and_ring<P: Pixel>(img: &Plane<P>, x: f64, y: f64, r: f64) -> (Vec<f64>, Vec<f64>) {
-    let step = (r / 12.0).max(1.0);
     let reach = 1.6 * r;
     let (mut inside, mut ring) = (Vec::new(), Vec::new());
-    let n = (reach / step).ceil() as i64;
-    for j in -n..=n {
-        for i in -n..=n {
-            let (dx, dy) = (i as f64 * step, j as f64 * step);
-            let d = dx.hypot(dy);
-            let (px, py) = ((x + dx).round(), (y + dy).round());
-            if px < 0.0 || py < 0.0 || px >= img.width as f64 || py >= img.height as f64 {
-                continue;
-            }
-            let v = f64::from(img.at(px as usize, py as usize));
-            if d <= 0.8 * r {
-                inside.push(v);
-            } else if (1.2 * r..=reach).contains(&d) {
-                ring.push(v);
-            }
+    square_grid(img, x, y, reach, (r / 12.0).max(1.0), |(dx, dy), _, v| {
+        let d = dx.hypot(dy);
+        if d <= 0.8 * r {
+            inside.push(v);
+        } else if (1.2 * r..=reach).contains(&d) {
+            ring.push(v);
         }
-    }
+    });
     (inside, ring)
 }
 
@@ -882,9 +874,9 @@ fn rim_change(diff: &Plane<f32>, c: &Circle) -> Option<f64> {
     let half = (RIM_BAND * c.r).max(2.0);
     let (inner, outer) = ((c.r - half).max(0.0), c.r + half);
     let (mut sum, mut n) = (0.0, 0usize);
-    square_grid(diff, c.x, c.y, outer, 1.0, |d, v| {
-        if (inner..=outer).contains(&d) {
-            sum += f64::from(v).powi(2);
+    square_grid(diff, c.x, c.y, outer, 1.0, |_, (px, py), v| {
+        if (inner..=outer).contains(&(px - c.x).hypot(py - c.y)) {
+            sum += v * v;
             n += 1;
         }
     });
@@ -899,8 +891,8 @@ fn rim_change(diff: &Plane<f32>, c: &Circle) -> Option<f64> {
 /// selection.
 fn local_variance(diff: &Plane<f32>, c: &Circle) -> Option<f64> {
     let mut squares = Vec::new();
-    square_grid(diff, c.x, c.y, 2.0 * c.r, (c.r / 8.0).max(1.0), |_, v| {
-        squares.push(f64::from(v).powi(2))
+    square_grid(diff, c.x, c.y, 2.0 * c.r, (c.r / 8.0).max(1.0), |_, _, v| {
+        squares.push(v * v)
     });
     if squares.len() < 16 {
         return None;
@@ -911,17 +903,26 @@ fn local_variance(diff: &Plane<f32>, c: &Circle) -> Option<f64> {
     Some((mean / CHI2_1_KEPT_MEAN).max(MIN_CHANGE_VARIANCE))
 }
 
-/// Calls `f(distance from (x, y), value)` for the pixels of `plane` nearest a grid of step `step` (px, at
-/// least 1) over the square of half-side `half` about (x, y); pixels outside the plane are skipped.
-fn square_grid(plane: &Plane<f32>, x: f64, y: f64, half: f64, step: f64, mut f: impl FnMut(f64, f32)) {
+/// Calls `f((dx, dy), (px, py), value)` for the points of a grid of step `step` (px, at least 1) over the
+/// square of half-side `half` about (x, y): each point's offset from (x, y), the pixel nearest it and that
+/// pixel's value; pixels outside the plane are skipped.
+fn square_grid<P: Pixel>(
+    plane: &Plane<P>,
+    x: f64,
+    y: f64,
+    half: f64,
+    step: f64,
+    mut f: impl FnMut((f64, f64), (f64, f64), f64),
+) {
     let n = (half / step).ceil() as i64;
     for j in -n..=n {
         for i in -n..=n {
-            let (px, py) = ((x + i as f64 * step).round(), (y + j as f64 * step).round());
+            let (dx, dy) = (i as f64 * step, j as f64 * step);
+            let (px, py) = ((x + dx).round(), (y + dy).round());
             if px < 0.0 || py < 0.0 || px >= plane.width as f64 || py >= plane.height as f64 {
                 continue;
             }
-            f((px - x).hypot(py - y), plane.at(px as usize, py as usize));
+            f((dx, dy), (px, py), f64::from(plane.at(px as usize, py as usize)));
         }
     }
 }
@@ -1024,7 +1025,7 @@ impl<'a> FrameCache<'a> {
     /// that stayed still: by their pixels where the rim can be measured ([`rim_change`] below
     /// [`STILL_CHANGE_Z`]: a still object, which a search of the other file may have missed or found a
     /// little elsewhere in heavy noise), else by `there` (the other file's circles) holding one at the same
-    /// place and size ([`split_static`]). Pixels settle it both ways: in heavy noise a slow ball's sides,
+    /// place and size ([`seen_in_place`]). Pixels settle it both ways: in heavy noise a slow ball's sides,
     /// which hardly move, can make a circle where it was.
     fn split_still(
         &mut self,
@@ -1043,7 +1044,7 @@ impl<'a> FrameCache<'a> {
             let z = rim_change(&diff, &s.circle);
             let is_still = match z {
                 Some(z) => z < STILL_CHANGE_Z,
-                None => !split_static(std::slice::from_ref(s), there).1.is_empty(),
+                None => seen_in_place(&s.circle, there),
             };
             if is_still {
                 still.push(s.clone())
