@@ -11,7 +11,9 @@
 //! the same way.
 //! Clean circles centred beyond the frame's edges (a ball mostly out of view) are looked for after clean ones
 //! inside it and before doubtful ones, so that a seam's lobe on the visible cap of a ball whose centre is out
-//! of view is not taken for the ball.
+//! of view is not taken for the ball. Among doubtful circles, a radius band where no two files' vote peaks
+//! make a pair has each file's clearest circles followed into the next file from where they were: in heavy
+//! noise a ball's rim can be clear in one file and outvoted by grains and noise in the next.
 //!
 //! Most clips show the ball from their first frame, so the first pair of frames is tried before the clip is
 //! searched one octave of radii at a time: a search through the whole clip for radii larger than the ball's
@@ -22,7 +24,7 @@ use crate::ball_search::{BALL_CANDIDATES, MIN_BALL_RADIUS_PX, hint_window, radiu
 use crate::clip::{ClipTracking, TrackError, on_plane, with_plane};
 use crate::hough::{Circle, CircleDetection, detect_circles, radius_bands};
 use crate::plane::{Pixel, Plane, median};
-use crate::refine::refine_candidates;
+use crate::refine::{EdgeSearch, refine_candidates, refine_circle};
 use crate::tracker::CLEAN_QUALITY;
 use bouncelab_frames::{Clip, Frame};
 use std::collections::HashMap;
@@ -262,7 +264,9 @@ impl PairSearch<'_> {
 
     /// The clearest moving pair at [`CANDIDATE_QUALITY`] in radius band `band` (its range `radii`, px) that
     /// any vote source sees at any pair of files through the first half of the clip: the search position of
-    /// its first file, the pair and the pass that saw it.
+    /// its first file, the pair and the pass that saw it. When the vote peaks of the files make no pair in
+    /// the band, the same files are searched again following each file's clearest circles into the next
+    /// ([`Self::followed_pair_at`]); a band where the vote peaks do make pairs is left as it was.
     fn clearest_in_band(
         &mut self,
         band: usize,
@@ -270,24 +274,34 @@ impl PairSearch<'_> {
     ) -> Result<Option<(usize, MovingPair, Pass)>, TrackError> {
         let (n, gap) = (self.clip.len(), self.gap);
         let mut best: Option<(usize, MovingPair, Pass)> = None;
-        let mut k = 0;
-        while k + gap < n && k <= n / 2 {
-            for (voters, votes) in self.sources() {
-                let pass = Pass {
-                    threshold: CANDIDATE_QUALITY,
-                    band,
-                    radii,
-                    beyond_edge: false,
-                    votes,
-                    voters,
-                };
-                if let Some(pair) = self.pair_at(k, &pass)?
-                    && best.as_ref().is_none_or(|b| clarity(&pair) > clarity(&b.1))
-                {
-                    best = Some((k, pair, pass));
-                }
+        for follow in [false, true] {
+            if best.is_some() {
+                break;
             }
-            k += gap;
+            let mut k = 0;
+            while k + gap < n && k <= n / 2 {
+                for (voters, votes) in self.sources() {
+                    let pass = Pass {
+                        threshold: CANDIDATE_QUALITY,
+                        band,
+                        radii,
+                        beyond_edge: false,
+                        votes,
+                        voters,
+                    };
+                    let got = if follow {
+                        self.followed_pair_at(k, &pass)?
+                    } else {
+                        self.pair_at(k, &pass)?
+                    };
+                    if let Some(pair) = got
+                        && best.as_ref().is_none_or(|b| clarity(&pair) > clarity(&b.1))
+                    {
+                        best = Some((k, pair, pass));
+                    }
+                }
+                k += gap;
+            }
         }
         Ok(best)
     }
@@ -507,6 +521,63 @@ impl PairSearch<'_> {
         )
     }
 
+    /// The clearest pair at files `k` and `k + gap` in this (doubtful) pass made by following: each of the
+    /// [`FOLLOWED`] clearest circles of file `k` that moved (by its pixels) is looked for again where it
+    /// was, in file `k + gap` and, from the middle of the two, half-way ([`FrameCache::follow`]); it is a
+    /// pair when both are found at [`CANDIDATE_QUALITY`] as one ball that moved ([`one_ball_moved`]), the
+    /// second moved by its pixels too, and the half-way circle is of its size within the reach
+    /// [`first_found`] allows. In heavy noise a ball's rim, clear in one file, may be missing from the next
+    /// file's vote peaks, outvoted by grains and circles of noise, while a search from where it was finds
+    /// it. `None` when no circle moved or none was found again.
+    fn followed_pair_at(&mut self, k: usize, pass: &Pass) -> Result<Option<MovingPair>, TrackError> {
+        let (gap, width) = (self.gap, self.width);
+        let loose = |s: &Seen| s.circle.support > CANDIDATE_QUALITY;
+        let mut a: Vec<Seen> = self.circles(k, pass)?.into_iter().filter(loose).collect();
+        a.truncate(FOLLOWED);
+        let (a_moved, _) = self.frames.split_still(k, k + gap, &a, &[])?;
+        let mut best: Option<MovingPair> = None;
+        for sa in &a_moved {
+            let half_width = follow_half_width(sa.circle.r);
+            let Some(sb) = self.frames.follow(k + gap, &sa.circle, half_width)? else {
+                continue;
+            };
+            if !loose(&sb) || !one_ball_moved(sa, &sb, width) {
+                continue;
+            }
+            let (b_moved, _) = self.frames.split_still(k, k + gap, std::slice::from_ref(&sb), &[])?;
+            if b_moved.is_empty() {
+                continue;
+            }
+            let (mx, my, reach) = halfway_between(&sa.circle, &sb.circle);
+            if gap >= 2 {
+                let middle = Circle {
+                    x: mx,
+                    y: my,
+                    ..sa.circle
+                };
+                let Some(sm) = self.frames.follow(k + gap / 2, &middle, half_width)? else {
+                    continue;
+                };
+                let m = sm.circle;
+                if !loose(&sm)
+                    || (m.x - mx).hypot(m.y - my) > reach
+                    || (m.r - sa.circle.r).abs() > 0.05 * sa.circle.r + 1.0
+                {
+                    continue;
+                }
+            }
+            let pair = MovingPair {
+                a: sa.circle,
+                b: sb.circle,
+                other: None,
+            };
+            if best.as_ref().is_none_or(|b| clarity(&pair) > clarity(b)) {
+                best = Some(pair);
+            }
+        }
+        Ok(best)
+    }
+
     /// What acquisition learnt from the moving pair seen in files `k` and `k + gap`.
     fn acquired(&self, k: usize, pair: &MovingPair) -> Acquired {
         let r = 0.5 * (pair.a.r + pair.b.r);
@@ -626,18 +697,36 @@ fn pairs(a: &[Seen], b: &[Seen], width: f64) -> Vec<(Circle, Circle)> {
     let mut moving: Vec<(Circle, Circle)> = Vec::new();
     for sa in a {
         for sb in b {
-            let (ca, cb) = (sa.circle, sb.circle);
-            let same_size = (ca.r - cb.r).abs() <= 0.05 * ca.r + 1.0;
-            let moved = (ca.x - cb.x).hypot(ca.y - cb.y);
-            let same_ball = look_correlation(&sa.look, &sb.look) >= MIN_LOOK_CORRELATION
-                || sa.contrast.min(sb.contrast) >= MIN_DISC_CONTRAST;
-            if same_size && moved > MIN_PAIR_MOVE_PX && moved < 0.5 * width && same_ball {
-                moving.push((ca, cb));
+            if one_ball_moved(sa, sb, width) {
+                moving.push((sa.circle, sb.circle));
             }
         }
     }
     moving.sort_by(|p, q| q.0.support.min(q.1.support).total_cmp(&p.0.support.min(p.1.support)));
     moving
+}
+
+/// Whether `a` and `b`, seen in two files, are one ball that moved: of one size (within 5 % and a pixel),
+/// one ball (the same look, see [`look_correlation`], or both standing out from their surroundings, see
+/// [`disc_contrast`]), moved by more than [`MIN_PAIR_MOVE_PX`] and less than half the region's `width`.
+fn one_ball_moved(a: &Seen, b: &Seen, width: f64) -> bool {
+    let (ca, cb) = (a.circle, b.circle);
+    let same_size = (ca.r - cb.r).abs() <= 0.05 * ca.r + 1.0;
+    let moved = (ca.x - cb.x).hypot(ca.y - cb.y);
+    let same_ball =
+        look_correlation(&a.look, &b.look) >= MIN_LOOK_CORRELATION || a.contrast.min(b.contrast) >= MIN_DISC_CONTRAST;
+    same_size && moved > MIN_PAIR_MOVE_PX && moved < 0.5 * width && same_ball
+}
+
+/// Where the ball is, half-way between two sightings `a` and `b`, give or take: a quarter of the distance
+/// covered allows for gravity and for a bounce between them, and 2 px for the sightings' own errors. The
+/// middle (x, y) and that reach, px.
+fn halfway_between(a: &Circle, b: &Circle) -> (f64, f64, f64) {
+    (
+        0.5 * (a.x + b.x),
+        0.5 * (a.y + b.y),
+        0.25 * (a.x - b.x).hypot(a.y - b.y) + 2.0,
+    )
 }
 
 /// The first of `pairs` that `halfway` finds again with a circle clearer than `least`.
@@ -647,12 +736,22 @@ fn first_found(
     least: f64,
 ) -> Result<Option<(Circle, Circle)>, TrackError> {
     for (ca, cb) in pairs {
-        let reach = 0.25 * (ca.x - cb.x).hypot(ca.y - cb.y) + 2.0;
-        if halfway(0.5 * (ca.x + cb.x), 0.5 * (ca.y + cb.y), ca.r, reach, least)? {
+        let (mx, my, reach) = halfway_between(&ca, &cb);
+        if halfway(mx, my, ca.r, reach, least)? {
             return Ok(Some((ca, cb)));
         }
     }
     Ok(None)
+}
+
+/// The clearest circles of a file that [`PairSearch::followed_pair_at`] looks for again in the next.
+const FOLLOWED: usize = 3;
+
+/// How far either side of a followed circle's rim its next sighting is looked for, px: a third of its
+/// radius (a ball moves less than that in a sighting gap unless it is small and fast, and then its vote
+/// peaks find it), at least 6 px.
+fn follow_half_width(r: f64) -> f64 {
+    (r / 3.0).max(6.0)
 }
 
 /// How clear a pair is: its weaker sighting's quality.
@@ -1055,6 +1154,45 @@ impl<'a> FrameCache<'a> {
         Ok((moved, still))
     }
 
+    /// Circle `c` looked for again in file `k` from where it is: refined on the frame with the rays'
+    /// window `half_width` px either side of its rim, re-centred while it moves ([`refine_circle`]), then
+    /// measured again with the window candidates end with (a wide window's quality is not theirs) and seen
+    /// as candidates are (quality, look, contrast on the frame). Not grown outward as candidates are: in
+    /// heavy noise that takes a ball to a circle of noise round it. `None` when too few edges are found.
+    /// Cost: two refinements, well under a millisecond.
+    fn follow(&mut self, k: usize, c: &Circle, half_width: f64) -> Result<Option<Seen>, TrackError> {
+        let search = &self.opts.tracker.search;
+        let wide = EdgeSearch {
+            half_width,
+            beyond_window: false,
+            ..search.clone()
+        };
+        let settled = EdgeSearch {
+            half_width: 0.5 * search.half_width.max(6.0),
+            beyond_window: false,
+            ..search.clone()
+        };
+        let gain = self.gain;
+        let f = self.get(k)?;
+        Ok(with_plane(&f.pixels, gain, |p| {
+            on_plane!(p, p => refine_circle(&p, c.x, c.y, c.r, &wide, None)
+            .and_then(|f| refine_circle(&p, f.fit.x, f.fit.y, f.fit.r, &settled, None))
+            .map(|f| {
+                let circle = Circle {
+                    x: f.fit.x,
+                    y: f.fit.y,
+                    r: f.fit.r,
+                    support: f.quality(),
+                };
+                Seen {
+                    look: disc_look(&p, &circle),
+                    contrast: disc_contrast(&p, circle.x, circle.y, circle.r),
+                    circle,
+                }
+            }))
+        }))
+    }
+
     /// Circle candidates in frame `k`: vote peaks from `votes`, each measured on the frame itself.
     fn candidates(
         &mut self,
@@ -1287,31 +1425,41 @@ mod tests {
         );
     }
 
+    /// The two scenes drawn as the frames of a clip in a fresh folder (removed when the guard is dropped), each
+    /// with its own noise seed.
+    fn two_frames(scenes: [Scene; 2]) -> tempfile::TempDir {
+        let dir = tempfile::tempdir().unwrap();
+        for (i, s) in scenes.into_iter().enumerate() {
+            let s = Scene { seed: i as u64, ..s };
+            let img = image::GrayImage::from_raw(s.size.0 as u32, s.size.1 as u32, render(&s)).unwrap();
+            img.save(dir.path().join(format!("f{i:04}.png"))).unwrap();
+        }
+        dir
+    }
+
+    /// A sighting of the circle (x, y, r) at quality 0.9, its look not taken.
+    fn seen(x: f64, y: f64, r: f64) -> Seen {
+        Seen {
+            circle: Circle { x, y, r, support: 0.9 },
+            look: Vec::new(),
+            contrast: 0.0,
+        }
+    }
+
     /// Whether a circle stayed put is told by the pixels: a still disc the other frame's search missed is
     /// still, and a slowly moving ball is not held still by a circle of noise where it was.
     #[test]
     fn pixels_tell_a_still_circle_from_a_slow_ball() {
-        let dir = tempfile::tempdir().unwrap();
         let disc = (190.0, 60.0, 14.0, 60.0);
-        for (i, ball) in [(100.0, 100.0, 40.0), (101.0, 102.5, 40.0)].into_iter().enumerate() {
-            let s = Scene {
-                ball,
-                noise: 12.0,
-                seed: i as u64,
-                distractors: vec![disc],
-                ..Scene::default()
-            };
-            let img = image::GrayImage::from_raw(256, 256, render(&s)).unwrap();
-            img.save(dir.path().join(format!("f{i:04}.png"))).unwrap();
-        }
+        let dir = two_frames([(100.0, 100.0, 40.0), (101.0, 102.5, 40.0)].map(|ball| Scene {
+            ball,
+            noise: 12.0,
+            distractors: vec![disc],
+            ..Scene::default()
+        }));
         let clip = Clip::open(dir.path()).unwrap();
         let opts = ClipTracking::default();
         let mut frames = FrameCache::new(&clip, &opts, 1.0, Order::Forward);
-        let seen = |x, y, r| Seen {
-            circle: Circle { x, y, r, support: 0.9 },
-            look: Vec::new(),
-            contrast: 0.0,
-        };
         let here = [seen(100.0, 100.0, 40.0), seen(disc.0, disc.1, disc.2)];
         // The second frame's search: a ghost where the ball was, and the disc missed.
         let there = [seen(100.2, 100.1, 40.1)];
@@ -1319,6 +1467,54 @@ mod tests {
         let centres = |v: &[Seen]| v.iter().map(|s| (s.circle.x, s.circle.y)).collect::<Vec<_>>();
         assert_eq!(centres(&moved), vec![(100.0, 100.0)]);
         assert_eq!(centres(&still), vec![(disc.0, disc.1)]);
+    }
+
+    #[test]
+    fn a_ball_is_followed_to_where_it_moved_and_a_still_disc_stays() {
+        let disc = (200.0, 200.0, 20.0, 40.0);
+        let dir = two_frames([(100.0, 100.0, 45.0), (108.3, 111.6, 45.0)].map(|ball| Scene {
+            ball,
+            noise: 14.0,
+            surface: Some((230.0, 0.0)),
+            band: (90.0, 40.0),
+            distractors: vec![disc],
+            ..Scene::default()
+        }));
+        let clip = Clip::open(dir.path()).unwrap();
+        let opts = ClipTracking::default();
+        let mut frames = FrameCache::new(&clip, &opts, 1.0, Order::Forward);
+        // From where the ball was, 14 px from where it is now.
+        let ball = seen(100.0, 100.0, 45.0);
+        let found = frames
+            .follow(1, &ball.circle, follow_half_width(45.0))
+            .unwrap()
+            .unwrap();
+        let c = found.circle;
+        assert!((c.x - 108.3).hypot(c.y - 111.6) < 0.5, "{c:?}");
+        assert!((c.r - 45.0).abs() < 0.5 && c.support > CANDIDATE_QUALITY, "{c:?}");
+        assert!(found.contrast >= MIN_DISC_CONTRAST, "{}", found.contrast);
+        let first = frames.follow(0, &ball.circle, 6.0).unwrap().unwrap();
+        assert!(
+            one_ball_moved(&first, &found, 256.0),
+            "{:?} {}",
+            first.circle,
+            first.contrast
+        );
+        // A still disc is found where it was: no pair.
+        let still = frames
+            .follow(1, &seen(disc.0, disc.1, disc.2).circle, follow_half_width(disc.2))
+            .unwrap()
+            .unwrap();
+        assert!(
+            (still.circle.x - disc.0).hypot(still.circle.y - disc.1) < 1.0,
+            "{:?}",
+            still.circle
+        );
+        let before = frames
+            .follow(0, &seen(disc.0, disc.1, disc.2).circle, 6.0)
+            .unwrap()
+            .unwrap();
+        assert!(!one_ball_moved(&before, &still, 256.0));
     }
 
     #[test]
