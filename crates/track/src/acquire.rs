@@ -1159,7 +1159,7 @@ impl<'a> FrameCache<'a> {
     /// measured again with the window candidates end with (a wide window's quality is not theirs) and seen
     /// as candidates are (quality, look, contrast on the frame). Not grown outward as candidates are: in
     /// heavy noise that takes a ball to a circle of noise round it. `None` when too few edges are found.
-    /// Cost: two refinements, well under a millisecond.
+    /// Cost: two refinements, each up to five passes of the rays across their window.
     fn follow(&mut self, k: usize, c: &Circle, half_width: f64) -> Result<Option<Seen>, TrackError> {
         let search = &self.opts.tracker.search;
         let wide = EdgeSearch {
