@@ -521,8 +521,8 @@ impl PairSearch<'_> {
         )
     }
 
-    /// The clearest pair at files `k` and `k + gap` in this (doubtful) pass made by following: each of the
-    /// [`FOLLOWED`] clearest circles of file `k` that moved (by its pixels) is looked for again where it
+    /// The clearest pair at files `k` and `k + gap` in this (doubtful) pass made by following: of the
+    /// [`FOLLOWED`] clearest circles of file `k`, each that moved (by its pixels) is looked for again where it
     /// was, in file `k + gap` and, from the middle of the two, half-way ([`FrameCache::follow`]); it is a
     /// pair when both are found at [`CANDIDATE_QUALITY`] as one ball that moved ([`one_ball_moved`]), the
     /// second moved by its pixels too, and the half-way circle is of its size within the reach
