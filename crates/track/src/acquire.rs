@@ -24,7 +24,7 @@ use crate::ball_search::{BALL_CANDIDATES, MIN_BALL_RADIUS_PX, hint_window, radiu
 use crate::clip::{ClipTracking, TrackError, on_plane, with_plane};
 use crate::hough::{Circle, CircleDetection, detect_circles, radius_bands};
 use crate::plane::{Pixel, Plane, median};
-use crate::refine::{EdgeSearch, refine_candidates, refine_circle};
+use crate::refine::{EdgeSearch, refine_candidates, refine_circle, settled_search};
 use crate::tracker::CLEAN_QUALITY;
 use bouncelab_frames::{Clip, Frame};
 use std::collections::HashMap;
@@ -514,9 +514,10 @@ impl PairSearch<'_> {
             pass.threshold,
             |mx, my, r, reach, least| {
                 Ok(gap < 2
-                    || self.circles(k + gap / 2, pass)?.iter().map(|s| &s.circle).any(|c| {
-                        c.support > least && (c.x - mx).hypot(c.y - my) <= reach && (c.r - r).abs() <= 0.05 * r + 1.0
-                    }))
+                    || self
+                        .circles(k + gap / 2, pass)?
+                        .iter()
+                        .any(|s| seen_halfway(&s.circle, (mx, my, reach), r, least)))
             },
         )
     }
@@ -558,11 +559,7 @@ impl PairSearch<'_> {
                 let Some(sm) = self.frames.follow(k + gap / 2, &middle, half_width)? else {
                     continue;
                 };
-                let m = sm.circle;
-                if !loose(&sm)
-                    || (m.x - mx).hypot(m.y - my) > reach
-                    || (m.r - sa.circle.r).abs() > 0.05 * sa.circle.r + 1.0
-                {
+                if !seen_halfway(&sm.circle, (mx, my, reach), sa.circle.r, CANDIDATE_QUALITY) {
                     continue;
                 }
             }
@@ -711,11 +708,22 @@ fn pairs(a: &[Seen], b: &[Seen], width: f64) -> Vec<(Circle, Circle)> {
 /// [`disc_contrast`]), moved by more than [`MIN_PAIR_MOVE_PX`] and less than half the region's `width`.
 fn one_ball_moved(a: &Seen, b: &Seen, width: f64) -> bool {
     let (ca, cb) = (a.circle, b.circle);
-    let same_size = (ca.r - cb.r).abs() <= 0.05 * ca.r + 1.0;
+    let same_size = of_a_size(ca.r, cb.r);
     let moved = (ca.x - cb.x).hypot(ca.y - cb.y);
     let same_ball =
         look_correlation(&a.look, &b.look) >= MIN_LOOK_CORRELATION || a.contrast.min(b.contrast) >= MIN_DISC_CONTRAST;
     same_size && moved > MIN_PAIR_MOVE_PX && moved < 0.5 * width && same_ball
+}
+
+/// Whether a circle of radius `other` is of the size `r`: within 5 % of it and a pixel.
+fn of_a_size(r: f64, other: f64) -> bool {
+    (other - r).abs() <= 0.05 * r + 1.0
+}
+
+/// Whether `c`, seen half-way between two sightings of radius `r`, is the ball there: clearer than `least`,
+/// within `reach` of their middle (x, y) ([`halfway_between`]) and of their size.
+fn seen_halfway(c: &Circle, (x, y, reach): (f64, f64, f64), r: f64, least: f64) -> bool {
+    c.support > least && (c.x - x).hypot(c.y - y) <= reach && of_a_size(r, c.r)
 }
 
 /// Where the ball is, half-way between two sightings `a` and `b`, give or take: a quarter of the distance
@@ -774,9 +782,10 @@ fn split_static(here: &[Seen], there: &[Seen]) -> (Vec<Seen>, Vec<Seen>) {
 
 /// Whether `there` holds a circle where `c` is, of its size (see [`split_static`]).
 fn seen_in_place(c: &Circle, there: &[Seen]) -> bool {
-    there.iter().map(|o| &o.circle).any(|o| {
-        (o.x - c.x).hypot(o.y - c.y) <= MIN_PAIR_MOVE_PX.max(0.05 * c.r) && (o.r - c.r).abs() <= 0.05 * c.r + 1.0
-    })
+    there
+        .iter()
+        .map(|o| &o.circle)
+        .any(|o| (o.x - c.x).hypot(o.y - c.y) <= MIN_PAIR_MOVE_PX.max(0.05 * c.r) && of_a_size(c.r, o.r))
 }
 
 /// A circle seen in a frame, with what its disc looks like there.
@@ -1167,11 +1176,7 @@ impl<'a> FrameCache<'a> {
             beyond_window: false,
             ..search.clone()
         };
-        let settled = EdgeSearch {
-            half_width: 0.5 * search.half_width.max(6.0),
-            beyond_window: false,
-            ..search.clone()
-        };
+        let settled = settled_search(search);
         let gain = self.gain;
         let f = self.get(k)?;
         Ok(with_plane(&f.pixels, gain, |p| {

@@ -775,11 +775,7 @@ pub fn refine_candidates<P: Pixel>(
         rays: (search.rays / 4).max(16),
         ..wide.clone()
     };
-    let settled = EdgeSearch {
-        half_width: 0.5 * wide.half_width,
-        beyond_window: false,
-        ..search.clone()
-    };
+    let settled = settled_search(search);
     // A circle centred beyond the frame's edge is judged on the rim the frame can show.
     let quality = |f: &Refined| {
         if detection.beyond_edge {
@@ -846,6 +842,16 @@ pub fn refine_candidates<P: Pixel>(
     });
     out.sort_by(|a, b| b.0.support.total_cmp(&a.0.support));
     out
+}
+
+/// The search a candidate is measured with at the end, once followed to where it settles: half the
+/// candidates' window (at least 6 px, so ±3 px), on the window's edges alone (see [`refine_candidates`]).
+pub(crate) fn settled_search(search: &EdgeSearch) -> EdgeSearch {
+    EdgeSearch {
+        half_width: 0.5 * search.half_width.max(6.0),
+        beyond_window: false,
+        ..search.clone()
+    }
 }
 
 /// The outermost clean circle around `f`: a ball's seam or shading can form a circle inside the ball; the
