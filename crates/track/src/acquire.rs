@@ -68,7 +68,8 @@ enum Voters {
 
 /// The ball's radius range and two sightings (see the module's description). Clean circles (quality above
 /// [`CLEAN_QUALITY`]) are tried first over the whole search, then circles down to [`CANDIDATE_QUALITY`] (a ball
-/// crossing a ruler, or in heavy noise; there the clearest pair is taken, see [`PairSearch::doubtful`]);
+/// crossing a ruler, or in heavy noise; there the earliest pair nearly as clear as the clearest is taken, see
+/// [`PairSearch::doubtful`]);
 /// moving votes before the frame's own. When nothing moves, the error lists the static circles seen. With a
 /// scale hint only radii within ±20 % of the ball's are searched.
 pub(crate) fn acquire(clip: &Clip, opts: &ClipTracking, gain: f32, noise: f32) -> Result<Acquired, TrackError> {
@@ -230,13 +231,14 @@ impl PairSearch<'_> {
 
     /// The doubtful pass, after the clean ones found nothing: in each radius band of `bands`, the clearest
     /// pair (its weaker sighting's quality) any vote source sees at any pair of files through the first half
-    /// of the clip ([`Self::clearest_in_band`]). A smaller band's pair takes the place of a larger band's only
+    /// of the clip, or the earliest nearly as clear ([`Self::clearest_in_band`]). A smaller band's pair takes the place of a larger band's only
     /// when clearer by [`CLEARER_BY`] and standing out from its surroundings at least as much
     /// ([`disc_contrast`]), as in [`Self::clearer_inside`]: a seam's lobe on a ball, which can be clearer than
     /// a doubtful rim, has felt on both sides, while the ball stands out from its backdrop and a circle of
     /// noise does not. The pair taken may yet give way to a clearer one inside it ([`Self::clearer_inside`]).
     /// In heavy noise circles of noise pulled along by part of the ball's rim move with it, in its band and
-    /// in larger ones; the first such pair found is not the ball as often as the clearest is. The clean
+    /// in larger ones; the first such pair found is not the ball as often as the clearest is, while one
+    /// nearly as clear and earlier is the ball as often and starts the track earlier. The clean
     /// passes have searched the same files and bands, so their circles are known.
     fn doubtful(&mut self, bands: &[(f64, f64)]) -> Result<Option<Acquired>, TrackError> {
         let mut best: Option<(usize, MovingPair, Pass)> = None;
@@ -263,8 +265,9 @@ impl PairSearch<'_> {
     }
 
     /// The clearest moving pair at [`CANDIDATE_QUALITY`] in radius band `band` (its range `radii`, px) that
-    /// any vote source sees at any pair of files through the first half of the clip: the search position of
-    /// its first file, the pair and the pass that saw it. When the vote peaks of the files make no pair in
+    /// any vote source sees at any pair of files through the first half of the clip, or the earliest nearly
+    /// as clear ([`earliest_of_the_clearest`]): the search position of its first file, the pair and the pass
+    /// that saw it. When the vote peaks of the files make no pair in
     /// the band, the same files are searched again following each file's clearest circles into the next
     /// ([`Self::followed_pair_at`]); a band where the vote peaks do make pairs is left as it was.
     fn clearest_in_band(
@@ -273,9 +276,9 @@ impl PairSearch<'_> {
         radii: (f64, f64),
     ) -> Result<Option<(usize, MovingPair, Pass)>, TrackError> {
         let (n, gap) = (self.clip.len(), self.gap);
-        let mut best: Option<(usize, MovingPair, Pass)> = None;
+        let mut found: Vec<(usize, MovingPair, Pass)> = Vec::new();
         for follow in [false, true] {
-            if best.is_some() {
+            if !found.is_empty() {
                 break;
             }
             let mut k = 0;
@@ -294,16 +297,14 @@ impl PairSearch<'_> {
                     } else {
                         self.pair_at(k, &pass)?
                     };
-                    if let Some(pair) = got
-                        && best.as_ref().is_none_or(|b| clarity(&pair) > clarity(&b.1))
-                    {
-                        best = Some((k, pair, pass));
+                    if let Some(pair) = got {
+                        found.push((k, pair, pass));
                     }
                 }
                 k += gap;
             }
         }
-        Ok(best)
+        Ok(earliest_of_the_clearest(found, |f| clarity(&f.1)))
     }
 
     /// The clearest moving pair at files `k` and `k + gap` in the bands of `bands` smaller than `pass`'s whose
@@ -760,6 +761,16 @@ const FOLLOWED: usize = 3;
 /// peaks find it), at least 6 px.
 fn follow_half_width(r: f64) -> f64 {
     (r / 3.0).max(6.0)
+}
+
+/// The first of `found` (in search order) whose `clarity` is within [`CLEARER_BY`] of the clearest's: pairs
+/// that close are as clear as one rim refined from two starts, and the earliest starts the track nearest the
+/// clip's start, as a clean pass would. A track started later is measured back from there, and in heavy
+/// noise where it starts moves every frame's centre by a tenth of a pixel or more. `None` when `found` is
+/// empty. Cost: two passes over `found`.
+fn earliest_of_the_clearest<T>(found: Vec<T>, clarity: impl Fn(&T) -> f64) -> Option<T> {
+    let clearest = found.iter().map(&clarity).fold(f64::NEG_INFINITY, f64::max);
+    found.into_iter().find(|f| clarity(f) >= clearest - CLEARER_BY)
 }
 
 /// How clear a pair is: its weaker sighting's quality.
@@ -1520,6 +1531,17 @@ mod tests {
             .unwrap()
             .unwrap();
         assert!(!one_ball_moved(&before, &still, 256.0));
+    }
+
+    #[test]
+    fn the_earliest_pair_nearly_as_clear_as_the_clearest_is_taken() {
+        let clarity = |p: &(usize, f64)| p.1;
+        // Search positions and clarities: 0.62 is further than CLEARER_BY from 0.70, 0.66 is not.
+        let found = vec![(0, 0.62), (10, 0.66), (20, 0.70), (30, 0.69)];
+        assert_eq!(earliest_of_the_clearest(found, clarity), Some((10, 0.66)));
+        let alone = vec![(40, 0.3)];
+        assert_eq!(earliest_of_the_clearest(alone, clarity), Some((40, 0.3)));
+        assert_eq!(earliest_of_the_clearest(Vec::<(usize, f64)>::new(), clarity), None);
     }
 
     #[test]
