@@ -25,7 +25,9 @@ pub struct ClipResult {
     pub centre_rms_px: (f64, f64),
     /// Why the shot could not be measured, if it could not.
     pub failure: Option<String>,
-    /// Contact line used (its cue) and its level error at the truth's column, px (measured − truth, + down).
+    /// Contact line used (its cue), its level error at the truth's column, px (measured − truth, + down), and
+    /// the line's part of the contact level's standard error as the estimator takes it, px
+    /// (`SurfaceLine::level_sigma_px`).
     pub level: Option<(String, f64, f64)>,
     /// COR and μ: (estimate, SE, truth).
     pub cor: Option<(f64, f64, f64)>,
@@ -205,7 +207,7 @@ fn evaluate_clip(
                 // The truth's surface line is given at the image's centre column.
                 let xc = (clip.dimensions().0 as f64 - 1.0) / 2.0;
                 let err = line.y_at(xc) - num(truth, "surface_y_px");
-                result.level = Some((line.cue.name().to_string(), err, line.sigma_y0));
+                result.level = Some((line.cue.name().to_string(), err, line.level_sigma_px()));
             }
             result.cor = Some((e.cor.value, e.cor.se, num(truth, "cor")));
             result.mu = Some((e.mu.value, e.mu.se, num(truth, "mu_eff")));
@@ -291,6 +293,29 @@ pub fn family_table(results: &[ClipResult]) -> String {
             worst(&cor),
             rms(&mu),
             worst(&mu),
+        );
+    }
+    s
+}
+
+/// One Markdown table row per contact-line cue: how far the contact level stands from the truth's surface
+/// against the standard error stated for it (see [`ClipResult::level`]): shots, RMS error, RMS of error/σ
+/// (1 when the stated errors are honest), and the shots more than 3 σ off.
+pub fn level_table(results: &[ClipResult]) -> String {
+    let mut cues: BTreeMap<&str, Vec<(f64, f64)>> = BTreeMap::new();
+    for (cue, err, sigma) in results.iter().filter_map(|r| r.level.as_ref()) {
+        cues.entry(cue.as_str()).or_default().push((*err, *sigma));
+    }
+    let mut s = String::from("| line cue | shots | level RMS px | RMS error/σ | beyond 3σ |\n|---|---|---|---|---|\n");
+    for (cue, v) in &cues {
+        let z: Vec<f64> = v.iter().map(|(e, sd)| e / sd).collect();
+        let errs: Vec<f64> = v.iter().map(|(e, _)| *e).collect();
+        s += &format!(
+            "| {cue} | {} | {:.2} | {:.2} | {} |\n",
+            v.len(),
+            rms(&errs),
+            rms(&z),
+            z.iter().filter(|z| z.abs() > 3.0).count()
         );
     }
     s

@@ -559,9 +559,7 @@ impl LevelErrors {
         } else {
             radius / s
         };
-        let sigma = ((line.sigma_y0.powi(2) + line.edge_definition_px.powi(2) / 3.0) * s * s
-            + (radius_scale * scale.sigma_m_per_px).powi(2))
-        .sqrt();
+        let sigma = (line.level_sigma_px() * s).hypot(radius_scale * scale.sigma_m_per_px);
         let scatter_scale = (scale.sigma_m_per_px.powi(2) - scale.sigma_shape_m_per_px.powi(2))
             .max(0.0)
             .sqrt();
@@ -928,8 +926,7 @@ impl TrajectoryView {
     /// A line agrees with the trajectory when their levels differ by less than 3σ of both plus a pixel (or
     /// 3 % of the radius): gross disagreement means the line is not where the ball lands.
     fn agrees(&self, m: &Measured, line: &SurfaceLine) -> bool {
-        let line_se = (line.sigma_y0.powi(2) + line.edge_definition_px.powi(2) / 3.0).sqrt();
-        m.value.abs() <= 3.0 * m.se.hypot(line_se) + (0.03 * self.radius_px).max(1.0)
+        m.value.abs() <= 3.0 * m.se.hypot(line.level_sigma_px()) + (0.03 * self.radius_px).max(1.0)
     }
 
     /// The line found when the trajectory agrees with it (or contradicts itself across it), else the first

@@ -15,9 +15,11 @@
 //! the sharper); where they disagree the topmost is taken and the other is returned as an alternative, so a
 //! later stage can choose with the ball's own trajectory (unless the texture line is seen along clearly more
 //! of the band: then it is kept). The roughness of the edge (the scatter of the column edges about the line)
-//! is reported, and widens the line's stated uncertainty on a ragged band: its height's, and its tilt's by a
-//! uniform tilt of up to ± the roughness over the line's half-length, since how each column's edge is
-//! defined can drift smoothly across the frame where no column statistic sees it.
+//! is reported, and widens the line's stated uncertainty on a ragged band: its height's, by a uniform
+//! (Type-B) term of ± twice the roughness whichever cue found it (the plane lies between the edge's mean and
+//! its highest points), and its tilt's by a uniform tilt of up to ± the roughness over the line's
+//! half-length, since how each column's edge is defined can drift smoothly across the frame where no column
+//! statistic sees it.
 //!
 //! The tracker looks for the line in the mean of a clip's first frames (`Tracker`), where the noise is
 //! smaller than in any one frame.
@@ -40,9 +42,11 @@ pub struct SurfaceLine {
     /// Columns that agree with the line.
     pub columns: usize,
     /// How much the line's height depends on how its edge is defined, px: the median over its columns of
-    /// the distance between the narrowest difference's edge and the smoothed derivative's. A lit or rough
-    /// top edge makes them differ (0.15–0.18 px on rendered clay, 0.01–0.06 on the tapes); the estimator takes it as
-    /// the half-width of a uniform (Type-B) uncertainty of the contact level. 0 in lines stored before it.
+    /// the distance between the narrowest difference's edge and the smoothed derivative's (a lit top edge
+    /// makes them differ: 0.15–0.18 px on rendered clay, 0.01–0.06 on the tapes), and at least twice the
+    /// edge's roughness (the plane lies between a ragged edge's mean and its highest points) for the lines
+    /// [`find_surface_lines`] returns. The estimator takes it as the half-width of a uniform (Type-B)
+    /// uncertainty of the contact level. 0 in lines stored before it.
     #[serde(default)]
     pub edge_definition_px: f64,
     /// RMS distance of the supporting columns' edges from the line, px: the band edge's raggedness (grains,
@@ -114,6 +118,12 @@ impl SurfaceLine {
         }
     }
 
+    /// The standard error of the line's height as a contact level, px: its columns' scatter (`sigma_y0`)
+    /// and its edge's definition as the half-width of a uniform (Type-B) term, in quadrature.
+    pub fn level_sigma_px(&self) -> f64 {
+        (self.sigma_y0.powi(2) + self.edge_definition_px.powi(2) / 3.0).sqrt()
+    }
+
     /// How far above the line the band's ragged edge may reach, px: twice its roughness beyond the
     /// pixel of scatter any measured edge has (0 for a clean edge).
     pub fn ragged_reach_px(&self) -> f64 {
@@ -154,8 +164,8 @@ pub fn find_surface_line<P: Pixel>(img: &Plane<P>) -> Option<SurfaceLine> {
 /// not the surface (a ruler, a fixture's edge or a shadow crossing the frame above the ball) and is left
 /// out. Cost ≈ 3 ms for 512×512.
 pub fn find_surface_lines<P: Pixel>(img: &Plane<P>, ball: Option<(f64, f64, f64)>) -> Option<SurfaceLines> {
-    let step = brightness_lines(img);
-    let texture = crate::texture::texture_lines(img);
+    let step = brightness_lines(img).into_iter().map(ragged).collect();
+    let texture = crate::texture::texture_lines(img).into_iter().map(ragged).collect();
     let mut candidates: Vec<SurfaceLine> = merge_cues(step, texture, img.width)
         .into_iter()
         .filter(|l| ball.is_none_or(|(x, y, r)| l.height_of(x, y) >= BALL_CLEARANCE_RADII * r))
@@ -168,6 +178,17 @@ pub fn find_surface_lines<P: Pixel>(img: &Plane<P>, ball: Option<(f64, f64, f64)
         line,
         alternatives: candidates,
     })
+}
+
+/// `line` with its edge definition at least twice its own roughness (before [`merge_cues`] lends it a
+/// twin's), whichever cue found it: on a ragged edge the plane the ball rests on lies somewhere between the
+/// edge's mean, where the line runs, and its highest grains or fibres, which no column statistic tells
+/// apart (the texture cue's lines are made so, see [`crate::texture::texture_lines`]).
+fn ragged(line: SurfaceLine) -> SurfaceLine {
+    SurfaceLine {
+        edge_definition_px: line.edge_definition_px.abs().max(2.0 * line.roughness_px),
+        ..line
+    }
 }
 
 /// One list of candidates from both cues, topmost first: where a brightness line and a texture line see the
@@ -453,6 +474,7 @@ fn refine_line(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::testutil::{Scene, render};
 
     /// A column crossing a band's top edge at row `e`: backdrop 70 above; below, a band of 90 whose top
     /// `lip` rows catch the light (up to +12, fading linearly); the edge's coverage ramps over one row.
@@ -534,6 +556,31 @@ mod tests {
         let smoothed = 20.0 + 0.5 * (a0 - a2) / (a0 - 2.0 * a1 + a2);
         assert!((smoothed - e).abs() > 0.25, "{smoothed}");
         assert!((y - e).abs() < 0.2, "{y}");
+    }
+
+    /// A step in brightness at a ragged edge: the line's stated level error holds the edge's raggedness
+    /// (its edge definition at least twice its roughness), and covers where the edge was drawn.
+    #[test]
+    fn a_ragged_step_s_level_error_holds_its_roughness() {
+        for seed in 1..=6u64 {
+            let y0 = 180.3 + 0.1 * seed as f64;
+            let s = Scene {
+                surface: Some((y0, 0.01)),
+                backdrop: (95.0, 95.0),
+                band: (140.0, 4.0),
+                roughness: 2.0,
+                noise: 3.0,
+                seed,
+                ..Scene::default()
+            };
+            let px = render(&s);
+            let line = find_surface_line(&Plane::new(&px, 256, 256)).expect("a line");
+            assert_eq!(line.cue, LineCue::Brightness, "{line:?}");
+            assert!(line.roughness_px > 0.3, "{line:?}");
+            assert!(line.edge_definition_px >= 2.0 * line.roughness_px, "{line:?}");
+            let sigma = line.level_sigma_px();
+            assert!((line.y0 - y0).abs() <= 3.0 * sigma, "{} vs {y0} ± {sigma}", line.y0);
+        }
     }
 
     /// The line's edge definition is what the two edges disagree by: about nothing on a plain step, a
