@@ -229,17 +229,17 @@ impl PairSearch<'_> {
         Ok(None)
     }
 
-    /// The doubtful pass, after the clean ones found nothing: in each radius band of `bands`, the clearest
-    /// pair (its weaker sighting's quality) any vote source sees at any pair of files through the first half
-    /// of the clip, or the earliest nearly as clear ([`Self::clearest_in_band`]). A smaller band's pair takes the place of a larger band's only
-    /// when clearer by [`CLEARER_BY`] and standing out from its surroundings at least as much
-    /// ([`disc_contrast`]), as in [`Self::clearer_inside`]: a seam's lobe on a ball, which can be clearer than
-    /// a doubtful rim, has felt on both sides, while the ball stands out from its backdrop and a circle of
-    /// noise does not. The pair taken may yet give way to a clearer one inside it ([`Self::clearer_inside`]).
-    /// In heavy noise circles of noise pulled along by part of the ball's rim move with it, in its band and
-    /// in larger ones; the first such pair found is not the ball as often as the clearest is, while one
-    /// nearly as clear and earlier is the ball as often and starts the track earlier. The clean
-    /// passes have searched the same files and bands, so their circles are known.
+    /// The doubtful pass, after the clean ones found nothing: in each radius band of `bands`, the earliest
+    /// pair nearly as clear (its weaker sighting's quality) as the clearest any vote source sees at any pair
+    /// of files through the first half of the clip ([`Self::clearest_in_band`]). A smaller band's pair takes
+    /// the place of a larger band's only when clearer by [`CLEARER_BY`] and standing out from its
+    /// surroundings at least as much ([`disc_contrast`]), as in [`Self::clearer_inside`]: a seam's lobe on a
+    /// ball, which can be clearer than a doubtful rim, has felt on both sides, while the ball stands out from
+    /// its backdrop and a circle of noise does not. The pair taken may yet give way to a clearer one inside
+    /// it ([`Self::clearer_inside`]). In heavy noise circles of noise pulled along by part of the ball's rim
+    /// move with it, in its band and in larger ones; the first pair found at any clarity is not the ball as
+    /// often as the clearest is. The clean passes have searched the same files and bands, so their circles
+    /// are known.
     fn doubtful(&mut self, bands: &[(f64, f64)]) -> Result<Option<Acquired>, TrackError> {
         let mut best: Option<(usize, MovingPair, Pass)> = None;
         for (band, &radii) in bands.iter().enumerate() {
@@ -264,12 +264,12 @@ impl PairSearch<'_> {
         Ok(Some(self.acquired(k, &pair)))
     }
 
-    /// The clearest moving pair at [`CANDIDATE_QUALITY`] in radius band `band` (its range `radii`, px) that
-    /// any vote source sees at any pair of files through the first half of the clip, or the earliest nearly
-    /// as clear ([`earliest_of_the_clearest`]): the search position of its first file, the pair and the pass
-    /// that saw it. When the vote peaks of the files make no pair in
-    /// the band, the same files are searched again following each file's clearest circles into the next
-    /// ([`Self::followed_pair_at`]); a band where the vote peaks do make pairs is left as it was.
+    /// The earliest moving pair at [`CANDIDATE_QUALITY`] in radius band `band` (its range `radii`, px) nearly
+    /// as clear as the clearest any vote source sees at any pair of files through the first half of the clip
+    /// ([`earliest_of_the_clearest`]): the search position of its first file, the pair and the pass that saw
+    /// it. When the vote peaks of the files make no pair in the band, the same files are searched again
+    /// following each file's clearest circles into the next ([`Self::followed_pair_at`]); a band where the
+    /// vote peaks do make pairs is left as it was.
     fn clearest_in_band(
         &mut self,
         band: usize,
@@ -764,10 +764,10 @@ fn follow_half_width(r: f64) -> f64 {
 }
 
 /// The first of `found` (in search order) whose `clarity` is within [`CLEARER_BY`] of the clearest's: pairs
-/// that close are as clear as one rim refined from two starts, and the earliest starts the track nearest the
-/// clip's start, as a clean pass would. A track started later is measured back from there, and in heavy
-/// noise where it starts moves every frame's centre by a tenth of a pixel or more. `None` when `found` is
-/// empty. Cost: two passes over `found`.
+/// that close are as clear as one rim refined from two starts, so clarity does not choose among them, and the
+/// earliest starts the track nearest the clip's start, as a clean pass would. A track started later is
+/// measured back from there, and in heavy noise where it starts moves every frame's centre by up to a few
+/// tenths of a pixel. `None` when `found` is empty. Cost: two passes over `found`.
 fn earliest_of_the_clearest<T>(found: Vec<T>, clarity: impl Fn(&T) -> f64) -> Option<T> {
     let clearest = found.iter().map(&clarity).fold(f64::NEG_INFINITY, f64::max);
     found.into_iter().find(|f| clarity(f) >= clearest - CLEARER_BY)
