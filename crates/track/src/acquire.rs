@@ -231,7 +231,7 @@ impl PairSearch<'_> {
 
     /// The doubtful pass, after the clean ones found nothing: in each radius band of `bands`, the earliest
     /// pair nearly as clear (its weaker sighting's quality) as the clearest any vote source sees at any pair
-    /// of files through the first half of the clip ([`Self::clearest_in_band`]). A smaller band's pair takes
+    /// of files through the first half of the clip ([`Self::earliest_clear_in_band`]). A smaller band's pair takes
     /// the place of a larger band's only when clearer by [`CLEARER_BY`] and standing out from its
     /// surroundings at least as much ([`disc_contrast`]), as in [`Self::clearer_inside`]: a seam's lobe on a
     /// ball, which can be clearer than a doubtful rim, has felt on both sides, while the ball stands out from
@@ -243,7 +243,7 @@ impl PairSearch<'_> {
     fn doubtful(&mut self, bands: &[(f64, f64)]) -> Result<Option<Acquired>, TrackError> {
         let mut best: Option<(usize, MovingPair, Pass)> = None;
         for (band, &radii) in bands.iter().enumerate() {
-            let Some(found) = self.clearest_in_band(band, radii)? else {
+            let Some(found) = self.earliest_clear_in_band(band, radii)? else {
                 continue;
             };
             let takes_over = match &best {
@@ -270,7 +270,7 @@ impl PairSearch<'_> {
     /// it. When the vote peaks of the files make no pair in the band, the same files are searched again
     /// following each file's clearest circles into the next ([`Self::followed_pair_at`]); a band where the
     /// vote peaks do make pairs is left as it was.
-    fn clearest_in_band(
+    fn earliest_clear_in_band(
         &mut self,
         band: usize,
         radii: (f64, f64),

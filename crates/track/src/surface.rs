@@ -165,7 +165,7 @@ pub fn find_surface_line<P: Pixel>(img: &Plane<P>) -> Option<SurfaceLine> {
 /// out. Cost ≈ 3 ms for 512×512.
 pub fn find_surface_lines<P: Pixel>(img: &Plane<P>, ball: Option<(f64, f64, f64)>) -> Option<SurfaceLines> {
     let step = brightness_lines(img).into_iter().map(ragged).collect();
-    let texture = crate::texture::texture_lines(img).into_iter().map(ragged).collect();
+    let texture = crate::texture::texture_lines(img);
     let mut candidates: Vec<SurfaceLine> = merge_cues(step, texture, img.width)
         .into_iter()
         .filter(|l| ball.is_none_or(|(x, y, r)| l.height_of(x, y) >= BALL_CLEARANCE_RADII * r))
@@ -183,8 +183,8 @@ pub fn find_surface_lines<P: Pixel>(img: &Plane<P>, ball: Option<(f64, f64, f64)
 /// `line` with its edge definition at least twice its own roughness (before [`merge_cues`] lends it a
 /// twin's), whichever cue found it: on a ragged edge the plane the ball rests on lies somewhere between the
 /// edge's mean, where the line runs, and its highest grains or fibres, which no column statistic tells
-/// apart (the texture cue's lines are made so, see [`crate::texture::texture_lines`]).
-fn ragged(line: SurfaceLine) -> SurfaceLine {
+/// apart. Both cues' lines are made so ([`brightness_lines`]' here, [`crate::texture::texture_lines`]' there).
+pub(crate) fn ragged(line: SurfaceLine) -> SurfaceLine {
     SurfaceLine {
         edge_definition_px: line.edge_definition_px.abs().max(2.0 * line.roughness_px),
         ..line

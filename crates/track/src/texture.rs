@@ -54,8 +54,8 @@ pub fn texture_line<P: Pixel>(img: &Plane<P>) -> Option<SurfaceLine> {
 }
 
 /// The long near-horizontal changes of texture across the image, topmost first. Each line's
-/// `edge_definition_px` is twice its roughness: on a ragged band the plane the ball rests on lies somewhere
-/// between the edge's mean and its highest grains.
+/// `edge_definition_px` is twice its roughness ([`crate::surface::ragged`]): on a ragged band the plane the
+/// ball rests on lies somewhere between the edge's mean and its highest grains.
 pub fn texture_lines<P: Pixel>(img: &Plane<P>) -> Vec<SurfaceLine> {
     let (w, h) = (img.width, img.height);
     if w < 4 * HALF_BOX || h < 4 * STEP_ROWS + 8 {
@@ -79,10 +79,11 @@ pub fn texture_lines<P: Pixel>(img: &Plane<P>) -> Vec<SurfaceLine> {
     let mut lines: Vec<SurfaceLine> = lines_through(&cands, &leans, cols.len(), w, TOLERANCE_PX, MIN_STRENGTH, 0.0)
         .into_iter()
         .map(|line| robust_refit(&cands, line))
-        .map(|line| SurfaceLine {
-            edge_definition_px: 2.0 * line.roughness_px,
-            cue: LineCue::Texture,
-            ..line
+        .map(|line| {
+            crate::surface::ragged(SurfaceLine {
+                cue: LineCue::Texture,
+                ..line
+            })
         })
         .collect();
     // The refit moves a line by up to a few px: topmost first again.
