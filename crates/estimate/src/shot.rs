@@ -536,7 +536,7 @@ fn flights(points: &[Point], first: usize, last: usize) -> Result<(Vec<&Point>, 
 struct LevelErrors {
     /// Uncertainty of "one radius above the surface line" in the local frame, m: all of it for this shot's
     /// errors (the line's scatter and its edge's definition as a uniform Type-B term, the scale's at one
-    /// radius).
+    /// radius, and the rim's common offset of the centre).
     sigma: f64,
     /// Its shot-to-shot part, m, for a fit's per-shot level: without the Type-B terms that a surface's clips
     /// share (see `Estimate::surface_sigma_m`).
@@ -553,13 +553,15 @@ impl LevelErrors {
     fn of(line: &SurfaceLine, scale: &bouncelab_track::Scale, radius: f64) -> Self {
         let s = scale.m_per_px;
         // A level taken from the trajectory is where the centre was at the touch, one radius above a line put
-        // one radius below it: the scale's error in that radius cancels.
-        let radius_scale = if line.cue == LineCue::Trajectory {
-            0.0
-        } else {
-            radius / s
-        };
-        let sigma = (line.level_sigma_px() * s).hypot(radius_scale * scale.sigma_m_per_px);
+        // one radius below it: the scale's error in that radius cancels, and so does an offset of the centre.
+        let from_image = line.cue != LineCue::Trajectory;
+        let radius_scale = if from_image { radius / s } else { 0.0 };
+        // The rim's unseen first harmonic offsets every centre alike: against a line seen in the image it
+        // moves the contact as much as a level error (Type-B, like the radius's rim term; see `Scale`).
+        let centre = if from_image { scale.rim_shape_px * s } else { 0.0 };
+        let sigma = (line.level_sigma_px() * s)
+            .hypot(radius_scale * scale.sigma_m_per_px)
+            .hypot(centre);
         let scatter_scale = (scale.sigma_m_per_px.powi(2) - scale.sigma_shape_m_per_px.powi(2))
             .max(0.0)
             .sqrt();

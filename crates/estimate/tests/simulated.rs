@@ -65,6 +65,7 @@ fn shot(model: &Model, incline_deg: f64, drop_m: f64, after: f64, seed: u64) -> 
             m_per_px: SCALE,
             sigma_m_per_px: SCALE * 2e-4,
             sigma_shape_m_per_px: 0.0,
+            rim_shape_px: 0.0,
             radius_px: r / SCALE,
             frames: 150,
         }),
@@ -205,6 +206,31 @@ fn a_surface_line_off_by_its_sigma_is_one_standard_error_of_the_contact_time() {
             "{angle}°: {:?}",
             e.cor
         );
+    }
+}
+
+/// A rim found inside the ball on its dim side offsets every centre alike (the circle absorbs the rim's
+/// first harmonic). Against a line seen in the image that moves the contact as a level error does, and the
+/// contact time's error counts it at the rim shape's RMS.
+#[test]
+fn a_centre_offset_by_the_rim_s_shape_is_one_standard_error_of_the_contact_time() {
+    let model = Model::paper(25_650.0, 14.0, 0.5);
+    for (angle, drop) in [(0.0, 0.2), (22.5, 0.9)] {
+        let (mut track, truth) = shot(&model, angle, drop, 0.02, 11);
+        // The centres 0.5 px high in every frame, and a rim shape of 0.5 px RMS.
+        for f in &mut track.fixes {
+            f.y_px -= 0.5;
+        }
+        let scale = track.scale.as_mut().unwrap();
+        scale.rim_shape_px = 0.5;
+        let e = estimate(&track, &conditions(angle)).unwrap();
+        let z = (e.contact_ms.value - truth.contact_time() * 1e3) / e.contact_ms.se;
+        assert!((-1.25..=-0.8).contains(&z), "{angle}°: contact time error/SE = {z}");
+        // Without the term the same error is many standard errors.
+        track.scale.as_mut().unwrap().rim_shape_px = 0.0;
+        let e = estimate(&track, &conditions(angle)).unwrap();
+        let z = (e.contact_ms.value - truth.contact_time() * 1e3) / e.contact_ms.se;
+        assert!(z < -3.0, "{angle}°: without the rim term, contact time error/SE = {z}");
     }
 }
 

@@ -105,6 +105,9 @@ pub struct Scale {
     /// that is the same for every clip of a session gives every clip about the same radius bias, so it is
     /// not a shot-to-shot scatter.
     pub sigma_shape_m_per_px: f64,
+    /// The rim shape's RMS, px (see `scale_from`): the Type-B standard uncertainty of the radius, and of
+    /// the centre's offset common to every frame, which moves the ball's lowest point as the radius does.
+    pub rim_shape_px: f64,
     /// Mean free-flight radius, px.
     pub radius_px: f64,
     /// Frames it was measured on.
@@ -297,7 +300,7 @@ pub fn track_clip(
         tracker.surface(),
         opts.ball_diameter_m,
         tracker.edge_definition_px(),
-        tracker.rim_shape().map_or(0.0, |s| s.rms_px()),
+        tracker.rim_shape_rms_px(),
     );
     let (ox, oy) = roi_origin(opts.roi.as_ref());
     // Back to the whole frame's pixels.
@@ -857,7 +860,8 @@ fn observe<P: Pixel>(tracker: &mut Tracker, frame: usize, t_s: f64, p: &Plane<P>
 ///   different amounts at different angles (the learned [`RimShape`](crate::RimShape)). Their mean over the
 ///   rim, which is what biases the radius, cannot be seen (a circle absorbs it), so it is taken to be as
 ///   uncertain as the part that can: the shape's RMS, as a standard uncertainty. The same reasoning keeps
-///   the uncorrected spread in each frame's centre σ.
+///   the uncorrected spread in each frame's centre σ, and the estimator takes the first harmonic, which
+///   offsets every frame's centre alike, to be as uncertain (`Scale::rim_shape_px`).
 pub(crate) fn scale_from(
     fixes: &[BallFix],
     surface: Option<&SurfaceLine>,
@@ -899,6 +903,7 @@ pub(crate) fn scale_from(
         sigma_m_per_px: m_per_px * ((sd * sd / n) + edge_definition_px.powi(2) / 3.0 + rim_shape_rms_px.powi(2)).sqrt()
             / mean,
         sigma_shape_m_per_px: m_per_px * rim_shape_rms_px / mean,
+        rim_shape_px: rim_shape_rms_px,
         radius_px: mean,
         frames: radii.len(),
     })

@@ -171,6 +171,10 @@ pub struct Tracker {
     flight_edges: Vec<f64>,
     /// The rim's shape, learned from full-rim free-flight frames until the first partly hidden one.
     rim: RimShapeLearner,
+    /// The same from the full-rim free-flight frames that are not clean enough to teach it (heavy noise):
+    /// the shape they give is not applied, only its RMS taken for the rim's errors when no clean frame
+    /// taught one (see [`Tracker::rim_shape_rms_px`]).
+    rim_doubtful: RimShapeLearner,
     rim_frozen: bool,
     /// The edge points `(ray, [x, y])` of this frame's search around the prediction while the rim's shape
     /// is being learned (its residuals teach the shape without a second search); empty otherwise.
@@ -256,6 +260,7 @@ impl Tracker {
             flight_radii: Vec::new(),
             flight_edges: Vec::new(),
             rim: RimShapeLearner::default(),
+            rim_doubtful: RimShapeLearner::default(),
             rim_frozen: false,
             rim_rays: Vec::new(),
             surface: None,
@@ -310,6 +315,18 @@ impl Tracker {
         let mut e = self.flight_edges.clone();
         let mid = e.len() / 2;
         *e.select_nth_unstable_by(mid, f64::total_cmp).1
+    }
+
+    /// How far the apparent rim strays from a circle, px: the RMS of the rim's shape learned from clean
+    /// frames, else of the shape the doubtful full-rim flight frames give (at least [`RIM_MIN_SAMPLES`] of
+    /// them), else 0 (no full-rim flight frame to tell).
+    pub fn rim_shape_rms_px(&self) -> f64 {
+        let doubtful = || {
+            (self.rim_doubtful.frames() >= RIM_MIN_SAMPLES)
+                .then(|| self.rim_doubtful.shape())
+                .flatten()
+        };
+        self.rim_shape().cloned().or_else(doubtful).map_or(0.0, |s| s.rms_px())
     }
 
     /// The rim's shape learned so far (see [`RimShape`](crate::RimShape)), if enough full-rim frames were seen.
@@ -663,11 +680,13 @@ impl Tracker {
             if f.edge_definition_px.is_finite() && self.flight_edges.len() < EDGE_SAMPLES {
                 self.flight_edges.push(f.edge_definition_px);
             }
-            // Only clean circles teach the rim's shape (a seam circle fits its edges less well).
+            // Only clean circles teach the rim's shape (a seam circle fits its edges less well); the others
+            // only tell how large it is.
+            let clean = f.quality() >= CLEAN_QUALITY;
             if !self.rim_frozen
                 && f.rays_outside == 0
-                && f.quality() >= CLEAN_QUALITY
                 && self.rim.frames() < RIM_SAMPLES
+                && (clean || self.rim_doubtful.frames() < RIM_SAMPLES)
             {
                 // The frame's own edge points when it was measured around the prediction; a frame found by
                 // detection is searched once more.
@@ -676,9 +695,14 @@ impl Tracker {
                 } else {
                     residuals_about(&fit, &self.rim_rays)
                 };
-                self.rim.add(self.opts.search.rays.max(8), &res);
-                if self.rim.frames() >= RIM_MIN_SAMPLES {
-                    self.opts.search.rim_shape = self.rim.shape();
+                let rays = self.opts.search.rays.max(8);
+                if clean {
+                    self.rim.add(rays, &res);
+                    if self.rim.frames() >= RIM_MIN_SAMPLES {
+                        self.opts.search.rim_shape = self.rim.shape();
+                    }
+                } else {
+                    self.rim_doubtful.add(rays, &res);
                 }
             }
         } else if f.rays_hidden > 0 && self.rim.frames() >= RIM_MIN_SAMPLES {
@@ -730,6 +754,46 @@ mod tests {
             .iter()
             .map(|&v| (v as f64 + noise * rng.normal()).round().clamp(0.0, 255.0) as u8)
             .collect()
+    }
+
+    /// A ball whose rim is not clean in any frame teaches no rim shape to correct with, yet the shape's size
+    /// is still measured for the errors.
+    #[test]
+    fn doubtful_frames_tell_the_rim_shape_s_size() {
+        // The same scene at full and at a fifth of its contrast (noise scaled alike): the dim one's rim is
+        // below the contrast of a clean circle in every frame.
+        let track = |dim: f64| {
+            let mut tracker = Tracker::new(TrackOptions {
+                radius_px: Some((35.0, 45.0)),
+                ..TrackOptions::default()
+            });
+            let mut qualities = Vec::new();
+            for k in 0..48 {
+                let t = k as f64;
+                let img = render(&Scene {
+                    ball: (110.3 + 0.3 * t, 80.2 + 0.8 * t, 40.0),
+                    ball_level: 200.0 * dim,
+                    backdrop: (70.0 * dim, 110.0 * dim),
+                    marks: vec![(34.0, 24.0, 16.0, 95.0 * dim)],
+                    noise: 2.0 * dim,
+                    seed: k as u64,
+                    ..Scene::default()
+                });
+                let f = tracker.observe(k, t * 1e-4, &Plane::new(&img, 256, 256));
+                qualities.push(f.quality);
+            }
+            (tracker.rim_shape().is_some(), tracker.rim_shape_rms_px(), qualities)
+        };
+        let (clean_learned, clean_rms, _) = track(1.0);
+        let (dim_learned, dim_rms, q) = track(0.2);
+        assert!(clean_learned && clean_rms > 0.0);
+        assert!(!dim_learned, "a clean frame at a fifth of the contrast: {q:?}");
+        // Its rays of least contrast, which carry most of the shape, drop out more often in the dim frames
+        // (0.016 px against 0.071 px here): a lower bound on the shape, not its measure.
+        assert!(
+            dim_rms > 0.1 * clean_rms && dim_rms < 1.5 * clean_rms,
+            "rim shape RMS {dim_rms:.3} px at a fifth of the contrast against {clean_rms:.3} px at full contrast"
+        );
     }
 
     /// A band a single noisy frame does not show is found in the mean of the first frames, where its
