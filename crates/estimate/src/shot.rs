@@ -346,8 +346,10 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
     let sep = crossing(&fout, radius, points[last].t);
     let with_level = |c: &Crossing| Measured::new(c.t.value, c.t.se.hypot(c.dt_dlevel * level.sigma));
     let (t_touch, t_sep) = (with_level(&touch), with_level(&sep));
-    let vin = velocity_parts(&fin, &touch, &level);
-    let vout = velocity_parts(&fout, &sep, &level);
+    // The rim's bias drifting along a flight moves its velocities by as much (see `RadiusLine`).
+    let drift = |set: &[&Point]| RadiusLine::of(set).map_or(0.0, |l| l.centre_drift() * s);
+    let vin = velocity_parts(&fin, &touch, &level, drift(&incoming));
+    let vout = velocity_parts(&fout, &sep, &level, drift(&outgoing));
     let cor = restitution(&vin, &vout, &level);
     let mu = friction(&vin, &vout, &level);
     let contact_se =
@@ -404,11 +406,26 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
 }
 
 /// The change of the measured radius between the flights, px: mean outgoing − mean incoming, its standard
-/// error from each flight's scatter about a line in time, with the variance factor of that scatter's
-/// correlation (`ballistic::ar1_factor`; a drift along the flight is not counted as correlated noise);
-/// `None` when a flight holds fewer than four radii.
+/// error from each flight's scatter about a line in time (see [`RadiusLine`]); `None` when a flight holds
+/// fewer than four radii.
 fn rim_change(incoming: &[&Point], outgoing: &[&Point]) -> Option<Measured> {
-    let mean_and_var = |set: &[&Point]| -> Option<(f64, f64)> {
+    let (i, o) = (RadiusLine::of(incoming)?, RadiusLine::of(outgoing)?);
+    Some(Measured::new(o.mean - i.mean, (i.var_mean + o.var_mean).sqrt()))
+}
+
+/// The measured radius through one flight as a line in time, px.
+struct RadiusLine {
+    mean: f64,
+    /// The mean's variance, px², with the variance factor of the residuals' correlation
+    /// (`ballistic::ar1_factor`; a drift along the flight is not counted as correlated noise).
+    var_mean: f64,
+    /// The radius's drift, px/s, and its standard error (with the same factor).
+    slope: Measured,
+}
+
+impl RadiusLine {
+    /// The least-squares line of the finite radii of `set`; `None` with fewer than four.
+    fn of(set: &[&Point]) -> Option<Self> {
         let tr: Vec<(f64, f64)> = set
             .iter()
             .map(|p| (p.t, p.r_px))
@@ -430,10 +447,23 @@ fn rim_change(incoming: &[&Point], outgoing: &[&Point]) -> Option<Measured> {
         };
         let residuals: Vec<f64> = tr.iter().map(|p| p.1 - mr - slope * (p.0 - mt)).collect();
         let var = residuals.iter().map(|x| x * x).sum::<f64>() / (n - 2.0);
-        Some((mr, var / n * crate::ballistic::ar1_factor(&residuals)))
-    };
-    let ((mi, vi), (mo, vo)) = (mean_and_var(incoming)?, mean_and_var(outgoing)?);
-    Some(Measured::new(mo - mi, (vi + vo).sqrt()))
+        let factor = crate::ballistic::ar1_factor(&residuals);
+        Some(RadiusLine {
+            mean: mr,
+            var_mean: var / n * factor,
+            slope: Measured::new(slope, (var / stt.max(f64::MIN_POSITIVE) * factor).sqrt()),
+        })
+    }
+
+    /// How fast the rim's bias may move the centre, px/s: the radius's drift beyond its noise
+    /// (√max(0, slope² − SE²), an unbiased estimate of the squared drift). A rigid ball's radius does not
+    /// change in flight, but its apparent rim does where the light on its limb or the backdrop behind it
+    /// changes along the path; a bias on one side moves the centre about as much as the radius (a
+    /// half-wave-rectified offset by π/2 times as much, a uniform one not at all), in a direction the
+    /// circle does not tell. So it is taken as a standard uncertainty of each velocity component.
+    fn centre_drift(&self) -> f64 {
+        (self.slope.value.powi(2) - self.slope.se.powi(2)).max(0.0).sqrt()
+    }
 }
 
 /// The fixes a fit weighs ([`bouncelab_track::Status::fitted`] with a finite centre); an error when they
@@ -575,13 +605,14 @@ impl LevelErrors {
     }
 }
 
-/// Per velocity component at a crossing: the value, the fit's error (for ratios, where the scale and the
-/// level's common part are propagated separately), its derivative with the level, and the total error.
-fn velocity_parts(f: &BallisticFit, c: &Crossing, level: &LevelErrors) -> [VelocityPart; 2] {
+/// Per velocity component at a crossing: the value, the fit's error with the flight's `drift` (m/s, see
+/// [`RadiusLine::centre_drift`]; for ratios, where the scale and the level's common part are propagated
+/// separately), its derivative with the level, and the total error.
+fn velocity_parts(f: &BallisticFit, c: &Crossing, level: &LevelErrors, drift: f64) -> [VelocityPart; 2] {
     let v = f.velocity(c.t.value);
     [0, 1].map(|k| {
         let (_, sv, _) = f.errors_at(k, c.t.value);
-        let stat = (sv * sv + (f.a[k] * c.t.se).powi(2)).sqrt();
+        let stat = (sv * sv + (f.a[k] * c.t.se).powi(2) + drift * drift).sqrt();
         let dv_dlevel = f.a[k] * c.dt_dlevel;
         let tilt = v[1 - k] * level.sigma_theta;
         let total =
@@ -1031,7 +1062,8 @@ struct Crossing {
 #[derive(Clone, Copy)]
 struct VelocityPart {
     value: f64,
-    /// The flight fit's standard error (its timing included, the level's and scale's errors not).
+    /// The flight's own standard error: the fit's (its timing included) and the rim's drift along it; the
+    /// level's and scale's errors not.
     stat: f64,
     /// How the value moves with the contact level (the arc's acceleration × dt/dlevel), 1/s.
     dv_dlevel: f64,

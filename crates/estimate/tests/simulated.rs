@@ -234,6 +234,36 @@ fn a_centre_offset_by_the_rim_s_shape_is_one_standard_error_of_the_contact_time(
     }
 }
 
+/// A rim whose bias grows along the incoming flight (the light on the limb changing along the path) shrinks
+/// the radius and moves the centre alike: the incoming velocity's error counts the radius's drift, so the
+/// error it makes is about one standard error, where it would be many without.
+#[test]
+fn a_rim_drifting_along_a_flight_is_in_its_velocity_s_error() {
+    let model = Model::paper(25_650.0, 14.0, 0.5);
+    let (mut track, truth) = shot(&model, 0.0, 0.3, 0.02, 5);
+    let z_in = |track: &Track| {
+        let e = estimate(track, &conditions(0.0)).unwrap();
+        (e.v_in[1].value - truth.state_in.vy) / e.v_in[1].se
+    };
+    // 20 px/s (0.3 px over the 15 ms before the touch): the centre rises and the radius shrinks together.
+    const RATE: f64 = 20.0;
+    for f in track.fixes.iter_mut().filter(|f| f.t_s < 0.014) {
+        f.y_px -= RATE * f.t_s;
+        f.r_px -= RATE * f.t_s;
+    }
+    let z = z_in(&track);
+    assert!(
+        (0.6..=1.1).contains(&z.abs()),
+        "v_in,n error/SE = {z} with the radius drifting"
+    );
+    // The same centres with a steady radius: the error is not counted.
+    for f in track.fixes.iter_mut().filter(|f| f.t_s < 0.014) {
+        f.r_px += RATE * f.t_s;
+    }
+    let z = z_in(&track);
+    assert!(z.abs() > 3.0, "v_in,n error/SE = {z} with a steady radius");
+}
+
 /// A clip whose band shows no line: the contact level comes from where the ball leaves its incoming arc and
 /// rejoins its outgoing one, and the shot is measured as well as its error says.
 #[test]
