@@ -347,9 +347,10 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
     let with_level = |c: &Crossing| Measured::new(c.t.value, c.t.se.hypot(c.dt_dlevel * level.sigma));
     let (t_touch, t_sep) = (with_level(&touch), with_level(&sep));
     // The rim's bias drifting along a flight moves its velocities by as much (see `RadiusLine`).
-    let drift = |set: &[&Point]| RadiusLine::of(set).map_or(0.0, |l| l.centre_drift() * s);
-    let vin = velocity_parts(&fin, &touch, &level, drift(&incoming));
-    let vout = velocity_parts(&fout, &sep, &level, drift(&outgoing));
+    let radius_lines = (RadiusLine::of(&incoming), RadiusLine::of(&outgoing));
+    let drift = |l: &Option<RadiusLine>| l.as_ref().map_or(0.0, |l| l.centre_drift() * s);
+    let vin = velocity_parts(&fin, &touch, &level, drift(&radius_lines.0));
+    let vout = velocity_parts(&fout, &sep, &level, drift(&radius_lines.1));
     let cor = restitution(&vin, &vout, &level);
     let mu = friction(&vin, &vout, &level);
     let contact_se =
@@ -369,7 +370,7 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
         note_gravity(g, c.incline_deg, c.gravity, &mut flags, &mut notes);
     }
     note_scatter(&fin, &fout, &mut notes);
-    let rim_change_px = rim_change(&incoming, &outgoing);
+    let rim_change_px = rim_change(&radius_lines);
     Ok(Estimate {
         v_in: vin.map(|v| Measured::new(v.value, v.total)),
         v_out: vout.map(|v| Measured::new(v.value, v.total)),
@@ -405,11 +406,11 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
     })
 }
 
-/// The change of the measured radius between the flights, px: mean outgoing − mean incoming, its standard
-/// error from each flight's scatter about a line in time (see [`RadiusLine`]); `None` when a flight holds
-/// fewer than four radii.
-fn rim_change(incoming: &[&Point], outgoing: &[&Point]) -> Option<Measured> {
-    let (i, o) = (RadiusLine::of(incoming)?, RadiusLine::of(outgoing)?);
+/// The change of the measured radius between the flights (incoming, outgoing), px: mean outgoing − mean
+/// incoming, its standard error from each flight's scatter about a line in time (see [`RadiusLine`]);
+/// `None` when a flight holds fewer than four radii.
+fn rim_change(lines: &(Option<RadiusLine>, Option<RadiusLine>)) -> Option<Measured> {
+    let (i, o) = (lines.0.as_ref()?, lines.1.as_ref()?);
     Some(Measured::new(o.mean - i.mean, (i.var_mean + o.var_mean).sqrt()))
 }
 
@@ -592,7 +593,7 @@ impl LevelErrors {
         let sigma = (line.level_sigma_px() * s)
             .hypot(radius_scale * scale.sigma_m_per_px)
             .hypot(centre);
-        let scatter_scale = (scale.sigma_m_per_px.powi(2) - scale.sigma_shape_m_per_px.powi(2))
+        let scatter_scale = (scale.sigma_m_per_px.powi(2) - scale.sigma_shape_m_per_px().powi(2))
             .max(0.0)
             .sqrt();
         let sigma_scatter = ((line.sigma_y0 * s).powi(2) + (radius_scale * scatter_scale).powi(2)).sqrt();

@@ -64,7 +64,6 @@ fn shot(model: &Model, incline_deg: f64, drop_m: f64, after: f64, seed: u64) -> 
         scale: Some(Scale {
             m_per_px: SCALE,
             sigma_m_per_px: SCALE * 2e-4,
-            sigma_shape_m_per_px: 0.0,
             rim_shape_px: 0.0,
             radius_px: r / SCALE,
             frames: 150,

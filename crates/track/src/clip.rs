@@ -101,10 +101,6 @@ pub struct Scale {
     pub m_per_px: f64,
     /// Its standard error, m/px.
     pub sigma_m_per_px: f64,
-    /// The part of `sigma_m_per_px` that is the rim shape's Type-B term, m/px (see `scale_from`): lighting
-    /// that is the same for every clip of a session gives every clip about the same radius bias, so it is
-    /// not a shot-to-shot scatter.
-    pub sigma_shape_m_per_px: f64,
     /// The rim shape's RMS, px (see `scale_from`): the Type-B standard uncertainty of the radius, and of
     /// the centre's offset common to every frame, which moves the ball's lowest point as the radius does.
     pub rim_shape_px: f64,
@@ -112,6 +108,15 @@ pub struct Scale {
     pub radius_px: f64,
     /// Frames it was measured on.
     pub frames: usize,
+}
+
+impl Scale {
+    /// The part of `sigma_m_per_px` that is the rim shape's Type-B term, m/px (see `scale_from`): lighting
+    /// that is the same for every clip of a session gives every clip about the same radius bias, so it is
+    /// not a shot-to-shot scatter.
+    pub fn sigma_shape_m_per_px(&self) -> f64 {
+        self.m_per_px * self.rim_shape_px / self.radius_px
+    }
 }
 
 /// A tracked clip.
@@ -902,7 +907,6 @@ pub(crate) fn scale_from(
         m_per_px,
         sigma_m_per_px: m_per_px * ((sd * sd / n) + edge_definition_px.powi(2) / 3.0 + rim_shape_rms_px.powi(2)).sqrt()
             / mean,
-        sigma_shape_m_per_px: m_per_px * rim_shape_rms_px / mean,
         rim_shape_px: rim_shape_rms_px,
         radius_px: mean,
         frames: radii.len(),
@@ -954,8 +958,8 @@ mod tests {
         let rel = shaped.sigma_m_per_px / shaped.m_per_px;
         assert!((rel - scatter.hypot(0.08 / 80.0)).abs() < 1e-9, "{rel}");
         // That part is named, for what is common to a session's clips.
-        assert!((shaped.sigma_shape_m_per_px / shaped.m_per_px - 0.08 / 80.0).abs() < 1e-12);
-        assert_eq!(plain.sigma_shape_m_per_px, 0.0);
+        assert!((shaped.sigma_shape_m_per_px() / shaped.m_per_px - 0.08 / 80.0).abs() < 1e-12);
+        assert_eq!(plain.sigma_shape_m_per_px(), 0.0);
     }
 
     /// A ball first sighted in frames 20 and 25 is measured in the frames before from there, backward, and the

@@ -325,8 +325,9 @@ impl Tracker {
             (self.rim_doubtful.frames() >= RIM_MIN_SAMPLES)
                 .then(|| self.rim_doubtful.shape())
                 .flatten()
+                .map(|s| s.rms_px())
         };
-        self.rim_shape().cloned().or_else(doubtful).map_or(0.0, |s| s.rms_px())
+        self.rim_shape().map(|s| s.rms_px()).or_else(doubtful).unwrap_or(0.0)
     }
 
     /// The rim's shape learned so far (see [`RimShape`](crate::RimShape)), if enough full-rim frames were seen.
