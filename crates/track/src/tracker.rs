@@ -6,7 +6,8 @@ use crate::hough::{Circle, CircleDetection};
 use crate::motion::fit_motion;
 use crate::plane::{Pixel, Plane, median};
 use crate::refine::{
-    EdgeSearch, Refined, RimShapeLearner, refine_circle_with_rays, refined_candidates, residuals_about, rim_residuals,
+    EdgeSearch, Refined, RimShapeLearner, refine_circle, refine_circle_with_rays, refined_candidates, residuals_about,
+    rim_residuals,
 };
 use crate::surface::{SurfaceLine, find_surface_lines};
 use serde::{Deserialize, Serialize};
@@ -219,6 +220,10 @@ pub(crate) const CLEAN_QUALITY: f64 = 0.85;
 /// Search half-width around a confident prediction, px.
 const CONFIDENT_HALF_WIDTH: f64 = 2.0;
 
+/// Half-width of the search that looks for the rim again when a narrow one finds it less clear than the
+/// track's recent fixes, px (see [`Tracker::wider_look`]).
+const WIDE_HALF_WIDTH: f64 = 8.0;
+
 /// Candidates within this fraction of the best support count as rivals.
 const RIVAL_SUPPORT: f64 = 0.7;
 
@@ -366,11 +371,16 @@ impl Tracker {
     /// Whether every fix the prediction is fitted to has the ball's whole disc clear of the surface line
     /// (by 2 px beyond the band's ragged reach); false while no line is known.
     fn in_flight(&self) -> bool {
+        !self.history.is_empty() && self.history.iter().all(|&(_, x, y)| self.clear_of_surface(x, y))
+    }
+
+    /// Whether a ball centred at (x, y) px has its whole disc clear of the surface line, by 2 px beyond the
+    /// band's ragged reach; false while no line is known.
+    fn clear_of_surface(&self, x: f64, y: f64) -> bool {
         let (Some(line), Some(r)) = (self.surface.as_ref(), self.expected_radius()) else {
             return false;
         };
-        let margin = 2.0 + line.ragged_reach_px();
-        !self.history.is_empty() && self.history.iter().all(|&(_, x, y)| line.height_of(x, y) > r + margin)
+        line.height_of(x, y) > r + 2.0 + line.ragged_reach_px()
     }
 
     /// [`MAX_DOWNWARD_ACCELERATION_M_S2`] in px/s², when the ball's size is known.
@@ -489,24 +499,34 @@ impl Tracker {
             beyond_window: !settled && self.opts.search.beyond_window,
             ..self.opts.search.clone()
         };
-        let max_jump = self.opts.max_jump_px.max(2.0 * self.last_innovation + 2.0);
+        let mut max_jump = self.opts.max_jump_px.max(2.0 * self.last_innovation + 2.0);
         let learning = !self.rim_frozen && self.rim.frames() < RIM_SAMPLES;
         let mut rays = std::mem::take(&mut self.rim_rays);
         rays.clear();
-        let found = match (self.predict(t_s), self.expected_radius()) {
+        let mut found = match (self.predict(t_s), self.expected_radius()) {
             (Some((px, py)), Some(r)) => {
                 let rays = learning.then_some(&mut rays);
                 refine_circle_with_rays(img, px, py, r, &search, self.surface.as_ref(), rays).map(|f| (f, px, py, r))
             }
             _ => None,
         };
+        if let Some((narrow, px, py, r)) = found
+            && half_width < WIDE_HALF_WIDTH
+            && self.in_flight()
+            && self.clear_of_surface(narrow.fit.x, narrow.fit.y)
+            && self.below_recent_quality(&narrow)
+            && let Some(better) = self.wider_look(img, &narrow, &search, learning.then_some(&mut rays))
+        {
+            found = Some((better, px, py, r));
+            max_jump = max_jump.max(WIDE_HALF_WIDTH);
+        }
         self.rim_rays = rays;
         if let Some((found, px, py, r)) = found
             && self.plausible(&found, px, py, r, max_jump)
             && self.same_rim(&found)
         {
             self.last_innovation = (found.fit.x - px).hypot(found.fit.y - py);
-            self.note_innovation(self.last_innovation);
+            self.note_innovation(self.last_innovation, (found.fit.x, found.fit.y));
             return Some(self.accept(frame, t_s, img, found, Status::Ok));
         }
         self.last_innovation = 0.0;
@@ -558,7 +578,7 @@ impl Tracker {
             .expect("non-empty");
         let chosen = cands.swap_remove(i);
         if self.missed == 0 {
-            self.note_innovation(d(&chosen));
+            self.note_innovation(d(&chosen), (chosen.1.fit.x, chosen.1.fit.y));
         }
         if rivals > 1 {
             self.warnings.push(format!(
@@ -628,8 +648,13 @@ impl Tracker {
     /// Keeps `innovation` (px, the distance of a fix from its prediction) among the recent ones; when it is
     /// far beyond them ([`CHANGE_OF_MOTION_PX`]) the motion changed (a bounce seen in few frames): the fixes
     /// before it no longer describe the path, and a fit through them would lag behind it.
-    fn note_innovation(&mut self, innovation: f64) {
-        if innovation > CHANGE_OF_MOTION_PX.max(4.0 * median(&mut self.innovations.clone())) {
+    ///
+    /// In free flight (the fixes and this one at (x, y) clear of the surface) nothing changes the motion, and
+    /// a large innovation is the fix's own error: the fixes are kept, as a fit through the last two alone
+    /// would carry that error on.
+    fn note_innovation(&mut self, innovation: f64, (x, y): (f64, f64)) {
+        let flying = self.in_flight() && self.clear_of_surface(x, y);
+        if !flying && innovation > CHANGE_OF_MOTION_PX.max(4.0 * median(&mut self.innovations.clone())) {
             let stale = self.history.len().saturating_sub(2);
             self.history.drain(..stale);
         }
@@ -637,6 +662,45 @@ impl Tracker {
         if self.innovations.len() > QUALITY_FIXES {
             self.innovations.remove(0);
         }
+    }
+
+    /// Whether `f`'s visible rim is less clear than the median of the track's recent fixes (with five
+    /// known).
+    fn below_recent_quality(&self, f: &Refined) -> bool {
+        self.qualities.len() >= 5 && f.visible_quality() < median(&mut self.qualities.clone())
+    }
+
+    /// A narrow window that drifted off the rim in free flight (onto a seam or texture inside it, while the
+    /// prediction follows the drift) cannot see the rim again: a search [`WIDE_HALF_WIDTH`] wide around `narrow`
+    /// finds it, and a narrow one from there measures it as every other frame is measured. That circle,
+    /// when its visible rim is the clearer and it lies more than half the narrow window from `narrow` (its
+    /// edge points left in `rays`); `None` otherwise (`rays` then hold `narrow`'s, untouched). Nearer, it
+    /// is the rim the narrow window already holds, and taking the other fit would only trade one reading of
+    /// a dim side for another from frame to frame. Cost: two more refinements.
+    fn wider_look<P: Pixel>(
+        &self,
+        img: &Plane<P>,
+        narrow: &Refined,
+        search: &EdgeSearch,
+        rays: Option<&mut Vec<(usize, [f64; 2])>>,
+    ) -> Option<Refined> {
+        let surface = self.surface.as_ref();
+        let r = narrow.fit.r;
+        let wide = EdgeSearch {
+            half_width: WIDE_HALF_WIDTH,
+            ..search.clone()
+        };
+        let seen = refine_circle(img, narrow.fit.x, narrow.fit.y, r, &wide, surface)?;
+        let mut own = Vec::new();
+        let again = refine_circle_with_rays(img, seen.fit.x, seen.fit.y, r, search, surface, Some(&mut own))?;
+        let moved = (again.fit.x - narrow.fit.x).hypot(again.fit.y - narrow.fit.y);
+        if moved <= 0.5 * CONFIDENT_HALF_WIDTH || again.visible_quality() <= narrow.visible_quality() {
+            return None;
+        }
+        if let Some(rays) = rays {
+            *rays = own;
+        }
+        Some(again)
     }
 
     /// Whether `f` is as clear a rim as the track's recent fixes (see [`QUALITY_DROP`]); true until five
@@ -882,5 +946,86 @@ mod tests {
         tracker.seed((0.0, 100.0, 166.0), (1e-4, 100.5, 168.0));
         let contact = tracker.max_accel_px_s2().unwrap();
         assert!((contact - MAX_BALL_ACCELERATION_M_S2 * px_per_m).abs() < 1e-6 * contact);
+    }
+
+    fn falling_tracker() -> Tracker {
+        let mut tracker = Tracker::new(TrackOptions {
+            radius_px: Some((30.0, 30.0)),
+            ball_diameter_m: Some(1.5),
+            ..TrackOptions::default()
+        });
+        tracker.set_surface(SurfaceLine::given(128.0, 400.0, 0.0));
+        tracker
+    }
+
+    /// A ball falling at 2,000 frames/s, clear of the line at y = 400 while y < 368.
+    fn fall(k: usize) -> (f64, f64, f64) {
+        let t = k as f64 * 5e-4;
+        (t, 100.0 + 600.0 * t, 100.0 + 4000.0 * t + 0.5 * 392.4 * t * t)
+    }
+
+    /// In free flight a fix far from its prediction is its own error and the fixes are kept; near the
+    /// surface it is a change of motion (a bounce) and only the last ones are.
+    #[test]
+    fn only_a_fix_near_the_surface_starts_the_motion_again() {
+        let mut tracker = falling_tracker();
+        tracker.history = (0..8).map(fall).collect();
+        tracker.note_innovation(5.0, (150.0, 150.0));
+        assert_eq!(tracker.history.len(), 8);
+        let mut tracker = falling_tracker();
+        tracker.history = (0..8).map(fall).map(|(t, x, y)| (t, x, y + 280.0)).collect();
+        tracker.note_innovation(5.0, (150.0, 380.0));
+        assert_eq!(tracker.history.len(), 2);
+    }
+
+    /// A narrow window pulled off a dim rim (its prediction 3 px to the side, onto a bright lobe inside the
+    /// ball) finds the rim again in a wider one.
+    #[test]
+    fn a_track_pulled_off_the_rim_finds_it_again() {
+        let at = |k: usize| (120.3 + 0.3 * k as f64, 90.7 + 0.8 * k as f64);
+        let frame = |k: usize| {
+            let (x, y) = at(k);
+            render(&Scene {
+                ball: (x, y, 40.0),
+                ball_level: 105.0,
+                marks: vec![(12.0, 0.0, 26.0, 250.0)],
+                noise: 2.0,
+                seed: k as u64,
+                ..Scene::default()
+            })
+        };
+        let mut tracker = Tracker::new(TrackOptions {
+            radius_px: Some((40.0, 40.0)),
+            ..TrackOptions::default()
+        });
+        let (a, b) = (at(0), at(1));
+        tracker.seed((0.0, a.0, a.1), (1e-4, b.0, b.1));
+        for k in 0..12 {
+            let px = frame(k);
+            let fix = tracker.observe(k, k as f64 * 1e-4, &Plane::new(&px, 256, 256));
+            let (x, y) = at(k);
+            assert!((fix.x_px - x).hypot(fix.y_px - y) < 0.3, "frame {k}: {fix:?}");
+        }
+        // A prediction 3 px to the right, as a track drifting along a seam's lobe would make.
+        let px = frame(12);
+        let img = Plane::new(&px, 256, 256);
+        let (x, y) = at(12);
+        let search = EdgeSearch {
+            half_width: CONFIDENT_HALF_WIDTH,
+            ..tracker.opts.search.clone()
+        };
+        let narrow = refine_circle(&img, x + 3.0, y, 40.0, &search, None).unwrap();
+        assert!(
+            (narrow.fit.x - x).abs() > 1.0,
+            "the narrow window alone stays off: {:?}",
+            narrow.fit
+        );
+        let found = tracker
+            .wider_look(&img, &narrow, &search, None)
+            .expect("the rim found again");
+        assert!((found.fit.x - x).hypot(found.fit.y - y) < 0.3, "{:?}", found.fit);
+        // On the rim, the wider look changes nothing.
+        let on_rim = refine_circle(&img, x, y, 40.0, &search, None).unwrap();
+        assert!(tracker.wider_look(&img, &on_rim, &search, None).is_none());
     }
 }
