@@ -881,6 +881,25 @@ mod tests {
         assert_eq!(line.cue, LineCue::Texture);
     }
 
+    /// Seeds `tracker` with the ball at (`at`) frames 0 and 1 (0.1 ms apart) and tracks it through the first
+    /// `frames` of `frame` (256×256), each fix within `tolerance` px of the ball.
+    fn follow(
+        tracker: &mut Tracker,
+        at: impl Fn(usize) -> (f64, f64),
+        frame: impl Fn(usize) -> Vec<u8>,
+        frames: usize,
+        tolerance: f64,
+    ) {
+        let (a, b) = (at(0), at(1));
+        tracker.seed((0.0, a.0, a.1), (1e-4, b.0, b.1));
+        for k in 0..frames {
+            let px = frame(k);
+            let fix = tracker.observe(k, k as f64 * 1e-4, &Plane::new(&px, 256, 256));
+            let (x, y) = at(k);
+            assert!((fix.x_px - x).hypot(fix.y_px - y) < tolerance, "frame {k}: {fix:?}");
+        }
+    }
+
     /// A ball sweeping across the first frames leaves no edge in their mean (no band in this scene: no line
     /// is found), since frames stop being summed once it has crossed a quarter of the frame.
     #[test]
@@ -900,14 +919,7 @@ mod tests {
             max_jump_px: 20.0,
             ..TrackOptions::default()
         });
-        let (a, b) = (at(0), at(1));
-        tracker.seed((0.0, a.0, a.1), (1e-4, b.0, b.1));
-        for k in 0..34 {
-            let img = frame(k);
-            let fix = tracker.observe(k, k as f64 * 1e-4, &Plane::new(&img, 256, 256));
-            let (x, y) = at(k);
-            assert!((fix.x_px - x).hypot(fix.y_px - y) < 0.5, "frame {k}: {fix:?}");
-        }
+        follow(&mut tracker, at, frame, 34, 0.5);
         assert!(tracker.surface().is_none(), "{:?}", tracker.surface());
     }
 
@@ -998,14 +1010,7 @@ mod tests {
             radius_px: Some((40.0, 40.0)),
             ..TrackOptions::default()
         });
-        let (a, b) = (at(0), at(1));
-        tracker.seed((0.0, a.0, a.1), (1e-4, b.0, b.1));
-        for k in 0..12 {
-            let px = frame(k);
-            let fix = tracker.observe(k, k as f64 * 1e-4, &Plane::new(&px, 256, 256));
-            let (x, y) = at(k);
-            assert!((fix.x_px - x).hypot(fix.y_px - y) < 0.3, "frame {k}: {fix:?}");
-        }
+        follow(&mut tracker, at, frame, 12, 0.3);
         // A prediction 3 px to the right, as a track drifting along a seam's lobe would make.
         let px = frame(12);
         let img = Plane::new(&px, 256, 256);
