@@ -478,7 +478,8 @@ impl Tracker {
 
     /// The ball refined around its predicted position, when that gives a plausible circle of the same rim. A
     /// confident track needs one narrow pass; the window widens when the last prediction missed (a sudden
-    /// change of motion).
+    /// change of motion), and in free flight a rim less clear than the recent ones is looked for again in a
+    /// wider one ([`Self::wider_look`]).
     fn around_prediction<P: Pixel>(&mut self, frame: usize, t_s: f64, img: &Plane<P>) -> Option<BallFix> {
         let confident = self.history.len() >= 3 && self.last_innovation < 0.5;
         let half_width = if confident {
@@ -963,7 +964,6 @@ mod tests {
     fn falling_tracker() -> Tracker {
         let mut tracker = Tracker::new(TrackOptions {
             radius_px: Some((30.0, 30.0)),
-            ball_diameter_m: Some(1.5),
             ..TrackOptions::default()
         });
         tracker.set_surface(SurfaceLine::given(128.0, 400.0, 0.0));
