@@ -665,10 +665,18 @@ impl Tracker {
         }
     }
 
-    /// Whether `f`'s visible rim is less clear than the median of the track's recent fixes (with five
-    /// known).
+    /// Whether `f`'s visible rim is not clean ([`CLEAN_QUALITY`]) and less clear than the track's recent
+    /// fixes by more than their own spread (below their median by 1.4826 median absolute deviations, a
+    /// standard deviation were they normal; with five known): a clean rim, or one that has merely drawn worse
+    /// noise, is not looked for again.
     fn below_recent_quality(&self, f: &Refined) -> bool {
-        self.qualities.len() >= 5 && f.visible_quality() < median(&mut self.qualities.clone())
+        if self.qualities.len() < 5 || f.visible_quality() >= CLEAN_QUALITY {
+            return false;
+        }
+        let mut q = self.qualities.clone();
+        let mid = median(&mut q);
+        let mut dev: Vec<f64> = q.iter().map(|v| (v - mid).abs()).collect();
+        f.visible_quality() < mid - 1.4826 * median(&mut dev)
     }
 
     /// A narrow window that drifted off the rim in free flight (onto a seam or texture inside it, while the
@@ -677,7 +685,8 @@ impl Tracker {
     /// when its visible rim is the clearer and it lies more than half the narrow window from `narrow` (its
     /// edge points left in `rays`); `None` otherwise (`rays` then hold `narrow`'s, untouched). Nearer, it
     /// is the rim the narrow window already holds, and taking the other fit would only trade one reading of
-    /// a dim side for another from frame to frame. Cost: two more refinements.
+    /// a dim side for another from frame to frame. Cost: one refinement with a window four times as wide, and
+    /// a narrow one when that lands more than a quarter of the narrow window (0.5 px) from `narrow`.
     fn wider_look<P: Pixel>(
         &self,
         img: &Plane<P>,
@@ -692,6 +701,10 @@ impl Tracker {
             ..search.clone()
         };
         let seen = refine_circle(img, narrow.fit.x, narrow.fit.y, r, &wide, surface)?;
+        // The wide window held the same rim (the common case): the narrow fit stands.
+        if (seen.fit.x - narrow.fit.x).hypot(seen.fit.y - narrow.fit.y) <= 0.25 * CONFIDENT_HALF_WIDTH {
+            return None;
+        }
         let mut own = Vec::new();
         let again = refine_circle_with_rays(img, seen.fit.x, seen.fit.y, r, search, surface, Some(&mut own))?;
         let moved = (again.fit.x - narrow.fit.x).hypot(again.fit.y - narrow.fit.y);
@@ -1080,5 +1093,48 @@ mod tests {
         let (x, y) = at(21);
         assert_eq!(fix.status, Status::Ok, "{fix:?}");
         assert!((fix.x_px - x).hypot(fix.y_px - y) < 0.3, "{fix:?}");
+    }
+
+    /// A fix kept `inliers` of 128 rays at full contrast: its visible quality is `inliers`/128.
+    fn fix_keeping(inliers: usize) -> Refined {
+        Refined {
+            fit: crate::circle_fit::CircleFit {
+                x: 100.0,
+                y: 100.0,
+                r: 40.0,
+                sigma_x: 0.01,
+                sigma_y: 0.01,
+                sigma_r: 0.01,
+                rms: 0.05,
+                inliers,
+            },
+            rays_with_edge: 128,
+            rays_outside: 0,
+            rays_hidden: 0,
+            rays: 128,
+            contrast: 20.0,
+            edge_definition_px: f64::NAN,
+        }
+    }
+
+    /// The wider look is for a rim that is neither clean nor within the recent fixes' own spread of
+    /// quality.
+    #[test]
+    fn only_a_rim_clearly_worse_than_the_recent_ones_is_looked_for_again() {
+        let mut tracker = falling_tracker();
+        // Recent qualities 0.70–0.80 (median 0.75, spread 1.4826 × 0.03 ≈ 0.044).
+        tracker.qualities = [0.72, 0.75, 0.78, 0.70, 0.80, 0.75, 0.74, 0.76].to_vec();
+        assert!(tracker.below_recent_quality(&fix_keeping(77)), "0.60");
+        assert!(
+            !tracker.below_recent_quality(&fix_keeping(93)),
+            "0.73: within the spread"
+        );
+        // Below a clean track's median, but clean itself.
+        tracker.qualities = vec![1.0; 8];
+        assert!(!tracker.below_recent_quality(&fix_keeping(115)), "0.90");
+        assert!(tracker.below_recent_quality(&fix_keeping(100)), "0.78");
+        // Too few recent fixes to judge by.
+        tracker.qualities = vec![1.0; 4];
+        assert!(!tracker.below_recent_quality(&fix_keeping(64)));
     }
 }
