@@ -553,9 +553,10 @@ impl Tracker {
         let Some((px, py)) = self.predict_after_gap(t_s) else {
             return self.first_sighting(frame, t_s, img, cands);
         };
-        // Only a circle where the ball can be continues the track: within half a radius of the prediction,
-        // and further by the ground the ball covers per frame for every frame it has been missed (a bounce or
-        // a turn unseen). Anything else is another object, and the frame is absent, never `ok`.
+        // Only a circle of the ball's size where the ball can be continues the track: within half a radius
+        // of the prediction, and further by the ground the ball covers per frame for every frame it has been
+        // missed (a bounce or a turn unseen). Anything else is another object (or a circle inside the ball,
+        // as a pressed ball's part-hidden rim gives), and the frame is absent, never `ok`.
         let r_expected = self.expected_radius().unwrap_or(0.5 * (lo + hi));
         let gate = 0.5 * r_expected + (2.0 * self.speed_px_per_s() * self.frame_period() + 1.0) * self.missed as f64;
         let d = |c: &(Circle, Refined)| (c.1.fit.x - px).hypot(c.1.fit.y - py);
