@@ -374,6 +374,12 @@ impl Tracker {
         !self.history.is_empty() && self.history.iter().all(|&(_, x, y)| self.clear_of_surface(x, y))
     }
 
+    /// Whether a fix at (x, y) px continues free flight: the fixes the prediction is fitted to and this one
+    /// all clear of the surface ([`Self::in_flight`], [`Self::clear_of_surface`]).
+    fn flying_at(&self, x: f64, y: f64) -> bool {
+        self.in_flight() && self.clear_of_surface(x, y)
+    }
+
     /// Whether a ball centred at (x, y) px has its whole disc clear of the surface line, by 2 px beyond the
     /// band's ragged reach; false while no line is known.
     fn clear_of_surface(&self, x: f64, y: f64) -> bool {
@@ -513,8 +519,7 @@ impl Tracker {
         };
         if let Some((narrow, px, py, r)) = found
             && half_width < WIDE_HALF_WIDTH
-            && self.in_flight()
-            && self.clear_of_surface(narrow.fit.x, narrow.fit.y)
+            && self.flying_at(narrow.fit.x, narrow.fit.y)
             && self.below_recent_quality(&narrow)
             && let Some(better) = self.wider_look(img, &narrow, &search, learning.then_some(&mut rays))
         {
@@ -655,8 +660,7 @@ impl Tracker {
     /// a large innovation is the fix's own error: the fixes are kept, as a fit through the last two alone
     /// would carry that error on.
     fn note_innovation(&mut self, innovation: f64, (x, y): (f64, f64)) {
-        let flying = self.in_flight() && self.clear_of_surface(x, y);
-        if !flying && innovation > CHANGE_OF_MOTION_PX.max(4.0 * median(&mut self.innovations.clone())) {
+        if !self.flying_at(x, y) && innovation > CHANGE_OF_MOTION_PX.max(4.0 * median(&mut self.innovations.clone())) {
             let stale = self.history.len().saturating_sub(2);
             self.history.drain(..stale);
         }
