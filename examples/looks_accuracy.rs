@@ -2,8 +2,9 @@
 //
 //! The tracker and estimator on many looks (default: the `looks` preset, 64 shots, rendered into a temporary
 //! folder): a Markdown table per clip and one per look family (frames found, centre RMS in flight and
-//! contact, contact level error, COR and μ errors), and one per contact-line cue (the level against its stated
-//! standard error). The figures in `docs/accuracy.md` ("Many looks") come
+//! contact, the clip's constant offset in flight and the RMS about it, contact level error, COR and μ
+//! errors), one per contact-line cue (the level against its stated standard error), and one for COR and μ
+//! against their stated standard errors. The figures in `docs/accuracy.md` ("Many looks") come
 //! from this command. `--line plane` gives each clip the truth's surface plane as its contact line (as a lab
 //! gives a line it measured): the errors left are the tracker's and the estimator's alone. `--line
 //! drawn-edge` gives it the least-squares line through the band's edge as drawn (`truth/edges.csv`): the
@@ -30,4 +31,5 @@ fn main() {
     println!("{}", looks::clip_table(&results));
     println!("{}", looks::family_table(&results));
     println!("{}", looks::level_table(&results));
+    println!("{}", looks::se_table(&results));
 }

@@ -23,6 +23,13 @@ pub struct ClipResult {
     pub frames_wrong: usize,
     /// Centre RMS error in flight and in contact, px (the clip's constant offset included).
     pub centre_rms_px: (f64, f64),
+    /// The clip's constant offset: the mean centre error (x, y) in flight, px. On a lit ball the shading
+    /// runs into the rim on its dark side, whose edge is then found off the silhouette, so the whole track
+    /// sits off along the light's axis. A constant offset moves no velocity; it moves where the ball's bottom
+    /// stands against the line.
+    pub flight_offset_px: (f64, f64),
+    /// Centre RMS error in flight about that offset, px: what the frame-to-frame measurement adds.
+    pub flight_rms_about_offset_px: f64,
     /// Why the shot could not be measured, if it could not.
     pub failure: Option<String>,
     /// Contact line used (its cue), its level error at the truth's column, px (measured − truth, + down), and
@@ -133,6 +140,8 @@ fn evaluate_clip(
         frames_found: (0, 0),
         frames_wrong: 0,
         centre_rms_px: (f64::NAN, f64::NAN),
+        flight_offset_px: (f64::NAN, f64::NAN),
+        flight_rms_about_offset_px: f64::NAN,
         failure: None,
         level: None,
         cor: None,
@@ -168,6 +177,7 @@ fn evaluate_clip(
     };
     let frames = read_csv(&truth_dir.join(format!("{name}.csv")));
     let (mut flight, mut contact) = (Vec::new(), Vec::new());
+    let mut flight_xy = Vec::new();
     let mut visible = 0;
     for (f, t) in track.fixes.iter().zip(&frames) {
         if t["visible"] != "full" {
@@ -177,18 +187,27 @@ fn evaluate_clip(
         if !matches!(f.status, Status::Ok | Status::Occluded) {
             continue;
         }
-        let e = (f.x_px - num(t, "x_px")).hypot(f.y_px - num(t, "y_px"));
+        let (ex, ey) = (f.x_px - num(t, "x_px"), f.y_px - num(t, "y_px"));
+        let e = ex.hypot(ey);
         if e > 1.0 {
             result.frames_wrong += 1;
         }
         if t["phase"] == "flight" {
             flight.push(e);
+            flight_xy.push((ex, ey));
         } else {
             contact.push(e);
         }
     }
     result.frames_found = (flight.len() + contact.len(), visible);
     result.centre_rms_px = (rms(&flight), rms(&contact));
+    if !flight_xy.is_empty() {
+        let n = flight_xy.len() as f64;
+        let (mx, my) = flight_xy.iter().fold((0.0, 0.0), |a, e| (a.0 + e.0 / n, a.1 + e.1 / n));
+        result.flight_offset_px = (mx, my);
+        let about: Vec<f64> = flight_xy.iter().map(|e| (e.0 - mx).hypot(e.1 - my)).collect();
+        result.flight_rms_about_offset_px = rms(&about);
+    }
     let conditions = Conditions {
         incline_deg: entry.angle_deg,
         gravity: 9.81,
@@ -226,17 +245,20 @@ fn evaluate_clip(
 /// One Markdown table row per clip.
 pub fn clip_table(results: &[ClipResult]) -> String {
     let mut s = String::from(
-        "| clip | frames found | wrong | flight RMS px | contact RMS px | line | level err px | COR err | μ err | tilt err ° | failure |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| clip | frames found | wrong | flight RMS px | flight offset px | about it px | contact RMS px | line | level err px | COR err | μ err | tilt err ° | failure |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in results {
         let f = |v: Option<f64>, d: usize| v.map_or("–".to_string(), |v| format!("{v:+.d$}"));
         s += &format!(
-            "| {} | {}/{} | {} | {:.3} | {:.3} | {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {}/{} | {} | {:.3} | ({:+.2}, {:+.2}) | {:.3} | {:.3} | {} | {} | {} | {} | {} | {} |\n",
             r.clip,
             r.frames_found.0,
             r.frames_found.1,
             r.frames_wrong,
             r.centre_rms_px.0,
+            r.flight_offset_px.0,
+            r.flight_offset_px.1,
+            r.flight_rms_about_offset_px,
             r.centre_rms_px.1,
             r.level.as_ref().map_or("–".into(), |l| l.0.clone()),
             r.level
@@ -253,8 +275,9 @@ pub fn clip_table(results: &[ClipResult]) -> String {
 }
 
 /// One Markdown table row per look family: clips, shots lost (no estimate), shots flagged (an estimate the
-/// estimator says not to trust), frames found, the frames on another object, centre RMS in flight and
-/// contact, contact level RMS error, and COR and μ RMS and worst error over the shots estimated without a
+/// estimator says not to trust), frames found, the frames on another object, centre RMS in flight (and
+/// about each clip's constant offset, see [`ClipResult::flight_offset_px`]) and in contact, contact level
+/// RMS error, and COR and μ RMS and worst error over the shots estimated without a
 /// flag.
 pub fn family_table(results: &[ClipResult]) -> String {
     let mut fams: BTreeMap<String, Vec<&ClipResult>> = BTreeMap::new();
@@ -265,7 +288,7 @@ pub fn family_table(results: &[ClipResult]) -> String {
         fams.entry("(all)".into()).or_default().push(r);
     }
     let mut s = String::from(
-        "| family | clips | lost | flagged | frames found | on another object | flight RMS px | contact RMS px | level RMS px | COR RMS / worst | μ RMS / worst |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| family | clips | lost | flagged | frames found | on another object | flight RMS px | about offsets px | contact RMS px | level RMS px | COR RMS / worst | μ RMS / worst |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for (fam, rs) in &fams {
         let flagged = |r: &&&ClipResult| r.failure.as_deref().is_some_and(|f| f.starts_with("flagged"));
@@ -280,10 +303,11 @@ pub fn family_table(results: &[ClipResult]) -> String {
         let mu: Vec<f64> = trusted().filter_map(|r| r.mu.map(|c| c.0 - c.2)).collect();
         let worst = |v: &[f64]| v.iter().fold(0.0f64, |a, b| a.max(b.abs()));
         s += &format!(
-            "| {fam} | {} | {lost} | {} | {found}/{vis} | {wrong} | {:.3} | {:.3} | {:.2} | {:.4} / {:.4} | {:.4} / {:.4} |\n",
+            "| {fam} | {} | {lost} | {} | {found}/{vis} | {wrong} | {:.3} | {:.3} | {:.3} | {:.2} | {:.4} / {:.4} | {:.4} / {:.4} |\n",
             rs.len(),
             rs.iter().filter(flagged).count(),
             rms(&all(|r| r.centre_rms_px.0)),
+            rms(&all(|r| r.flight_rms_about_offset_px)),
             rms(&all(|r| r.centre_rms_px.1)),
             rms(&rs
                 .iter()
@@ -293,6 +317,28 @@ pub fn family_table(results: &[ClipResult]) -> String {
             worst(&cor),
             rms(&mu),
             worst(&mu),
+        );
+    }
+    s
+}
+
+/// One Markdown table row for COR and one for μ over the shots estimated without a flag: shots, RMS error,
+/// RMS of error/SE (1 when the stated standard errors are honest) and the shots more than 3 SE off.
+pub fn se_table(results: &[ClipResult]) -> String {
+    let mut s = String::from("| estimate | shots | RMS error | RMS error/SE | beyond 3 SE |\n|---|---|---|---|---|\n");
+    let trusted = || results.iter().filter(|r| r.failure.is_none());
+    for (name, values) in [
+        ("COR", trusted().filter_map(|r| r.cor).collect::<Vec<_>>()),
+        ("μ_eff", trusted().filter_map(|r| r.mu).collect()),
+    ] {
+        let errs: Vec<f64> = values.iter().map(|(v, _, t)| v - t).collect();
+        let z: Vec<f64> = values.iter().map(|(v, se, t)| (v - t) / se).collect();
+        s += &format!(
+            "| {name} | {} | {:.4} | {:.2} | {} |\n",
+            values.len(),
+            rms(&errs),
+            rms(&z),
+            z.iter().filter(|z| z.abs() > 3.0).count()
         );
     }
     s

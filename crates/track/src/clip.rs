@@ -282,6 +282,7 @@ pub fn track_clip(
     backward.surface = tracker.surface().copied();
     backward.retrack_start(&mut fixes, &mut warnings)?;
     backward.retrack_end(&mut fixes, noise, &mut warnings)?;
+    backward.retrack_bounce(&mut fixes, &tracker, &mut warnings)?;
     let measured = fixes.iter().filter(|f| f.status.measured()).count();
     if forward.saturated > 0 {
         warnings.push(format!(
@@ -508,6 +509,39 @@ impl Backward<'_> {
                 fixes[settled].frame
             ));
         }
+        Ok(())
+    }
+
+    /// The frames after the bounce that the forward track may have measured off the ball, measured again
+    /// backward ([`retrack_bounce`]); what was replaced is said.
+    fn retrack_bounce(
+        &self,
+        fixes: &mut [BallFix],
+        forward: &Tracker,
+        warnings: &mut Vec<String>,
+    ) -> Result<(), TrackError> {
+        let before = fixes.to_vec();
+        let Some(span) = retrack_bounce(fixes, forward, |tr, k, frame, t| self.measure(tr, k, frame, t))? else {
+            return Ok(());
+        };
+        if span.replaced == 0 {
+            return Ok(());
+        }
+        let moved: Vec<f64> = before
+            .iter()
+            .zip(fixes.iter())
+            .filter(|(a, b)| a.status.measured() && a != b)
+            .map(|(a, b)| (a.x_px - b.x_px).hypot(a.y_px - b.y_px))
+            .collect();
+        let unmeasured = span.replaced - moved.len();
+        warnings.push(format!(
+            "frame {}: {} of the {} frames from the bounce's lowest point to the clean flight after it re-measured by tracking backward from that flight ({unmeasured} not measured by the forward track, {} moved by up to {:.1} px)",
+            fixes[span.lowest].frame,
+            span.replaced,
+            span.settled - span.lowest,
+            moved.len(),
+            moved.iter().fold(0.0f64, |a, &b| a.max(b)),
+        ));
         Ok(())
     }
 
@@ -776,6 +810,49 @@ fn retrack_start(
     back.seed((-a.t_s, a.x_px, a.y_px), (-b.t_s, b.x_px, b.y_px));
     let replaced = track_back(fixes, back, settled, measure, clearer)?;
     Ok(Some((settled, replaced)))
+}
+
+/// What [`retrack_bounce`] measured again: the files from `lowest` up to `settled`, `replaced` of them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Retracked {
+    lowest: usize,
+    settled: usize,
+    replaced: usize,
+}
+
+/// The frames after the bounce that the forward track may have measured off the ball
+/// ([`crate::bounce::after_bounce`]), measured again backward in time from the clean flight after them by
+/// a fresh tracker that reads the rim as `forward` does ([`Tracker::fresh_on_same_rim`]), seeded by that
+/// flight's first two fixes; `measure(back, k, frame, −t)` measures file `k`. Where the two passes disagree
+/// a frame takes the backward fix as [`crate::bounce::back_replaces`] says. `None` when there is nothing to
+/// measure again (no line, no bounce, or a bounce the forward track held cleanly).
+fn retrack_bounce(
+    fixes: &mut [BallFix],
+    forward: &Tracker,
+    mut measure: impl FnMut(&mut Tracker, usize, usize, f64) -> Result<BallFix, TrackError>,
+) -> Result<Option<Retracked>, TrackError> {
+    let Some(line) = forward.surface() else {
+        return Ok(None);
+    };
+    let Some(span) = crate::bounce::after_bounce(fixes, line) else {
+        return Ok(None);
+    };
+    let (lowest, settled) = (span.lowest, span.settled);
+    let mut back = forward.fresh_on_same_rim();
+    let (a, b) = (fixes[settled + 1], fixes[settled]);
+    back.seed((-a.t_s, a.x_px, a.y_px), (-b.t_s, b.x_px, b.y_px));
+    let replaced = track_back(
+        &mut fixes[lowest..],
+        &mut back,
+        settled - lowest,
+        |tr, k, frame, t| measure(tr, lowest + k, frame, t),
+        |back, forward| crate::bounce::back_replaces(line, back, forward),
+    )?;
+    Ok(Some(Retracked {
+        lowest,
+        settled,
+        replaced,
+    }))
 }
 
 /// Whether a fix measured on another pass replaces `old`: `old` is not measured, or is a clearly weaker
@@ -1063,6 +1140,78 @@ mod tests {
             None
         );
         assert_eq!(fixes, before);
+    }
+
+    /// A ball pressed 3 px into a band whose top is at y = 200 at frame 10, rising again after it (px).
+    fn bouncing_at(k: usize) -> (f64, f64) {
+        let t = k as f64 - 10.0;
+        (80.3 + 3.0 * k as f64, 163.0 - 0.6 * t * t)
+    }
+
+    fn bounce_frame(k: usize) -> Vec<u8> {
+        render(&Scene {
+            ball: (bouncing_at(k).0, bouncing_at(k).1, 40.0),
+            surface: Some((200.0, 0.0)),
+            seed: k as u64,
+            ..Scene::default()
+        })
+    }
+
+    #[test]
+    fn frames_after_the_bounce_measured_off_the_ball_are_measured_again_backward() {
+        let mut forward = Tracker::new(TrackOptions {
+            radius_px: Some((34.0, 46.0)),
+            ..TrackOptions::default()
+        });
+        forward.set_surface(SurfaceLine::given(128.0, 200.0, 0.0));
+        let measure = |tr: &mut Tracker, k: usize, frame: usize, t: f64| {
+            Ok(tr.observe(frame, t, &Plane::new(&bounce_frame(k), 256, 256)))
+        };
+        let mut fixes: Vec<BallFix> = (0..24)
+            .map(|k| measure(&mut forward, k, k, k as f64 * 1e-4).unwrap())
+            .collect();
+        let on_path = |f: &BallFix, k: usize| {
+            let (x, y) = bouncing_at(k);
+            (f.x_px - x).hypot(f.y_px - y)
+        };
+        for (k, f) in fixes.iter().enumerate() {
+            assert!(
+                f.status == Status::Ok && on_path(f, k) < 0.2,
+                "forward frame {k}: {f:?}"
+            );
+        }
+        // The forward track held the bounce: nothing is measured again.
+        let held = fixes.clone();
+        assert_eq!(
+            retrack_bounce(&mut fixes, &forward, |_, _, _, _| unreachable!()).unwrap(),
+            None
+        );
+        assert_eq!(fixes, held);
+        // Frames 13-15 (the ball clear of the band from frame 13) as if the forward prediction had carried
+        // the contact's push on: 5 px ahead of the ball, a weak circle, one frame lost.
+        for (k, f) in fixes.iter_mut().enumerate().take(16).skip(13) {
+            if k == 14 {
+                *f = BallFix::absent(k, f.t_s, Status::Absent);
+            } else {
+                f.y_px -= 5.0;
+                f.quality = 0.5;
+            }
+        }
+        let out = retrack_bounce(&mut fixes, &forward, measure).unwrap();
+        assert_eq!(
+            out,
+            Some(Retracked {
+                lowest: 10,
+                settled: 16,
+                replaced: 3
+            })
+        );
+        for (k, f) in fixes.iter().enumerate() {
+            assert!(on_path(f, k) < 0.2, "frame {k}: {f:?}");
+            assert_eq!(f.t_s, k as f64 * 1e-4);
+        }
+        // The frames where the passes agree keep the forward fix.
+        assert_eq!(fixes[..13], held[..13]);
     }
 
     /// Fixes of a ball on the path `ball_at` (quality `q`), every frame measured.

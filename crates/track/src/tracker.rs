@@ -288,6 +288,23 @@ impl Tracker {
         self.history = vec![a, b];
     }
 
+    /// A tracker with no history that reads the ball as this one now does: on its surface line, with the
+    /// rim's shape it learned (and learning no more), and the flight radius and recent qualities it saw. A
+    /// pass over frames this one already measured (backward in time) then reads each rim the same way, not
+    /// with a rim it has had no free flight to learn.
+    pub fn fresh_on_same_rim(&self) -> Tracker {
+        Tracker {
+            qualities: self.qualities.clone(),
+            flight_radii: self.flight_radii.clone(),
+            flight_edges: self.flight_edges.clone(),
+            rim_frozen: true,
+            surface: self.surface,
+            surface_alternatives: self.surface_alternatives.clone(),
+            surface_tries: SURFACE_TRIES,
+            ..Tracker::new(self.opts.clone())
+        }
+    }
+
     /// Uses `line` as the surface instead of finding it.
     pub fn set_surface(&mut self, line: SurfaceLine) {
         self.surface = Some(line);
