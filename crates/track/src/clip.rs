@@ -520,28 +520,19 @@ impl Backward<'_> {
         forward: &Tracker,
         warnings: &mut Vec<String>,
     ) -> Result<(), TrackError> {
-        let before = fixes.to_vec();
         let Some(span) = retrack_bounce(fixes, forward, |tr, k, frame, t| self.measure(tr, k, frame, t))? else {
             return Ok(());
         };
-        if span.replaced == 0 {
-            return Ok(());
+        if span.replaced > 0 {
+            warnings.push(format!(
+                "frame {}: {} of the {} frames from the bounce's lowest point to the clean flight after it re-measured by tracking backward from that flight ({} not measured by the forward track, the others moved by up to {:.1} px)",
+                fixes[span.lowest].frame,
+                span.replaced,
+                span.settled - span.lowest,
+                span.unmeasured,
+                span.moved_px,
+            ));
         }
-        let moved: Vec<f64> = before
-            .iter()
-            .zip(fixes.iter())
-            .filter(|(a, b)| a.status.measured() && a != b)
-            .map(|(a, b)| (a.x_px - b.x_px).hypot(a.y_px - b.y_px))
-            .collect();
-        let unmeasured = span.replaced - moved.len();
-        warnings.push(format!(
-            "frame {}: {} of the {} frames from the bounce's lowest point to the clean flight after it re-measured by tracking backward from that flight ({unmeasured} not measured by the forward track, {} moved by up to {:.1} px)",
-            fixes[span.lowest].frame,
-            span.replaced,
-            span.settled - span.lowest,
-            moved.len(),
-            moved.iter().fold(0.0f64, |a, &b| a.max(b)),
-        ));
         Ok(())
     }
 
@@ -812,12 +803,15 @@ fn retrack_start(
     Ok(Some((settled, replaced)))
 }
 
-/// What [`retrack_bounce`] measured again: the files from `lowest` up to `settled`, `replaced` of them.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// What [`retrack_bounce`] measured again: the files from `lowest` up to `settled`, `replaced` of them,
+/// `unmeasured` of those not measured by the forward track, the others moved by up to `moved_px`.
+#[derive(Debug, Clone, Copy, PartialEq)]
 struct Retracked {
     lowest: usize,
     settled: usize,
     replaced: usize,
+    unmeasured: usize,
+    moved_px: f64,
 }
 
 /// The frames after the bounce that the forward track may have measured off the ball
@@ -841,17 +835,29 @@ fn retrack_bounce(
     let mut back = forward.fresh_on_same_rim();
     let (a, b) = (fixes[settled + 1], fixes[settled]);
     back.seed((-a.t_s, a.x_px, a.y_px), (-b.t_s, b.x_px, b.y_px));
+    let mut unmeasured = 0;
+    let mut moved_px = 0.0f64;
     let replaced = track_back(
         &mut fixes[lowest..],
         &mut back,
         settled - lowest,
         |tr, k, frame, t| measure(tr, lowest + k, frame, t),
-        |back, forward| crate::bounce::back_replaces(line, back, forward),
+        |back, forward| {
+            let takes = crate::bounce::back_replaces(line, back, forward);
+            if takes && forward.status.measured() {
+                moved_px = moved_px.max((back.x_px - forward.x_px).hypot(back.y_px - forward.y_px));
+            } else if takes {
+                unmeasured += 1;
+            }
+            takes
+        },
     )?;
     Ok(Some(Retracked {
         lowest,
         settled,
         replaced,
+        unmeasured,
+        moved_px,
     }))
 }
 
@@ -888,7 +894,7 @@ fn track_back(
     back: &mut Tracker,
     start: usize,
     mut measure: impl FnMut(&mut Tracker, usize, usize, f64) -> Result<BallFix, TrackError>,
-    takes: impl Fn(&BallFix, &BallFix) -> bool,
+    mut takes: impl FnMut(&BallFix, &BallFix) -> bool,
 ) -> Result<usize, TrackError> {
     let mut replaced = 0;
     for k in (0..start).rev() {
@@ -1197,15 +1203,9 @@ mod tests {
                 f.quality = 0.5;
             }
         }
-        let out = retrack_bounce(&mut fixes, &forward, measure).unwrap();
-        assert_eq!(
-            out,
-            Some(Retracked {
-                lowest: 10,
-                settled: 16,
-                replaced: 3
-            })
-        );
+        let out = retrack_bounce(&mut fixes, &forward, measure).unwrap().unwrap();
+        assert_eq!((out.lowest, out.settled, out.replaced, out.unmeasured), (10, 16, 3, 1));
+        assert!((out.moved_px - 5.0).abs() < 0.3, "{out:?}");
         for (k, f) in fixes.iter().enumerate() {
             assert!(on_path(f, k) < 0.2, "frame {k}: {f:?}");
             assert_eq!(f.t_s, k as f64 * 1e-4);
