@@ -10,14 +10,14 @@
 //! frames from free flight, as the forward pass predicts the compression from the incoming flight. So the
 //! frames from the lowest point to the first clean run after it are measured again backward, and in the
 //! frames where the ball is clear of the surface and the two passes disagree the backward fix is kept; in
-//! contact, where both passes predicted from a push, the clearer of the two. Cost: O(n) over the fixes; the pass itself runs only when
-//! the forward track was not clean from where the ball cleared the surface.
+//! contact, where both passes predicted from a push, the clearer of the two. Cost: O(n) over the fixes;
+//! the pass itself runs only when the forward track was not clean from where the ball cleared the surface.
 
 use crate::surface::SurfaceLine;
 use crate::tracker::{BallFix, CLEAN_QUALITY, Status};
 
 /// Consecutive clean flight fixes after the bounce from which the backward pass starts.
-pub(crate) const SETTLED_AFTER_BOUNCE: usize = 5;
+const SETTLED_AFTER_BOUNCE: usize = 5;
 
 /// The frames after a bounce to measure again: from `lowest` (the measured fix nearest the surface, in
 /// contact) up to, not including, `settled` (the first of [`SETTLED_AFTER_BOUNCE`] clean fixes clear of the
@@ -76,7 +76,7 @@ pub(crate) fn after_bounce(fixes: &[BallFix], line: &SurfaceLine) -> Option<Afte
 /// readings (0.3–0.6 px seen on the independent renderer's clips at their full rate), and neither is the
 /// better there; a pass that has left the ball is pixels away (1.9–10.5 px seen after a bounce at
 /// 2,000 fps).
-pub(crate) const SAME_CIRCLE_PX: f64 = 1.0;
+const SAME_CIRCLE_PX: f64 = 1.0;
 
 /// Whether the fix `back` of the backward pass replaces the forward pass's `forward` after the bounce on
 /// `line`: the forward frame was not measured, or the two are not the same circle (centres further apart
