@@ -23,9 +23,9 @@ pub struct ClipResult {
     pub frames_wrong: usize,
     /// Centre RMS error in flight and in contact, px (the clip's constant offset included).
     pub centre_rms_px: (f64, f64),
-    /// The clip's constant offset: the mean centre error (x, y) in flight, px. On a lit ball the shading
-    /// runs into the rim on its dark side, whose edge is then found off the silhouette, so the whole track
-    /// sits off along the light's axis. A constant offset moves no velocity; it moves where the ball's bottom
+    /// The clip's constant offset: the mean centre error (x, y) in flight, px. On the `looks` preset's lit
+    /// balls it lies along the light's axis (the shaded side's edge found off the silhouette, see
+    /// `docs/accuracy.md`). A constant offset moves no velocity; it moves where the ball's bottom
     /// stands against the line.
     pub flight_offset_px: (f64, f64),
     /// Centre RMS error in flight about that offset, px: what the frame-to-frame measurement adds.
@@ -176,8 +176,7 @@ fn evaluate_clip(
         }
     };
     let frames = read_csv(&truth_dir.join(format!("{name}.csv")));
-    let (mut flight, mut contact) = (Vec::new(), Vec::new());
-    let mut flight_xy = Vec::new();
+    let (mut flight_xy, mut contact) = (Vec::new(), Vec::new());
     let mut visible = 0;
     for (f, t) in track.fixes.iter().zip(&frames) {
         if t["visible"] != "full" {
@@ -193,12 +192,12 @@ fn evaluate_clip(
             result.frames_wrong += 1;
         }
         if t["phase"] == "flight" {
-            flight.push(e);
             flight_xy.push((ex, ey));
         } else {
             contact.push(e);
         }
     }
+    let flight: Vec<f64> = flight_xy.iter().map(|e| e.0.hypot(e.1)).collect();
     result.frames_found = (flight.len() + contact.len(), visible);
     result.centre_rms_px = (rms(&flight), rms(&contact));
     if !flight_xy.is_empty() {

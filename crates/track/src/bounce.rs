@@ -28,10 +28,10 @@ pub(crate) struct AfterBounce {
     pub settled: usize,
 }
 
-/// Whether a ball at `fix` has its whole disc clear of `line` by 2 px beyond the band's ragged reach (the
-/// tracker's own test for free flight).
+/// Whether `fix` is measured and its disc clear of `line` ([`SurfaceLine::clears_disc`], the tracker's own
+/// test for free flight).
 fn clear_of(line: &SurfaceLine, fix: &BallFix) -> bool {
-    fix.status.measured() && line.height_of(fix.x_px, fix.y_px) > fix.r_px + 2.0 + line.ragged_reach_px()
+    fix.status.measured() && line.clears_disc(fix.x_px, fix.y_px, fix.r_px)
 }
 
 /// The frames after the clip's bounce that the forward track may have measured off the ball: `None` when

@@ -124,6 +124,12 @@ impl SurfaceLine {
         (self.sigma_y0.powi(2) + self.edge_definition_px.powi(2) / 3.0).sqrt()
     }
 
+    /// Whether a disc centred at (x, y) with radius `r` px lies wholly above the line by 2 px beyond the
+    /// band's ragged reach ([`Self::ragged_reach_px`]): a ball in free flight, clear of the surface.
+    pub fn clears_disc(&self, x: f64, y: f64, r: f64) -> bool {
+        self.height_of(x, y) > r + 2.0 + self.ragged_reach_px()
+    }
+
     /// How far above the line the band's ragged edge may reach, px: twice its roughness beyond the
     /// pixel of scatter any measured edge has (0 for a clean edge).
     pub fn ragged_reach_px(&self) -> f64 {

@@ -403,7 +403,7 @@ impl Tracker {
         let (Some(line), Some(r)) = (self.surface.as_ref(), self.expected_radius()) else {
             return false;
         };
-        line.height_of(x, y) > r + 2.0 + line.ragged_reach_px()
+        line.clears_disc(x, y, r)
     }
 
     /// [`MAX_DOWNWARD_ACCELERATION_M_S2`] in px/s², when the ball's size is known.
