@@ -75,8 +75,9 @@ pub(crate) fn session_key(session: &Session) -> String {
 /// 7: a ball first sighted late followed back from its sighting, a doubtful circle giving way to a clearer one
 /// inside it; 8: the flights' and the onset's errors counting the residuals' correlation, an onset at the
 /// edge of its window only bounded, the radius's change between the flights; 9: a track that left the ball
-/// taken over by a pass tracked back from the clip's end).
-const MEASUREMENT_REVISION: u32 = 9;
+/// taken over by a pass tracked back from the clip's end; 10: the frames after a bounce measured again
+/// backward, a found line's level measured again from the band's mean gray).
+const MEASUREMENT_REVISION: u32 = 10;
 
 /// Everything besides the frame files that changes a shot's track or estimate.
 fn settings_text(entry: &ClipEntry, gravity: f64) -> String {

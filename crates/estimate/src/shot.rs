@@ -946,6 +946,7 @@ impl TrajectoryView {
             edge_definition_px: 0.0,
             roughness_px: 0.0,
             cue: LineCue::Trajectory,
+            level_shift_px: 0.0,
             ..axis
         }
     }

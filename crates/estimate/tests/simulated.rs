@@ -60,6 +60,7 @@ fn shot(model: &Model, incline_deg: f64, drop_m: f64, after: f64, seed: u64) -> 
             edge_definition_px: 0.0,
             roughness_px: 0.0,
             cue: Default::default(),
+            level_shift_px: 0.0,
         }),
         scale: Some(Scale {
             m_per_px: SCALE,

@@ -7,10 +7,13 @@
 //! clip's start, frames 0–32 from a fresh tracker: the cold start, then the frames while the surface line is
 //! looked for in the mean of the first 2 (the ball is known from the second frame), 8 and 32 frames. "cold_start_first_frame": the first frame of a
 //! clip without a track (Hough, refined candidates). "surface_line": one surface line search.
+//! "surface_level_by_mean_gray": the found line's level measured again from the band's mean gray.
 //! "detect_full_frame": the Hough transform alone.
 
 use bouncelab_track::testutil::{Scene, render};
-use bouncelab_track::{CircleDetection, Plane, TrackOptions, Tracker, detect_circles, find_surface_lines};
+use bouncelab_track::{
+    CircleDetection, Plane, TrackOptions, Tracker, detect_circles, find_surface_lines, mean_gray_level,
+};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
 
@@ -75,6 +78,12 @@ fn bench(c: &mut Criterion) {
     g.bench_function("surface_line", |b| {
         b.iter(|| black_box(find_surface_lines(&Plane::new(&frames[1], 512, 512), ball)))
     });
+    let plane = Plane::new(&frames[1], 512, 512);
+    if let Some(lines) = find_surface_lines(&plane, ball) {
+        g.bench_function("surface_level_by_mean_gray", |b| {
+            b.iter(|| black_box(mean_gray_level(&plane, &lines.line, None)))
+        });
+    }
     let det = CircleDetection {
         min_radius: 70.0,
         max_radius: 100.0,

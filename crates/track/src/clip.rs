@@ -960,7 +960,7 @@ pub(crate) fn scale_from(
     let clear_of_line: Vec<f64> = fixes
         .iter()
         .filter(|f| f.status == Status::Ok)
-        .filter(|f| surface.is_none_or(|l| f.y_px + f.r_px < l.y_at(f.x_px) - 3.0))
+        .filter(|f| surface.is_none_or(|l| f.y_px + f.r_px < l.top_at(f.x_px) - 3.0))
         .map(|f| f.r_px)
         .collect();
     // A line the ball never clears is not where it lands (the estimator will say so): the frames well above

@@ -16,6 +16,7 @@ mod bounce;
 mod circle_fit;
 mod clip;
 mod hough;
+mod level;
 mod local;
 mod motion;
 #[cfg(feature = "opencv")]
@@ -30,6 +31,7 @@ mod trajectory;
 pub use circle_fit::{CircleFit, fit_circle};
 pub use clip::{ClipTracking, Scale, Track, TrackError, track_clip};
 pub use hough::{Circle, CircleDetection, detect_circles, outermost, radius_bands};
+pub use level::{LevelShift, mean_gray_level, remeasured};
 pub use local::SurfaceFrame;
 pub use plane::{Pixel, Plane};
 pub use refine::{

@@ -944,6 +944,7 @@ mod tests {
             edge_definition_px: 0.0,
             roughness_px: 0.0,
             cue: Default::default(),
+            level_shift_px: 0.0,
         }
     }
 

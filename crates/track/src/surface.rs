@@ -22,7 +22,8 @@
 //! statistic sees it.
 //!
 //! The tracker looks for the line in the mean of a clip's first frames (`Tracker`), where the noise is
-//! smaller than in any one frame.
+//! smaller than in any one frame, and measures the found line's level again from the band's mean gray
+//! ([`crate::level`]): both cues put a ragged edge's line at its first grains, above its middle.
 
 use crate::plane::{Pixel, Plane, parabola_offset};
 
@@ -56,6 +57,10 @@ pub struct SurfaceLine {
     /// Which cue found the line.
     #[serde(default)]
     pub cue: LineCue,
+    /// How far the line's level was moved from where its cue found the band's edge, px (+ down): measured
+    /// again from the band's mean gray ([`crate::mean_gray_level`]). 0 for a line kept where it was found.
+    #[serde(default)]
+    pub level_shift_px: f64,
 }
 
 /// What a surface line was found from.
@@ -115,6 +120,7 @@ impl SurfaceLine {
             edge_definition_px: 0.0,
             roughness_px: 0.0,
             cue: LineCue::Given,
+            level_shift_px: 0.0,
         }
     }
 
@@ -131,9 +137,16 @@ impl SurfaceLine {
     }
 
     /// How far above the line the band's ragged edge may reach, px: twice its roughness beyond the
-    /// pixel of scatter any measured edge has (0 for a clean edge).
+    /// pixel of scatter any measured edge has (0 for a clean edge), measured from where the cue found the
+    /// edge when the level was moved down from it ([`Self::level_shift_px`]).
     pub fn ragged_reach_px(&self) -> f64 {
-        (2.0 * self.roughness_px - 1.0).max(0.0)
+        (2.0 * self.roughness_px - 1.0).max(0.0) + self.level_shift_px.max(0.0)
+    }
+
+    /// The band's top at column `x`, px: the line, or where its cue found the edge when that is higher (the
+    /// level moved down from it). What hides the ball's rim, as opposed to where it rests.
+    pub fn top_at(&self, x: f64) -> f64 {
+        self.y_at(x) - self.level_shift_px.max(0.0)
     }
 }
 
@@ -472,6 +485,7 @@ fn refine_line(
             },
             roughness_px: roughness,
             cue: LineCue::Brightness,
+            level_shift_px: 0.0,
         });
     }
     result

@@ -91,6 +91,30 @@ fn coverage(x: usize, y: usize, cx: f64, cy: f64, r: f64) -> f64 {
     n as f64 / 64.0
 }
 
+/// The band's top edge's offsets from its line per column, px (its pixels are half covered there): a few
+/// incommensurate waves, scaled to reach ±`roughness`.
+fn ragged_edge(scene: &Scene) -> Vec<f64> {
+    let mut phases = Rng::new(scene.seed ^ 0x9E37_79B9_7F4A_7C15);
+    let waves: Vec<(f64, f64)> = [2.3, 4.1, 7.9, 15.7]
+        .iter()
+        .map(|&l| (l, phases.uniform() * std::f64::consts::TAU))
+        .collect();
+    let ragged: Vec<f64> = (0..scene.size.0)
+        .map(|x| waves.iter().map(|(l, p)| (x as f64 / l + p).sin()).sum::<f64>() / waves.len() as f64)
+        .collect();
+    let peak = ragged.iter().fold(0.0f64, |a, v| a.max(v.abs())).max(1e-9);
+    ragged.iter().map(|v| scene.roughness * v / peak).collect()
+}
+
+/// The mean over the image's columns of the band's top edge as drawn, at the centre column, px: the level
+/// of the band's line (its `surface.0` plus the ragged edge's mean offset).
+pub fn band_edge_mean(scene: &Scene) -> f64 {
+    let r = ragged_edge(scene);
+    scene
+        .surface
+        .map_or(f64::NAN, |(y0, _)| y0 + r.iter().sum::<f64>() / r.len() as f64)
+}
+
 /// Renders `scene` as 8-bit pixels, row-major.
 pub fn render(scene: &Scene) -> Vec<u8> {
     let (w, h) = scene.size;
@@ -98,16 +122,7 @@ pub fn render(scene: &Scene) -> Vec<u8> {
     let tex: Vec<f64> = (0..w * h).map(|_| rng.normal()).collect();
     let (cx, cy, r) = scene.ball;
     let xc = (w as f64 - 1.0) / 2.0;
-    // The ragged edge: a few incommensurate waves, scaled to reach ±roughness.
-    let mut phases = Rng::new(scene.seed ^ 0x9E37_79B9_7F4A_7C15);
-    let waves: Vec<(f64, f64)> = [2.3, 4.1, 7.9, 15.7]
-        .iter()
-        .map(|&l| (l, phases.uniform() * std::f64::consts::TAU))
-        .collect();
-    let ragged: Vec<f64> = (0..w)
-        .map(|x| waves.iter().map(|(l, p)| (x as f64 / l + p).sin()).sum::<f64>() / waves.len() as f64)
-        .collect();
-    let peak = ragged.iter().fold(0.0f64, |a, v| a.max(v.abs())).max(1e-9);
+    let ragged = ragged_edge(scene);
     let mut out = vec![0u8; w * h];
     for y in 0..h {
         for x in 0..w {
@@ -129,7 +144,7 @@ pub fn render(scene: &Scene) -> Vec<u8> {
                 }
             }
             if let Some((y0, slope)) = scene.surface {
-                let edge = y0 + slope * (x as f64 - xc) + scene.roughness * ragged[x] / peak;
+                let edge = y0 + slope * (x as f64 - xc) + ragged[x];
                 // Anti-aliased top edge of the band, which hides whatever is behind it.
                 let cov = (y as f64 + 0.5 - edge).clamp(0.0, 1.0);
                 if cov > 0.0 {

@@ -3,6 +3,7 @@
 
 use crate::ball_search::{BALL_CANDIDATES, MIN_BALL_RADIUS_PX, radius_window};
 use crate::hough::{Circle, CircleDetection};
+use crate::level::remeasured;
 use crate::motion::fit_motion;
 use crate::plane::{Pixel, Plane, median};
 use crate::refine::{
@@ -487,9 +488,13 @@ impl Tracker {
         };
         let scale = 1.0 / self.stacked as f32;
         let mean: Vec<f32> = self.surface_stack.iter().map(|v| v * scale).collect();
-        if let Some(lines) = find_surface_lines(&Plane::new(&mean, img.width, img.height), ball) {
-            self.surface = Some(lines.line);
-            self.surface_alternatives = lines.alternatives;
+        let plane = Plane::new(&mean, img.width, img.height);
+        if let Some(lines) = find_surface_lines(&plane, ball) {
+            let level = |l: SurfaceLine| remeasured(&plane, l, self.ball_columns_near(&l, ball));
+            let line = level(lines.line);
+            let alternatives = lines.alternatives.into_iter().map(level).collect();
+            self.surface = Some(line);
+            self.surface_alternatives = alternatives;
         }
         if self.next_surface_try == usize::MAX && self.surface.is_some() {
             self.surface_tries = SURFACE_TRIES;
@@ -497,6 +502,16 @@ impl Tracker {
         if self.surface_tries >= SURFACE_TRIES {
             self.surface_stack = Vec::new();
         }
+    }
+
+    /// The columns the ball covered in the summed frames (their span of centres ± its radius and 4 px), when
+    /// its disc comes within reach of `line`'s level measurement ([`crate::level`]); `None` when it stays
+    /// clear of it. The ball is lowest in the last summed frame, so that frame's height decides.
+    fn ball_columns_near(&self, line: &SurfaceLine, ball: Option<(f64, f64, f64)>) -> Option<(f64, f64)> {
+        let (x, y, r) = ball?;
+        let (lo, hi) = self.stack_span.unwrap_or((x, x));
+        let clear = line.height_of(x, y) - r > crate::level::SPAN_PX as f64 + 4.0;
+        (!clear).then_some((lo - r - 4.0, hi + r + 4.0))
     }
 
     /// The ball refined around its predicted position, when that gives a plausible circle of the same rim. A
@@ -770,7 +785,7 @@ impl Tracker {
         }
         // The radius in free flight sets the scale: only frames with the whole rim clear of the surface.
         let clear = match &self.surface {
-            Some(line) => fit.y + fit.r < line.y_at(fit.x) - 3.0,
+            Some(line) => fit.y + fit.r < line.top_at(fit.x) - 3.0,
             None => true,
         };
         if status == Status::Ok && f.rays_hidden == 0 && f.rays_outside == 0 {
@@ -846,7 +861,7 @@ fn same_size(r: f64, expected: f64) -> bool {
 mod tests {
     use super::*;
     use crate::surface::LineCue;
-    use crate::testutil::{Scene, render};
+    use crate::testutil::{Scene, band_edge_mean, render};
     use bouncelab_testkit::Rng;
 
     /// A grainy band as gray as the backdrop, under sensor noise drawn afresh for each frame, with the ball
@@ -927,6 +942,50 @@ mod tests {
         assert!((line.y0 - 180.4).abs() < 0.5, "{line:?}");
         assert!((line.tilt_deg() - 1.5).abs() < 3.0 * line.sigma_tilt_deg, "{line:?}");
         assert_eq!(line.cue, LineCue::Texture);
+    }
+
+    /// The line the tracker keeps is the one found in the mean of the first frames with its level measured
+    /// again from the band's mean gray, and it lies at the ragged edge's mean.
+    #[test]
+    fn the_tracker_s_line_has_its_level_measured_again() {
+        let scene = |k: usize| Scene {
+            ball: (120.3 + 0.3 * k as f64, 70.2 + 0.8 * k as f64, 30.0),
+            surface: Some((180.4, 0.0)),
+            backdrop: (95.0, 95.0),
+            band: (65.0, 12.0),
+            roughness: 5.0,
+            noise: 3.0,
+            seed: k as u64,
+            ..Scene::default()
+        };
+        let truth = band_edge_mean(&scene(0));
+        let mut tracker = Tracker::new(TrackOptions {
+            radius_px: Some((25.0, 35.0)),
+            ..TrackOptions::default()
+        });
+        let mut sum = vec![0.0f32; 256 * 256];
+        for k in 0..SURFACE_STACK_MAX {
+            let img = render(&scene(k));
+            sum.iter_mut().zip(&img).for_each(|(s, v)| *s += *v as f32);
+            tracker.observe(k, k as f64 * 1e-4, &Plane::new(&img, 256, 256));
+        }
+        let mean: Vec<f32> = sum.iter().map(|s| s * (1.0 / SURFACE_STACK_MAX as f32)).collect();
+        let mean = Plane::new(&mean, 256, 256);
+        let found = find_surface_lines(&mean, None).expect("a line").line;
+        let shift = crate::level::mean_gray_level(&mean, &found, None).expect("a clear step");
+        let line = tracker.surface().expect("a line");
+        assert!(
+            (line.y0 - (found.y0 + shift.offset_px)).abs() < 1e-3,
+            "{line:?} against {found:?} {shift:?}"
+        );
+        assert!(
+            shift.offset_px.abs() > 0.01 && line.sigma_y0 == shift.sigma_px,
+            "{shift:?}"
+        );
+        assert!(
+            (line.y0 - truth).abs() < 0.3,
+            "{line:?} against the edge's mean {truth:.2}"
+        );
     }
 
     /// Seeds `tracker` with the ball at (`at`) frames 0 and 1 (0.1 ms apart) and tracks it through the first

@@ -1,0 +1,275 @@
+//! The level of a found surface line measured again from the band's mean gray: where, along the line, the
+//! mean brightness is half-way between the backdrop's and the band's.
+//!
+//! Both cues place a ragged edge's line above its middle: a column's strongest step, or its rise in texture
+//! energy, comes where the first grains reach, and the boundary between grains and backdrop adds texture of
+//! its own. The mean gray of a row parallel to the line is instead linear in how much of it the band covers,
+//! so in each block of columns the row where it is half-way between its levels well above and well below the
+//! line is where half the block's columns are covered: the median of the block's edge, whatever its
+//! roughness (a lip, a strip along the band's top brighter or darker than the band, still moves it). That
+//! needs a band whose mean gray differs from the backdrop's; on a band as gray as the backdrop the line is
+//! kept as found. Cost: one pass over the pixels within ±16 px of the line.
+
+use crate::plane::{Pixel, Plane, median};
+use crate::surface::SurfaceLine;
+
+/// Columns per block, px: each block gives one crossing, and the level is their median.
+const BLOCK_PX: usize = 16;
+/// How far from the line the band's and the backdrop's levels begin, px: beyond a ragged edge's reach of a
+/// few px, yet within a tape a dozen px thick.
+const REACH_PX: i32 = 10;
+/// Rows (1 px bins) averaged for each of the two levels.
+const LEVEL_ROWS: i32 = 7;
+/// How far from the line the measurement reaches on either side, px.
+pub(crate) const SPAN_PX: i32 = REACH_PX + LEVEL_ROWS - 1;
+/// Least step between the two levels, in standard errors of that difference, for a block's crossing to count.
+const MIN_STEP_SE: f64 = 8.0;
+/// Fewest blocks with a crossing for the level to be measured again.
+const MIN_BLOCKS: usize = 5;
+
+/// How far the line's level moves and its standard error, px.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LevelShift {
+    /// Distance from the line to the band's mean-gray half-way row, px (+ down), the median over blocks.
+    pub offset_px: f64,
+    /// Standard error of `offset_px`, px (the blocks' scatter).
+    pub sigma_px: f64,
+    /// Blocks whose crossing was used.
+    pub blocks: usize,
+}
+
+/// Sum, sum of squares and count of the pixels in one 1 px bin of distance from the line, and the sum of
+/// their distances (a level line's rows all lie a fraction of a pixel off the bin's centre).
+#[derive(Debug, Clone, Copy, Default)]
+struct Bin {
+    sum: f64,
+    sum_sq: f64,
+    n: usize,
+    sum_d: f64,
+}
+
+impl Bin {
+    fn distance(&self) -> f64 {
+        self.sum_d / self.n as f64
+    }
+    fn mean(&self) -> f64 {
+        self.sum / self.n as f64
+    }
+    fn var_of_mean(&self) -> f64 {
+        let m = self.mean();
+        ((self.sum_sq / self.n as f64 - m * m).max(0.0)) / self.n as f64
+    }
+}
+
+/// The shift of `line`'s level to the half-way row of the band's mean gray (see the module's description), or
+/// `None` unless at least five blocks of 16 columns, and half of those whose pixels reach ±16 px of the line
+/// inside the image, show a clear step in mean gray across it: a band only here and there darker than the
+/// backdrop (large grains, shading within it) is not one whose mean gray tells its edge. Columns in `skip`
+/// (x from, x to, px) are left out: the ball, where it comes near the line. Cost: O(width × 34).
+pub fn mean_gray_level<P: Pixel>(img: &Plane<P>, line: &SurfaceLine, skip: Option<(f64, f64)>) -> Option<LevelShift> {
+    let span = SPAN_PX;
+    let nbins = (2 * span + 1) as usize;
+    let mut offsets = Vec::new();
+    let mut looked = 0usize;
+    for x_lo in (0..img.width.saturating_sub(BLOCK_PX - 1)).step_by(BLOCK_PX) {
+        let x_hi = x_lo + BLOCK_PX - 1;
+        if skip.is_some_and(|(a, b)| (x_lo as f64) <= b && (x_hi as f64) >= a) {
+            continue;
+        }
+        let mut bins = vec![Bin::default(); nbins];
+        for x in x_lo..=x_hi {
+            let yl = line.y_at(x as f64);
+            let (top, bottom) = ((yl - span as f64 - 0.5).ceil(), (yl + span as f64 + 0.5).floor());
+            if top < 0.0 || bottom >= img.height as f64 {
+                continue;
+            }
+            for y in top as usize..=bottom as usize {
+                let d = y as f64 - yl;
+                let k = d.round() as i32 + span;
+                if (0..nbins as i32).contains(&k) {
+                    let v = img.at(x, y) as f64;
+                    let b = &mut bins[k as usize];
+                    b.sum += v;
+                    b.sum_sq += v * v;
+                    b.n += 1;
+                    b.sum_d += d;
+                }
+            }
+        }
+        if bins.iter().any(|b| b.n < BLOCK_PX / 2) {
+            continue;
+        }
+        looked += 1;
+        if let Some(off) = block_crossing(&bins) {
+            offsets.push(off);
+        }
+    }
+    if offsets.len() < MIN_BLOCKS.max(looked.div_ceil(2)) {
+        return None;
+    }
+    let n = offsets.len();
+    let mid = median(&mut offsets.clone());
+    let mad = median(&mut offsets.iter().map(|o| (o - mid).abs()).collect::<Vec<_>>());
+    // The median's standard error for normal scatter: √(π/2)·σ/√n, σ from the MAD.
+    let sigma = (std::f64::consts::FRAC_PI_2.sqrt() * 1.4826 * mad / (n as f64).sqrt()).max(0.02);
+    Some(LevelShift {
+        offset_px: mid,
+        sigma_px: sigma,
+        blocks: n,
+    })
+}
+
+/// One block's half-way row relative to the line, px: the levels are the means of the outermost `LEVEL_ROWS`
+/// bins on either side, the step must be `MIN_STEP_SE` standard errors, and of the places where the profile
+/// crosses half-way the one nearest the line is taken, linearly interpolated between the bins' mean
+/// distances. `None` when the step is unclear or the profile does not cross.
+fn block_crossing(bins: &[Bin]) -> Option<f64> {
+    let rows = LEVEL_ROWS as usize;
+    // A level's variance: its pixels' scatter, or its rows' when coarse grains make neighbouring pixels alike.
+    let level = |part: &[Bin]| {
+        let k = part.len() as f64;
+        let m = part.iter().map(Bin::mean).sum::<f64>() / k;
+        let within = part.iter().map(Bin::var_of_mean).sum::<f64>() / (k * k);
+        let between = part.iter().map(|b| (b.mean() - m).powi(2)).sum::<f64>() / ((k - 1.0) * k);
+        (m, within.max(between))
+    };
+    let (above, va) = level(&bins[..rows]);
+    let (below, vb) = level(&bins[bins.len() - rows..]);
+    let step = below - above;
+    if step.abs() < MIN_STEP_SE * (va + vb).sqrt() {
+        return None;
+    }
+    let f = |k: usize| (bins[k].mean() - above) / step - 0.5;
+    (0..bins.len() - 1)
+        .filter(|&k| f(k) * f(k + 1) <= 0.0 && f(k) != f(k + 1))
+        .map(|k| {
+            let (d0, d1) = (bins[k].distance(), bins[k + 1].distance());
+            d0 + (d1 - d0) * f(k) / (f(k) - f(k + 1))
+        })
+        .min_by(|a, b| a.abs().total_cmp(&b.abs()))
+}
+
+/// `line` with its level measured again ([`mean_gray_level`]) where that can be done: `y0` moved by the
+/// shift, `sigma_y0` the shift's standard error, the shift kept in `level_shift_px` (the band's grains still
+/// reach where the cue found them: see [`SurfaceLine::top_at`]). Otherwise `line` as it was.
+pub fn remeasured<P: Pixel>(img: &Plane<P>, line: SurfaceLine, skip: Option<(f64, f64)>) -> SurfaceLine {
+    match mean_gray_level(img, &line, skip) {
+        Some(s) => SurfaceLine {
+            y0: line.y0 + s.offset_px,
+            sigma_y0: s.sigma_px,
+            level_shift_px: line.level_shift_px + s.offset_px,
+            ..line
+        },
+        None => line,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::surface::find_surface_lines;
+    use crate::testutil::{Scene, band_edge_mean, render};
+
+    fn scene(y0: f64, slope: f64, band: (f64, f64), roughness: f64, noise: f64, seed: u64) -> Scene {
+        Scene {
+            surface: Some((y0, slope)),
+            backdrop: (95.0, 95.0),
+            band,
+            roughness,
+            noise,
+            seed,
+            ball: (128.0, 60.0, 20.0),
+            ..Scene::default()
+        }
+    }
+
+    fn band(y0: f64, slope: f64, band: (f64, f64), roughness: f64, noise: f64, seed: u64) -> Vec<u8> {
+        render(&scene(y0, slope, band, roughness, noise, seed))
+    }
+
+    /// On a ragged band darker or brighter than the backdrop, the level moves to the drawn edge's mean, from
+    /// wherever the cues put it, within its stated error.
+    #[test]
+    fn a_ragged_band_s_level_is_its_edge_s_mean() {
+        for (seed, offset, rough) in [(1u64, -30.0, 4.0), (2, 25.0, 6.0), (3, -15.0, 2.0), (4, 40.0, 0.0)] {
+            let y0 = 170.3;
+            let drawn = scene(y0, 0.0, (95.0 + offset, 20.0), rough, 3.0, seed);
+            let px = render(&drawn);
+            let img = Plane::new(&px, 256, 256);
+            let truth = band_edge_mean(&drawn);
+            for start in [-3.0, 0.0, 2.5] {
+                let line = SurfaceLine::given(127.5, truth + start, 0.0);
+                let s = mean_gray_level(&img, &line, None).expect("a clear step");
+                let err = line.y0 + s.offset_px - truth;
+                assert!(
+                    err.abs() < 3.0 * s.sigma_px + 0.05 && s.sigma_px < 0.2 * rough + 0.05,
+                    "seed {seed} rough {rough} start {start}: error {err:.3} ± {:.3}",
+                    s.sigma_px
+                );
+            }
+        }
+    }
+
+    /// A band as gray as the backdrop has no step in mean gray: its line is kept as found.
+    #[test]
+    fn a_band_as_gray_as_the_backdrop_keeps_its_line() {
+        let px = band(170.3, 0.0, (95.0, 30.0), 3.0, 3.0, 5);
+        let img = Plane::new(&px, 256, 256);
+        let found = find_surface_lines(&img, None).expect("a texture line").line;
+        assert!(mean_gray_level(&img, &found, None).is_none());
+        assert_eq!(remeasured(&img, found, None), found);
+    }
+
+    /// A band darker than the backdrop in fewer than half of its columns (large grains, shading) does not have
+    /// its level measured from its mean gray, however clear the step is there.
+    #[test]
+    fn a_band_darker_only_here_and_there_keeps_its_line() {
+        let mut px = band(170.3, 0.0, (95.0, 20.0), 0.0, 2.0, 9);
+        // Darken the band in six of the sixteen blocks.
+        for y in 171..256 {
+            for x in 160..256 {
+                px[y * 256 + x] = px[y * 256 + x].saturating_sub(40);
+            }
+        }
+        let img = Plane::new(&px, 256, 256);
+        let line = SurfaceLine::given(127.5, 170.3, 0.0);
+        assert!(mean_gray_level(&img, &line, None).is_none());
+        // Darkened across the whole width, it is measured in every block.
+        for y in 171..256 {
+            for x in 0..160 {
+                px[y * 256 + x] = px[y * 256 + x].saturating_sub(40);
+            }
+        }
+        let img = Plane::new(&px, 256, 256);
+        let s = mean_gray_level(&img, &line, None).expect("a clear step in every block");
+        assert_eq!(s.blocks, 16);
+    }
+
+    /// A tilted line is followed: the blocks measure across it, not across the image's rows.
+    #[test]
+    fn a_tilted_band_s_level_is_measured_across_the_line() {
+        let (y0, deg) = (160.6f64, 4.0f64);
+        let slope = -deg.to_radians().tan();
+        let px = band(y0, slope, (60.0, 15.0), 0.0, 2.0, 7);
+        let img = Plane::new(&px, 256, 256);
+        let line = SurfaceLine {
+            slope,
+            ..SurfaceLine::given(127.5, y0 - 1.5, 0.0)
+        };
+        let s = mean_gray_level(&img, &line, None).expect("a clear step");
+        assert!((line.y0 + s.offset_px - y0).abs() < 0.1, "{s:?}");
+    }
+
+    /// Columns left out (the ball's) do not count, and too few blocks give no level.
+    #[test]
+    fn skipped_columns_do_not_count() {
+        let px = band(170.3, 0.0, (60.0, 15.0), 0.0, 2.0, 8);
+        let img = Plane::new(&px, 256, 256);
+        let line = SurfaceLine::given(127.5, 171.0, 0.0);
+        let all = mean_gray_level(&img, &line, None).unwrap();
+        assert_eq!(all.blocks, 16);
+        let some = mean_gray_level(&img, &line, Some((40.0, 200.0))).unwrap();
+        assert_eq!(some.blocks, 5);
+        assert!(mean_gray_level(&img, &line, Some((20.0, 220.0))).is_none());
+    }
+}
