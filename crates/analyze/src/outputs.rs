@@ -338,7 +338,7 @@ const MAX_STEM_BYTES: usize = 96;
 /// The file name under `trajectories/` of each clip, unique and bounded, decided from the names alone (so
 /// the same clips always get the same files, whatever else the session holds). A name that is already a
 /// safe, short file name (letters, digits, `-`, `_`, `.`, not starting with `.`) is kept as it is plus
-/// `.csv`; any other is cleaned, cut to [`MAX_STEM_BYTES`] and given 8 hex digits of a hash of the
+/// `.csv`; any other is cleaned, cut to `MAX_STEM_BYTES` (96) and given 8 hex digits of a hash of the
 /// original, so `shot 1` and `shot_1` never share a file. Names equal but for case (one file on
 /// case-insensitive file systems) get `-2`, `-3` … in the order given.
 pub fn trajectory_files<'a>(clips: impl IntoIterator<Item = &'a str>) -> TrajectoryFiles {

@@ -729,7 +729,7 @@ fn note_scatter(fin: &BallisticFit, fout: &BallisticFit, notes: &mut Vec<String>
 /// passing a hot spot bias a few centres, which the flight fits' scatter absorbs.
 const SATURATED_FRAMES_SHARE: f64 = 0.05;
 
-/// Why `track` cannot be trusted when more than [`SATURATED_FRAMES_SHARE`] of its measured frames have the
+/// Why `track` cannot be trusted when more than `SATURATED_FRAMES_SHARE` (5 %) of its measured frames have the
 /// ball's rim in saturated pixels (see [`Track::saturated_frames`]); `None` otherwise. A shot that fails
 /// for another reason is best explained by this too, since clipping is usually the cause.
 pub fn saturation_flag(track: &Track) -> Option<String> {

@@ -57,7 +57,7 @@ impl<'a, P: Pixel> Plane<'a, P> {
         }
     }
 
-    /// The same pixels with every level multiplied by `gain` (see [`level_gain`]).
+    /// The same pixels with every level multiplied by `gain` (see `level_gain` in this module).
     pub fn with_gain(self, gain: f32) -> Self {
         Plane { gain, ..self }
     }

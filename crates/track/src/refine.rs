@@ -34,10 +34,10 @@ pub struct EdgeSearch {
     pub rim_shape: Option<RimShape>,
     /// Sample the rays through a 3 × 3 binomial filter ([`Plane::sample_smooth_inside`]): in heavy sensor
     /// noise a single noisy sample otherwise out-steps a soft rim (default false; the clip tracker turns it
-    /// on when a frame's noise exceeds [`NOISY_SIGMA`]).
+    /// on when a frame's noise exceeds `NOISY_SIGMA`, 5 on the 0–255 scale).
     pub smooth: bool,
     /// Also sample each ray 8 px beyond the window's outer end, so that a band's outer side within
-    /// [`LIMB_PX`] of the strongest step, and the level 2 px past it, are seen there too (default true). A
+    /// `LIMB_PX` (6 px) of the strongest step, and the level 2 px past it, are seen there too (default true). A
     /// search sitting on a wide limb's inner side sees the rim outside it only so; a settled track, whose
     /// window already sits on the rim, turns it off (sampled in every frame, they cost +80 % on the track
     /// bench's steady case).
@@ -190,7 +190,7 @@ impl RimShapeLearner {
 /// Per-ray edge residuals `(ray, distance from the fitted centre − fitted radius)` around `fit`, px, with
 /// the rays of `search` but no rim shape applied; points beyond 3 robust RMS of the fit are left out (a seam
 /// crossing the rim). Cost: one edge search (≈ 10 µs); the tracker takes them from its own search instead
-/// ([`refine_circle_with_rays`]).
+/// (`refine_circle_with_rays`).
 pub fn rim_residuals<P: Pixel>(
     img: &Plane<P>,
     fit: &CircleFit,

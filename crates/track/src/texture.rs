@@ -54,7 +54,7 @@ pub fn texture_line<P: Pixel>(img: &Plane<P>) -> Option<SurfaceLine> {
 }
 
 /// The long near-horizontal changes of texture across the image, topmost first. Each line's
-/// `edge_definition_px` is twice its roughness ([`crate::surface::ragged`]): on a ragged band the plane the
+/// `edge_definition_px` is twice its roughness (`surface::ragged`): on a ragged band the plane the
 /// ball rests on lies somewhere between the edge's mean and its highest grains.
 pub fn texture_lines<P: Pixel>(img: &Plane<P>) -> Vec<SurfaceLine> {
     let (w, h) = (img.width, img.height);

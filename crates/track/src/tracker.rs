@@ -142,7 +142,7 @@ pub struct TrackOptions {
     /// Largest distance between prediction and measurement before the measurement is not trusted, px.
     pub max_jump_px: f64,
     /// The ball's diameter, m, when known: with the measured radius it turns
-    /// [`MAX_BALL_ACCELERATION_M_S2`] into px/s² for the prediction (unbounded without it).
+    /// `MAX_BALL_ACCELERATION_M_S2` (3·10⁴ m/s²) into px/s² for the prediction (unbounded without it).
     pub ball_diameter_m: Option<f64>,
 }
 
@@ -341,7 +341,7 @@ impl Tracker {
     }
 
     /// How far the apparent rim strays from a circle, px: the RMS of the rim's shape learned from clean
-    /// frames, else of the shape the doubtful full-rim flight frames give (at least [`RIM_MIN_SAMPLES`] of
+    /// frames, else of the shape the doubtful full-rim flight frames give (at least `RIM_MIN_SAMPLES`, 16, of
     /// them), else 0 (no full-rim flight frame to tell).
     pub fn rim_shape_rms_px(&self) -> f64 {
         let doubtful = || {
