@@ -5,7 +5,7 @@
 //! the frames given are averaged first and one result is shown, as the tracker looks for the line.
 
 use bouncelab_frames::{FrameFormat, PngDecoder, decode_bytes};
-use bouncelab_track::{Plane, find_surface_lines, mean_gray_level, texture_line};
+use bouncelab_track::{Plane, ball_columns, find_surface_lines, mean_gray_level, texture_line};
 
 fn main() {
     let mut args: Vec<String> = std::env::args().skip(1).collect();
@@ -68,7 +68,7 @@ fn main() {
                     println!("  alternative {}", show(a));
                 }
                 // As the tracker does, with the ball's columns left out where it comes near the line.
-                let skip = ball.map(|(x, _, r)| (x - r - 4.0, x + r + 4.0));
+                let skip = ball.and_then(|b| ball_columns(&l.line, b, (b.0, b.0)));
                 match mean_gray_level(&plane, &l.line, skip) {
                     Some(s) => println!(
                         "  level by the band's mean gray: {:+.2} ± {:.2} px over {} blocks",

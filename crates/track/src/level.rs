@@ -21,7 +21,7 @@ const REACH_PX: i32 = 10;
 /// Rows (1 px bins) averaged for each of the two levels.
 const LEVEL_ROWS: i32 = 7;
 /// How far from the line the measurement reaches on either side, px.
-pub(crate) const SPAN_PX: i32 = REACH_PX + LEVEL_ROWS - 1;
+const SPAN_PX: i32 = REACH_PX + LEVEL_ROWS - 1;
 /// Least step between the two levels, in standard errors of that difference, for a block's crossing to count.
 const MIN_STEP_SE: f64 = 8.0;
 /// Fewest blocks with a crossing for the level to be measured again.
@@ -147,6 +147,15 @@ fn block_crossing(bins: &[Bin]) -> Option<f64> {
             d0 + (d1 - d0) * f(k) / (f(k) - f(k + 1))
         })
         .min_by(|a, b| a.abs().total_cmp(&b.abs()))
+}
+
+/// The columns to leave out of [`mean_gray_level`] for a ball of radius `r` px whose centre's x spanned
+/// `span` (from, to) px in the frames summed, the last at (x, y): those centres ± the radius and 4 px when its
+/// disc comes within 4 px of the measurement's reach above `line`, else `None`. The ball falls through the
+/// first frames, so the last summed frame's height decides.
+pub fn ball_columns(line: &SurfaceLine, (x, y, r): (f64, f64, f64), span: (f64, f64)) -> Option<(f64, f64)> {
+    let clear = line.height_of(x, y) - r > SPAN_PX as f64 + 4.0;
+    (!clear).then_some((span.0 - r - 4.0, span.1 + r + 4.0))
 }
 
 /// `line` with its level measured again ([`mean_gray_level`]) where that can be done: `y0` moved by the

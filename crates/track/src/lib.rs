@@ -31,7 +31,7 @@ mod trajectory;
 pub use circle_fit::{CircleFit, fit_circle};
 pub use clip::{ClipTracking, Scale, Track, TrackError, track_clip};
 pub use hough::{Circle, CircleDetection, detect_circles, outermost, radius_bands};
-pub use level::{LevelShift, mean_gray_level, remeasured};
+pub use level::{LevelShift, ball_columns, mean_gray_level, remeasured};
 pub use local::SurfaceFrame;
 pub use plane::{Pixel, Plane};
 pub use refine::{

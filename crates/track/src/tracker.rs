@@ -3,7 +3,7 @@
 
 use crate::ball_search::{BALL_CANDIDATES, MIN_BALL_RADIUS_PX, radius_window};
 use crate::hough::{Circle, CircleDetection};
-use crate::level::remeasured;
+use crate::level::{ball_columns, remeasured};
 use crate::motion::fit_motion;
 use crate::plane::{Pixel, Plane, median};
 use crate::refine::{
@@ -490,7 +490,9 @@ impl Tracker {
         let mean: Vec<f32> = self.surface_stack.iter().map(|v| v * scale).collect();
         let plane = Plane::new(&mean, img.width, img.height);
         if let Some(lines) = find_surface_lines(&plane, ball) {
-            let level = |l: SurfaceLine| remeasured(&plane, l, self.ball_columns_near(&l, ball));
+            let span = ball.map(|(x, _, _)| self.stack_span.unwrap_or((x, x)));
+            let skip = |l: &SurfaceLine| ball.zip(span).and_then(|(b, s)| ball_columns(l, b, s));
+            let level = |l: SurfaceLine| remeasured(&plane, l, skip(&l));
             let line = level(lines.line);
             let alternatives = lines.alternatives.into_iter().map(level).collect();
             self.surface = Some(line);
@@ -502,16 +504,6 @@ impl Tracker {
         if self.surface_tries >= SURFACE_TRIES {
             self.surface_stack = Vec::new();
         }
-    }
-
-    /// The columns the ball covered in the summed frames (their span of centres ± its radius and 4 px), when
-    /// its disc comes within reach of `line`'s level measurement ([`crate::level`]); `None` when it stays
-    /// clear of it. The ball is lowest in the last summed frame, so that frame's height decides.
-    fn ball_columns_near(&self, line: &SurfaceLine, ball: Option<(f64, f64, f64)>) -> Option<(f64, f64)> {
-        let (x, y, r) = ball?;
-        let (lo, hi) = self.stack_span.unwrap_or((x, x));
-        let clear = line.height_of(x, y) - r > crate::level::SPAN_PX as f64 + 4.0;
-        (!clear).then_some((lo - r - 4.0, hi + r + 4.0))
     }
 
     /// The ball refined around its predicted position, when that gives a plausible circle of the same rim. A
