@@ -34,7 +34,8 @@ pub struct ClipResult {
     pub failure: Option<String>,
     /// Contact line used (its cue), its level error at the truth's column, px (measured − truth, + down), and
     /// the line's part of the contact level's standard error as the estimator takes it, px
-    /// (`SurfaceLine::level_sigma_px`).
+    /// (`SurfaceLine::level_sigma_px`, times √(1 − the trajectory's share) for a level moved towards the
+    /// trajectory's, `Estimate::trajectory_share`).
     pub level: Option<(String, f64, f64)>,
     /// COR and μ: (estimate, SE, truth).
     pub cor: Option<(f64, f64, f64)>,
@@ -225,7 +226,9 @@ fn evaluate_clip(
                 // The truth's surface line is given at the image's centre column.
                 let xc = (clip.dimensions().0 as f64 - 1.0) / 2.0;
                 let err = line.y_at(xc) - num(truth, "surface_y_px");
-                result.level = Some((line.cue.name().to_string(), err, line.level_sigma_px()));
+                // A level partly from the trajectory has the line's variance times the line's weight.
+                let sigma = line.level_sigma_px() * (1.0 - e.trajectory_share).sqrt();
+                result.level = Some((line.cue.name().to_string(), err, sigma));
             }
             result.cor = Some((e.cor.value, e.cor.se, num(truth, "cor")));
             result.mu = Some((e.mu.value, e.mu.se, num(truth, "mu_eff")));

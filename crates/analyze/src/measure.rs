@@ -76,8 +76,9 @@ pub(crate) fn session_key(session: &Session) -> String {
 /// inside it; 8: the flights' and the onset's errors counting the residuals' correlation, an onset at the
 /// edge of its window only bounded, the radius's change between the flights; 9: a track that left the ball
 /// taken over by a pass tracked back from the clip's end; 10: the frames after a bounce measured again
-/// backward, a found line's level measured again from the band's mean gray).
-const MEASUREMENT_REVISION: u32 = 10;
+/// backward, a found line's level measured again from the band's mean gray; 11: the trajectory's level from
+/// the touch alone, a found line's level moved towards it by their weights).
+const MEASUREMENT_REVISION: u32 = 11;
 
 /// Everything besides the frame files that changes a shot's track or estimate.
 fn settings_text(entry: &ClipEntry, gravity: f64) -> String {

@@ -10,11 +10,12 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// The columns of `estimates.csv`, in order. Every name ends in its unit (`_m_s`, `_ms`, `_mm`, `_deg`,
-/// `_rad_s`, `_m_s2`, `_s`, `_m`); `cor`, `mu_eff`, their `_se` and `chi2_red_flight` are dimensionless. A
+/// `_rad_s`, `_m_s2`, `_s`, `_m`); `cor`, `mu_eff`, their `_se`, `chi2_red_flight` and `trajectory_share` are
+/// dimensionless. A
 /// standard error is `<quantity>_se_<unit>` (see `docs/outputs.md`). The measured quantities' columns are the
 /// store's `estimates` columns ([`Q`], `bouncelab_store::ESTIMATE_QUANTITIES`), so the file and the table name
 /// them alike.
-pub const ESTIMATE_COLUMNS: [&str; 43] = [
+pub const ESTIMATE_COLUMNS: [&str; 44] = [
     "clip",
     "surface",
     "angle_deg",
@@ -53,6 +54,7 @@ pub const ESTIMATE_COLUMNS: [&str; 43] = [
     "t_sep_se_s",
     "chi2_red_flight",
     "contact_line",
+    "trajectory_share",
     "surface_tilt_deg",
     "surface_tilt_se_deg",
     "flags",
@@ -210,6 +212,7 @@ fn estimate_cells(s: &ShotData, ball_mass_kg: f64, gravity: f64, files: &Traject
     ]);
     cells.push(num(worst_chi2));
     cells.push(e.contact_line.map_or(String::new(), |l| l.cue.name().to_string()));
+    cells.push(num(e.trajectory_share));
     cells.extend(value_se_cells(e.surface_tilt_deg.map(|t| (t.value, Some(t.se)))));
     cells.push(e.flags.join("; "));
     cells.push(e.notes.join("; "));
@@ -789,6 +792,7 @@ mod tests {
             "mu_eff_se",
             "chi2_red_flight",
             "contact_line",
+            "trajectory_share",
             "flags",
             "trajectory_file",
             "phase",

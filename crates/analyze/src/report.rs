@@ -1021,6 +1021,12 @@ fn contact_source(e: &bouncelab_estimate::Estimate) -> Option<String> {
         LineCue::Trajectory => "the ball's trajectory (no surface line it agrees with was found)",
     };
     let mut text = format!("contact level from {what}");
+    if e.trajectory_share > 0.005 {
+        text += &format!(
+            ", moved towards the ball's trajectory's level by {:.0} % (their inverse-variance weights)",
+            100.0 * e.trajectory_share
+        );
+    }
     if let Some(t) = e.surface_tilt_deg {
         text += &format!(", tilt {:+.3} ± {:.3}°", t.value, t.se).replace('-', "\u{2212}");
     }

@@ -134,6 +134,13 @@ pub struct Estimate {
     /// two agree), with its standard error; `None` where the trajectory could not tell.
     #[serde(default)]
     pub trajectory_level_px: Option<Measured>,
+    /// The share of the contact level taken from the ball's trajectory, 0–1: a line found in the image that
+    /// the trajectory agrees with is moved towards the trajectory's level by their inverse-variance
+    /// weights (the line's error taken with the scale's at one radius and the centres' common offset, which
+    /// the trajectory, measured in the centres' own frame, does not have). 0 for a given line, a level from
+    /// the trajectory alone, and estimates stored before it.
+    #[serde(default)]
+    pub trajectory_share: f64,
     /// The flights' acceleration, m/s² in the local frame (free fits of both arcs, weighted), against gravity's.
     #[serde(default)]
     pub gravity: Option<GravityCheck>,
@@ -299,20 +306,23 @@ struct Point {
 ///
 /// The contact line is the best evidence available, in this order: a line the user gave; the line the
 /// tracker found, if the ball's trajectory agrees that the contact is there (else the other cue's line, if
-/// it agrees); the contact level the trajectory gives (see `contact.rs`). The local frame follows that line's
-/// tilt in the image.
+/// it agrees), its level moved towards the trajectory's by their inverse-variance weights
+/// ([`Estimate::trajectory_share`]); the contact level the trajectory gives (see `contact.rs`). The local
+/// frame follows that line's tilt in the image.
 pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError> {
     c.check()?;
     let scale = track.scale.ok_or(EstimateError::NoScale)?;
     let s = scale.m_per_px;
     let measured = fitted_fixes(track)?;
     let beta = c.incline_deg.to_radians();
+    let radius = c.ball_diameter_m / 2.0;
     let choice = contact_line(
         track,
         &measured,
         scale.radius_px,
         -c.gravity * beta.cos() / s,
         c.surface_tilt_deg,
+        against_centres_px(&scale, radius),
     )?;
     let line = choice.line;
     let (frame, points) = local_points(track, &measured, &line, &scale);
@@ -326,10 +336,9 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
     };
     let fin = fit(&incoming, "incoming")?;
     let fout = fit(&outgoing, "outgoing")?;
-    let radius = c.ball_diameter_m / 2.0;
     let gravity = gravity_check(&incoming, &outgoing, a, c.gravity);
     let mut notes = choice.notes;
-    let mut level = LevelErrors::of(&line, &scale, radius);
+    let mut level = LevelErrors::of(&line, &scale, radius, choice.trajectory_share);
     if line.cue == LineCue::Trajectory
         && c.surface_tilt_deg.is_none()
         && let Some(g) = &gravity
@@ -399,6 +408,7 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
             .filter(|l| matches!(l.cue, LineCue::Brightness | LineCue::Texture))
             .map(|l| Measured::new(l.tilt_deg(), l.sigma_tilt_deg)),
         trajectory_level_px: choice.trajectory_level_px,
+        trajectory_share: choice.trajectory_share,
         gravity,
         rim_change_px,
         flags,
@@ -563,6 +573,14 @@ fn flights(points: &[Point], first: usize, last: usize) -> Result<(Vec<&Point>, 
     Ok((incoming, outgoing))
 }
 
+/// What "one radius above a line seen in the image" adds to the line's own error against the measured
+/// centres, px: the scale's error at one radius (`radius` m) and the rim's unseen first harmonic, which
+/// offsets every centre alike and so moves the contact as much as a level error (Type-B, like the radius's
+/// rim term; see `Scale`).
+fn against_centres_px(scale: &bouncelab_track::Scale, radius: f64) -> f64 {
+    (radius / scale.m_per_px * scale.sigma_m_per_px / scale.m_per_px).hypot(scale.rim_shape_px)
+}
+
 /// The errors of the contact level and the frame's axes that every crossing shares.
 struct LevelErrors {
     /// Uncertainty of "one radius above the surface line" in the local frame, m: all of it for this shot's
@@ -580,22 +598,26 @@ struct LevelErrors {
 }
 
 impl LevelErrors {
-    /// The errors for a contact `line`, at the clip's `scale`, for a ball of `radius` m.
-    fn of(line: &SurfaceLine, scale: &bouncelab_track::Scale, radius: f64) -> Self {
+    /// The errors for a contact `line`, at the clip's `scale`, for a ball of `radius` m, with `share` of
+    /// its level taken from the trajectory ([`Estimate::trajectory_share`]).
+    fn of(line: &SurfaceLine, scale: &bouncelab_track::Scale, radius: f64, share: f64) -> Self {
         let s = scale.m_per_px;
         // A level taken from the trajectory is where the centre was at the touch, one radius above a line put
         // one radius below it: the scale's error in that radius cancels, and so does an offset of the centre.
         let from_image = line.cue != LineCue::Trajectory;
         let radius_scale = if from_image { radius / s } else { 0.0 };
-        // The rim's unseen first harmonic offsets every centre alike: against a line seen in the image it
-        // moves the contact as much as a level error (Type-B, like the radius's rim term; see `Scale`).
-        let centre = if from_image { scale.rim_shape_px * s } else { 0.0 };
-        let sigma = (line.level_sigma_px() * s)
-            .hypot(radius_scale * scale.sigma_m_per_px)
-            .hypot(centre);
+        let against_centres = if from_image {
+            against_centres_px(scale, radius)
+        } else {
+            0.0
+        };
+        // Inverse-variance weights: the combined variance is the line's times its own weight, 1 − share.
+        let sigma = line.level_sigma_px().hypot(against_centres) * s * (1.0 - share).clamp(0.0, 1.0).sqrt();
         let scatter_scale = (scale.sigma_m_per_px.powi(2) - scale.sigma_shape_m_per_px().powi(2))
             .max(0.0)
             .sqrt();
+        // Left whole for a level partly from the trajectory: the fit that takes it as a prior sees the same
+        // centres.
         let sigma_scatter = ((line.sigma_y0 * s).powi(2) + (radius_scale * scatter_scale).powi(2)).sqrt();
         LevelErrors {
             sigma,
@@ -799,6 +821,8 @@ fn gravity_check(incoming: &[&Point], outgoing: &[&Point], expected: [f64; 2], g
 /// The contact line chosen, and what the choice rests on.
 struct ContactChoice {
     line: SurfaceLine,
+    /// The share of the line's level taken from the trajectory (see [`Estimate::trajectory_share`]).
+    trajectory_share: f64,
     trajectory_level_px: Option<Measured>,
     notes: Vec<String>,
     /// The trajectory's [`EstimateError::NoImpact`], when it holds no impact.
@@ -812,6 +836,7 @@ fn contact_line(
     radius_px: f64,
     a_px: f64,
     surface_tilt_deg: Option<f64>,
+    against_centres_px: f64,
 ) -> Result<ContactChoice, EstimateError> {
     let given = track.surface.filter(|l| l.cue == LineCue::Given);
     let found = track.surface.filter(|l| l.cue != LineCue::Given);
@@ -846,6 +871,7 @@ fn contact_line(
         }
         return Ok(ContactChoice {
             line,
+            trajectory_share: 0.0,
             trajectory_level_px,
             notes,
             no_impact,
@@ -853,7 +879,7 @@ fn contact_line(
     }
     match (found, &view.trajectory) {
         (Some(line), Ok(tc)) => {
-            let choice = view.found_or_trajectory(line, tc, &track.surface_alternatives, no_impact);
+            let choice = view.found_or_trajectory(line, tc, &track.surface_alternatives, no_impact, against_centres_px);
             if choice.line.cue != LineCue::Trajectory {
                 return Ok(choice);
             }
@@ -863,6 +889,7 @@ fn contact_line(
             Ok(match &across.trajectory {
                 Ok(tc) => ContactChoice {
                     line: across.level_line(tc),
+                    trajectory_share: 0.0,
                     trajectory_level_px: Some(Measured::new(0.0, tc.level_se_px)),
                     notes: [
                         choice.notes,
@@ -876,6 +903,7 @@ fn contact_line(
         }
         (Some(line), Err(_)) => Ok(ContactChoice {
             line,
+            trajectory_share: 0.0,
             trajectory_level_px: None,
             notes,
             no_impact,
@@ -888,6 +916,7 @@ fn contact_line(
             notes.extend(tc.notes.iter().cloned());
             Ok(ContactChoice {
                 line: view.level_line(tc),
+                trajectory_share: 0.0,
                 trajectory_level_px: Some(Measured::new(0.0, tc.level_se_px)),
                 notes,
                 no_impact,
@@ -972,6 +1001,7 @@ impl TrajectoryView {
         tc: &TrajectoryContact,
         alternatives: &[SurfaceLine],
         no_impact: Option<EstimateError>,
+        against_centres_px: f64,
     ) -> ContactChoice {
         let mut notes = Vec::new();
         let m = self.relative(tc, &line);
@@ -992,12 +1022,16 @@ impl TrajectoryView {
                     line.cue.name()
                 ));
             }
-            return ContactChoice {
-                line,
-                trajectory_level_px: Some(m),
-                notes,
-                no_impact,
-            };
+            if between {
+                return ContactChoice {
+                    line,
+                    trajectory_share: 0.0,
+                    trajectory_level_px: Some(m),
+                    notes,
+                    no_impact,
+                };
+            }
+            return self.combined(line, tc, notes, no_impact, against_centres_px);
         }
         for alt in alternatives.iter().copied() {
             let ma = self.relative(tc, &alt);
@@ -1010,12 +1044,7 @@ impl TrajectoryView {
                     alt.cue.name(),
                     alt.y0
                 ));
-                return ContactChoice {
-                    line: alt,
-                    trajectory_level_px: Some(ma),
-                    notes,
-                    no_impact,
-                };
+                return self.combined(alt, tc, notes, no_impact, against_centres_px);
             }
         }
         notes.push(format!(
@@ -1031,7 +1060,40 @@ impl TrajectoryView {
                 sigma_tilt_deg: line.sigma_tilt_deg,
                 ..self.level_line(tc)
             },
+            trajectory_share: 0.0,
             trajectory_level_px: Some(Measured::new(0.0, tc.level_se_px)),
+            notes,
+            no_impact,
+        }
+    }
+
+    /// A `line` seen in the image that the trajectory agrees with, its level moved towards the
+    /// trajectory's by their inverse-variance weights: two measures of one level, the line's (with
+    /// `against_centres_px`, what comparing it with the centres adds) and the touch's. On a ragged band the
+    /// line's is a few px and the touch's a few tenths; on a clean step the line's is a few hundredths.
+    fn combined(
+        &self,
+        line: SurfaceLine,
+        tc: &TrajectoryContact,
+        notes: Vec<String>,
+        no_impact: Option<EstimateError>,
+        against_centres_px: f64,
+    ) -> ContactChoice {
+        let m = self.relative(tc, &line);
+        let var_line = line.level_sigma_px().hypot(against_centres_px).powi(2);
+        let share = if var_line + m.se * m.se > 0.0 && m.se.is_finite() {
+            var_line / (var_line + m.se * m.se)
+        } else {
+            0.0
+        };
+        let line = SurfaceLine {
+            y0: line.y0 - share * m.value * (1.0 + line.slope * line.slope).sqrt(),
+            ..line
+        };
+        ContactChoice {
+            line,
+            trajectory_share: share,
+            trajectory_level_px: Some(self.relative(tc, &line)),
             notes,
             no_impact,
         }

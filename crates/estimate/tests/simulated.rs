@@ -187,17 +187,19 @@ fn a_clip_ending_close_to_the_impact_is_refused_with_a_reason() {
 }
 
 /// A surface line found off by its stated σ moves both crossings the same way (the contact level is common
-/// to them), so the contact time's error is the sum of the two crossings' shifts, and its SE says so.
+/// to them), so the contact time's error is the sum of the two crossings' shifts, and its SE says so. (A
+/// σ small against the trajectory's, ≈ 0.8 px here, so that the level takes little from it.)
 #[test]
 fn a_surface_line_off_by_its_sigma_is_one_standard_error_of_the_contact_time() {
     let model = Model::paper(25_650.0, 14.0, 0.5);
     for (angle, drop) in [(0.0, 0.2), (22.5, 0.9)] {
         let (mut track, truth) = shot(&model, angle, drop, 0.02, 11);
         let line = track.surface.as_mut().unwrap();
-        // Found 0.5 px above the true surface, and said to be uncertain by 0.5 px.
-        line.y0 -= 0.5;
-        line.sigma_y0 = 0.5;
+        // Found 0.25 px above the true surface, and said to be uncertain by 0.25 px.
+        line.y0 -= 0.25;
+        line.sigma_y0 = 0.25;
         let e = estimate(&track, &conditions(angle)).unwrap();
+        assert!(e.trajectory_share < 0.15, "{angle}°: share {}", e.trajectory_share);
         let z = (e.contact_ms.value - truth.contact_time() * 1e3) / e.contact_ms.se;
         assert!((0.8..=1.25).contains(&z), "{angle}°: contact time error/SE = {z}");
         // COR barely moves: both speeds change the same way.
@@ -209,9 +211,39 @@ fn a_surface_line_off_by_its_sigma_is_one_standard_error_of_the_contact_time() {
     }
 }
 
+/// A ragged band's line, found 2 px above the surface and honestly uncertain by 2 px: the trajectory, which
+/// the line agrees with, places the level to a few tenths, so the level leans on it (by their
+/// inverse-variance weights) and ends within a pixel of the surface, its stated error shrunk to match.
+#[test]
+fn a_ragged_line_s_level_leans_on_the_trajectory() {
+    let model = Model::paper(25_650.0, 14.0, 0.5);
+    let mut errs = Vec::new();
+    for (k, (angle, drop)) in [(0.0, 0.2), (7.5, 0.3), (15.0, 0.5)].into_iter().enumerate() {
+        let (mut track, truth) = shot(&model, angle, drop, 0.02, 70 + k as u64);
+        let line = track.surface.as_mut().unwrap();
+        line.y0 -= 2.0;
+        line.sigma_y0 = 2.0;
+        let e = estimate(&track, &conditions(angle)).unwrap();
+        let used = e.contact_line.unwrap();
+        assert_eq!(used.cue, LineCue::Brightness, "{angle}°: {:?}", e.notes);
+        assert!(e.trajectory_share > 0.7, "{angle}°: share {}", e.trajectory_share);
+        let err = SURFACE_Y - used.y0;
+        // The level's error as stated: the line's 2 px times √(1 − share).
+        let sigma = 2.0 * (1.0 - e.trajectory_share).sqrt();
+        assert!(err.abs() < 3.0 * sigma, "{angle}°: level {err} px off, ± {sigma}");
+        errs.push(err);
+        let z = (e.contact_ms.value - truth.contact_time() * 1e3) / e.contact_ms.se;
+        assert!(z.abs() < 2.5, "{angle}°: contact time error/SE = {z}");
+    }
+    // The line alone is 2 px off on every shot.
+    let rms = (errs.iter().map(|e| e * e).sum::<f64>() / errs.len() as f64).sqrt();
+    assert!(rms < 1.0, "level RMS {rms} px over {errs:?}");
+}
+
 /// A rim found inside the ball on its dim side offsets every centre alike (the circle absorbs the rim's
 /// first harmonic). Against a line seen in the image that moves the contact as a level error does, and the
-/// contact time's error counts it at the rim shape's RMS.
+/// contact time's error counts it at the rim shape's RMS; the trajectory, measured in the centres' own
+/// frame, takes a part of it out (its share of the level).
 #[test]
 fn a_centre_offset_by_the_rim_s_shape_is_one_standard_error_of_the_contact_time() {
     let model = Model::paper(25_650.0, 14.0, 0.5);
@@ -225,7 +257,11 @@ fn a_centre_offset_by_the_rim_s_shape_is_one_standard_error_of_the_contact_time(
         scale.rim_shape_px = 0.5;
         let e = estimate(&track, &conditions(angle)).unwrap();
         let z = (e.contact_ms.value - truth.contact_time() * 1e3) / e.contact_ms.se;
-        assert!((-1.25..=-0.8).contains(&z), "{angle}°: contact time error/SE = {z}");
+        assert!((-1.25..=0.0).contains(&z), "{angle}°: contact time error/SE = {z}");
+        // (At 22.5° this seed's touch and separation lie on either side of the line: no share is taken.)
+        if angle == 0.0 {
+            assert!(e.trajectory_share > 0.1, "{angle}°: share {}", e.trajectory_share);
+        }
         // Without the term the same error is many standard errors.
         track.scale.as_mut().unwrap().rim_shape_px = 0.0;
         let e = estimate(&track, &conditions(angle)).unwrap();
@@ -289,8 +325,10 @@ fn without_a_surface_line_the_trajectory_tells_the_contact() {
         // The level against the truth (the plane at SURFACE_Y), px.
         let err = SURFACE_Y - line.y0;
         z_level.push(err / line.sigma_y0);
+        // The touch alone places the level: a fast impact's (22.5°, 0.9 m: 1 px a frame along the normal)
+        // to ± 1.8 px.
         assert!(
-            err.abs() < 1.5 && line.sigma_y0 < 1.0,
+            err.abs() < 1.5 && line.sigma_y0 < 2.0,
             "{angle}°: level {err} px ± {}",
             line.sigma_y0
         );
