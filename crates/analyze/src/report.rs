@@ -558,15 +558,16 @@ fn shot_plot(a: &Analysis, c: &ShotComparison) -> r::ShotPlot {
         notes.push(source);
     }
     if let Some(level) = surface_level(a, &c.surface, &c.shot) {
-        // The level is the true surface's height in the measured frame: a negative one lies below the line
-        // found in the image, so the line lies above the plane the ball touches.
+        // The level is the true surface's height in the measured frame: a negative one lies below the contact
+        // line used (found, leaning on the touch, given or from the trajectory), so that line lies above the
+        // plane the ball touches.
         let (where_, size) = if level <= 0.0 {
             ("above", -level)
         } else {
             ("below", level)
         };
         notes.push(format!(
-            "fitted surface level {} µm: the surface line found in the image lies {:.1} µm {where_} the plane the ball touches",
+            "fitted surface level {} µm: the contact line used lies {:.1} µm {where_} the plane the ball touches",
             format!("{:+.1}", level * 1e6).replace('-', "\u{2212}"),
             size * 1e6
         ));
