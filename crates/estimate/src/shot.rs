@@ -1031,7 +1031,7 @@ impl TrajectoryView {
                     no_impact,
                 };
             }
-            return self.combined(line, tc, notes, no_impact, against_centres_px);
+            return self.combined(line, m, tc, notes, no_impact, against_centres_px);
         }
         for alt in alternatives.iter().copied() {
             let ma = self.relative(tc, &alt);
@@ -1044,7 +1044,7 @@ impl TrajectoryView {
                     alt.cue.name(),
                     alt.y0
                 ));
-                return self.combined(alt, tc, notes, no_impact, against_centres_px);
+                return self.combined(alt, ma, tc, notes, no_impact, against_centres_px);
             }
         }
         notes.push(format!(
@@ -1067,19 +1067,19 @@ impl TrajectoryView {
         }
     }
 
-    /// A `line` seen in the image that the trajectory agrees with, its level moved towards the
-    /// trajectory's by their inverse-variance weights: two measures of one level, the line's (with
+    /// A `line` seen in the image that the trajectory agrees with (`m`: the trajectory's level above it), its
+    /// level moved towards the trajectory's by their inverse-variance weights: two measures of one level, the line's (with
     /// `against_centres_px`, what comparing it with the centres adds) and the touch's. On a ragged band the
     /// line's is a few px and the touch's a few tenths; on a clean step the line's is a few hundredths.
     fn combined(
         &self,
         line: SurfaceLine,
+        m: Measured,
         tc: &TrajectoryContact,
         notes: Vec<String>,
         no_impact: Option<EstimateError>,
         against_centres_px: f64,
     ) -> ContactChoice {
-        let m = self.relative(tc, &line);
         let var_line = line.level_sigma_px().hypot(against_centres_px).powi(2);
         let share = if var_line + m.se * m.se > 0.0 && m.se.is_finite() {
             var_line / (var_line + m.se * m.se)
