@@ -576,9 +576,9 @@ fn flights(points: &[Point], first: usize, last: usize) -> Result<(Vec<&Point>, 
 /// What "one radius above a line seen in the image" adds to the line's own error against the measured
 /// centres, px: the scale's error at one radius (`radius` m) and the rim's unseen first harmonic, which
 /// offsets every centre alike and so moves the contact as much as a level error (Type-B, like the radius's
-/// rim term; see `Scale`).
+/// rim term, with the limb's silhouette's offset from the fitted circles; see `Scale::centre_offset_px`).
 fn against_centres_px(scale: &bouncelab_track::Scale, radius: f64) -> f64 {
-    (radius / scale.m_per_px * scale.sigma_m_per_px / scale.m_per_px).hypot(scale.rim_shape_px)
+    (radius / scale.m_per_px * scale.sigma_m_per_px / scale.m_per_px).hypot(scale.centre_offset_px())
 }
 
 /// The errors of the contact level and the frame's axes that every crossing shares.

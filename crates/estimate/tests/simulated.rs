@@ -66,6 +66,8 @@ fn shot(model: &Model, incline_deg: f64, drop_m: f64, after: f64, seed: u64) -> 
             m_per_px: SCALE,
             sigma_m_per_px: SCALE * 2e-4,
             rim_shape_px: 0.0,
+            limb_centre_px: 0.0,
+            limb_radius_px: 0.0,
             radius_px: r / SCALE,
             frames: 150,
         }),
@@ -268,6 +270,34 @@ fn a_centre_offset_by_the_rim_s_shape_is_one_standard_error_of_the_contact_time(
         let z = (e.contact_ms.value - truth.contact_time() * 1e3) / e.contact_ms.se;
         assert!(z < -3.0, "{angle}°: without the rim term, contact time error/SE = {z}");
     }
+}
+
+/// The same offset told by the limb's silhouette instead of the rim's shape (a shaded limb meeting a backdrop
+/// of its own gray, whose rim shape is small) is as much in the contact time's error.
+#[test]
+fn a_centre_offset_the_limb_tells_is_in_the_contact_time_s_error() {
+    let model = Model::paper(25_650.0, 14.0, 0.5);
+    let (mut track, truth) = shot(&model, 0.0, 0.2, 0.02, 11);
+    for f in &mut track.fixes {
+        f.y_px -= 0.5;
+    }
+    let z = |track: &Track| {
+        let e = estimate(track, &conditions(0.0)).unwrap();
+        (e.contact_ms.value - truth.contact_time() * 1e3) / e.contact_ms.se
+    };
+    let scale = track.scale.as_mut().unwrap();
+    scale.rim_shape_px = 0.05;
+    let without = z(&track);
+    assert!(
+        without < -3.0,
+        "a 0.05 px rim shape alone: contact time error/SE = {without}"
+    );
+    track.scale.as_mut().unwrap().limb_centre_px = 0.5;
+    let with = z(&track);
+    assert!(
+        (-1.25..=0.0).contains(&with),
+        "with the limb's 0.5 px: contact time error/SE = {with}"
+    );
 }
 
 /// A rim whose bias grows along the incoming flight (the light on the limb changing along the path) shrinks

@@ -104,6 +104,12 @@ pub struct Scale {
     /// The rim shape's RMS, px (see `scale_from`): the Type-B standard uncertainty of the radius, and of
     /// the centre's offset common to every frame, which moves the ball's lowest point as the radius does.
     pub rim_shape_px: f64,
+    /// How far the limb's silhouette lies from the fitted circles' centres, px (see [`crate::LimbOffset`]):
+    /// a further standard uncertainty of the centre's common offset. 0 when not measured.
+    pub limb_centre_px: f64,
+    /// How far it lies outside their radius, px: a further standard uncertainty of the radius. 0 when not
+    /// measured.
+    pub limb_radius_px: f64,
     /// Mean free-flight radius, px.
     pub radius_px: f64,
     /// Frames it was measured on.
@@ -115,7 +121,12 @@ impl Scale {
     /// that is the same for every clip of a session gives every clip about the same radius bias, so it is
     /// not a shot-to-shot scatter.
     pub fn sigma_shape_m_per_px(&self) -> f64 {
-        self.m_per_px * self.rim_shape_px / self.radius_px
+        self.m_per_px * self.rim_shape_px.hypot(self.limb_radius_px) / self.radius_px
+    }
+
+    /// The standard uncertainty of the offset every centre shares, px: the rim shape's and the limb's.
+    pub fn centre_offset_px(&self) -> f64 {
+        self.rim_shape_px.hypot(self.limb_centre_px)
     }
 }
 
@@ -307,6 +318,7 @@ pub fn track_clip(
         opts.ball_diameter_m,
         tracker.edge_definition_px(),
         tracker.rim_shape_rms_px(),
+        tracker.limb_offset(),
     );
     let (ox, oy) = roi_origin(opts.roi.as_ref());
     // Back to the whole frame's pixels.
@@ -949,13 +961,17 @@ fn observe<P: Pixel>(tracker: &mut Tracker, frame: usize, t_s: f64, p: &Plane<P>
 ///   rim, which is what biases the radius, cannot be seen (a circle absorbs it), so it is taken to be as
 ///   uncertain as the part that can: the shape's RMS, as a standard uncertainty. The same reasoning keeps
 ///   the uncorrected spread in each frame's centre σ, and the estimator takes the first harmonic, which
-///   offsets every frame's centre alike, to be as uncertain (`Scale::rim_shape_px`).
+///   offsets every frame's centre alike, to be as uncertain (`Scale::rim_shape_px`);
+/// - the limb's silhouette, `limb`: how far a shaded limb's silhouette lies outside the fitted circles (see
+///   [`LimbOffset`](crate::LimbOffset)), its mean a standard uncertainty of the radius and its first
+///   harmonic one of the centre's common offset (`Scale::limb_radius_px`, `Scale::limb_centre_px`).
 pub(crate) fn scale_from(
     fixes: &[BallFix],
     surface: Option<&SurfaceLine>,
     diameter: f64,
     edge_definition_px: f64,
     rim_shape_rms_px: f64,
+    limb: Option<crate::LimbOffset>,
 ) -> Option<Scale> {
     let clear_of_line: Vec<f64> = fixes
         .iter()
@@ -986,11 +1002,14 @@ pub(crate) fn scale_from(
     let mean = radii.iter().sum::<f64>() / n;
     let sd = (radii.iter().map(|r| (r - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
     let m_per_px = diameter / (2.0 * mean);
+    let (limb_radius_px, limb_centre_px) = limb.map_or((0.0, 0.0), |l| (l.radius_px.abs(), l.centre_len_px()));
+    let var_px = sd * sd / n + edge_definition_px.powi(2) / 3.0 + rim_shape_rms_px.powi(2) + limb_radius_px.powi(2);
     Some(Scale {
         m_per_px,
-        sigma_m_per_px: m_per_px * ((sd * sd / n) + edge_definition_px.powi(2) / 3.0 + rim_shape_rms_px.powi(2)).sqrt()
-            / mean,
+        sigma_m_per_px: m_per_px * var_px.sqrt() / mean,
         rim_shape_px: rim_shape_rms_px,
+        limb_centre_px,
+        limb_radius_px,
         radius_px: mean,
         frames: radii.len(),
     })
@@ -1032,8 +1051,8 @@ mod tests {
                 status: Status::Ok,
             })
             .collect();
-        let plain = scale_from(&fixes, None, 0.067, 0.0, 0.0).unwrap();
-        let shaped = scale_from(&fixes, None, 0.067, 0.0, 0.08).unwrap();
+        let plain = scale_from(&fixes, None, 0.067, 0.0, 0.0, None).unwrap();
+        let shaped = scale_from(&fixes, None, 0.067, 0.0, 0.08, None).unwrap();
         assert_eq!(plain.m_per_px, shaped.m_per_px);
         // The radii's scatter alone: 0.01 px / √20 of 80 px.
         let scatter = plain.sigma_m_per_px / plain.m_per_px;
@@ -1043,6 +1062,19 @@ mod tests {
         // That part is named, for what is common to a session's clips.
         assert!((shaped.sigma_shape_m_per_px() / shaped.m_per_px - 0.08 / 80.0).abs() < 1e-12);
         assert_eq!(plain.sigma_shape_m_per_px(), 0.0);
+        // The limb's silhouette 0.06 px outside the circles and 0.3 px off their centres: the radius's part
+        // enters the scale's error and the session-common part, the centre's only the common offset's.
+        let limb = crate::LimbOffset {
+            radius_px: -0.06,
+            centre_px: (0.18, -0.24),
+            rays: 128,
+        };
+        let both = scale_from(&fixes, None, 0.067, 0.0, 0.08, Some(limb)).unwrap();
+        assert_eq!(both.m_per_px, plain.m_per_px);
+        let rel = both.sigma_m_per_px / both.m_per_px;
+        assert!((rel - scatter.hypot(0.1 / 80.0)).abs() < 1e-9, "{rel}");
+        assert!((both.sigma_shape_m_per_px() / both.m_per_px - 0.1 / 80.0).abs() < 1e-12);
+        assert!((both.centre_offset_px() - 0.08f64.hypot(0.3)).abs() < 1e-12, "{both:?}");
     }
 
     /// A ball first sighted in frames 20 and 25 is measured in the frames before from there, backward, and the

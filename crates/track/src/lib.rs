@@ -17,6 +17,7 @@ mod circle_fit;
 mod clip;
 mod hough;
 mod level;
+mod limb;
 mod local;
 mod motion;
 #[cfg(feature = "opencv")]
@@ -32,6 +33,7 @@ pub use circle_fit::{CircleFit, fit_circle};
 pub use clip::{ClipTracking, Scale, Track, TrackError, track_clip};
 pub use hough::{Circle, CircleDetection, detect_circles, outermost, radius_bands};
 pub use level::{LevelShift, ball_columns, mean_gray_level, remeasured};
+pub use limb::{LimbLearner, LimbOffset};
 pub use local::SurfaceFrame;
 pub use plane::{Pixel, Plane};
 pub use refine::{

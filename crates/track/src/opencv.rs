@@ -394,7 +394,7 @@ pub fn track_clip_opencv(
         warnings.push(format!("ball not found in {absent} of {} frames", fixes.len()));
     }
     // OpenCV gives no edge profile, so no edge-definition term: statistical error only.
-    let scale = crate::clip::scale_from(&fixes, surface.as_ref(), opts.ball_diameter_m, 0.0, 0.0);
+    let scale = crate::clip::scale_from(&fixes, surface.as_ref(), opts.ball_diameter_m, 0.0, 0.0, None);
     Ok(Track {
         fixes,
         surface,

@@ -4,6 +4,7 @@
 use crate::ball_search::{BALL_CANDIDATES, MIN_BALL_RADIUS_PX, radius_window};
 use crate::hough::{Circle, CircleDetection};
 use crate::level::{ball_columns, remeasured};
+use crate::limb::{LimbLearner, LimbOffset};
 use crate::motion::fit_motion;
 use crate::plane::{Pixel, Plane, median};
 use crate::refine::{
@@ -177,6 +178,9 @@ pub struct Tracker {
     /// the shape they give is not applied, only its RMS taken for the rim's errors when no clean frame
     /// taught one (see [`Tracker::rim_shape_rms_px`]).
     rim_doubtful: RimShapeLearner,
+    /// The mean radial profile of the same full-rim free-flight frames, clean or not: where the limb's
+    /// silhouette lies against the fitted circles (see [`Tracker::limb_offset`]).
+    limb: LimbLearner,
     rim_frozen: bool,
     /// The edge points `(ray, [x, y])` of this frame's search around the prediction while the rim's shape
     /// is being learned (its residuals teach the shape without a second search); empty otherwise.
@@ -267,6 +271,7 @@ impl Tracker {
             flight_edges: Vec::new(),
             rim: RimShapeLearner::default(),
             rim_doubtful: RimShapeLearner::default(),
+            limb: LimbLearner::default(),
             rim_frozen: false,
             rim_rays: Vec::new(),
             surface: None,
@@ -338,6 +343,12 @@ impl Tracker {
         let mut e = self.flight_edges.clone();
         let mid = e.len() / 2;
         *e.select_nth_unstable_by(mid, f64::total_cmp).1
+    }
+
+    /// How far the limb's silhouette lies from the circles fitted in free flight, measured on the full-rim
+    /// free-flight frames that teach the rim's shape (see [`LimbOffset`]); `None` before 8 of them.
+    pub fn limb_offset(&self) -> Option<LimbOffset> {
+        self.limb.offset()
     }
 
     /// How far the apparent rim strays from a circle, px: the RMS of the rim's shape learned from clean
@@ -810,6 +821,7 @@ impl Tracker {
                     residuals_about(&fit, &self.rim_rays)
                 };
                 let rays = self.opts.search.rays.max(8);
+                self.limb.add(img, (fit.x, fit.y, fit.r), rays);
                 if clean {
                     self.rim.add(rays, &res);
                     if self.rim.frames() >= RIM_MIN_SAMPLES {
