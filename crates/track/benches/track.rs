@@ -8,11 +8,12 @@
 //! looked for in the mean of the first 2 (the ball is known from the second frame), 8 and 32 frames. "cold_start_first_frame": the first frame of a
 //! clip without a track (Hough, refined candidates). "surface_line": one surface line search.
 //! "surface_level_by_mean_gray": the found line's level measured again from the band's mean gray.
-//! "detect_full_frame": the Hough transform alone.
+//! "detect_full_frame": the Hough transform alone. "limb_learn_frame": one frame's radial profiles added to the
+//! limb's mean (128 rays); "limb_offset": the limb model fitted to the mean of 64 frames, once per clip.
 
 use bouncelab_track::testutil::{Scene, render};
 use bouncelab_track::{
-    CircleDetection, Plane, TrackOptions, Tracker, detect_circles, find_surface_lines, mean_gray_level,
+    CircleDetection, LimbLearner, Plane, TrackOptions, Tracker, detect_circles, find_surface_lines, mean_gray_level,
 };
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
@@ -92,6 +93,20 @@ fn bench(c: &mut Criterion) {
     g.bench_function("detect_full_frame", |b| {
         b.iter(|| black_box(detect_circles(&Plane::new(&frames[0], 512, 512), &det)))
     });
+    // The scene's own circles: the ball in full flight in every frame.
+    let circle = |i: usize| (150.0 + 1.5 * i as f64, 120.0 + 2.0 * i as f64, 84.0);
+    g.bench_function("limb_learn_frame", |b| {
+        b.iter(|| {
+            let mut l = LimbLearner::default();
+            l.add(&Plane::new(&frames[10], 512, 512), circle(10), 128);
+            black_box(l.frames())
+        })
+    });
+    let mut limb = LimbLearner::default();
+    for (i, f) in frames.iter().enumerate().take(64) {
+        limb.add(&Plane::new(f, 512, 512), circle(i), 128);
+    }
+    g.bench_function("limb_offset", |b| b.iter(|| black_box(limb.offset())));
     g.finish();
 }
 

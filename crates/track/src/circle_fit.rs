@@ -113,6 +113,25 @@ pub fn fit_circle(points: &[[f64; 2]], x: f64, y: f64, r: f64) -> Option<CircleF
     })
 }
 
+/// Least squares of `v ≈ m + a·cos θ + b·sin θ` over `(cos θ, sin θ, v)`: `(m, a, b)`, the mean and first
+/// harmonic of values round a circle (what a circle fit absorbs as its radius and centre). `None` when the
+/// angles cannot tell them apart.
+pub(crate) fn first_harmonic(points: impl IntoIterator<Item = (f64, f64, f64)>) -> Option<[f64; 3]> {
+    let mut ata = [[0.0f64; 3]; 3];
+    let mut atb = [0.0f64; 3];
+    for (c, s, v) in points {
+        let row = [1.0, c, s];
+        for (j, rj) in row.iter().enumerate() {
+            atb[j] += rj * v;
+            for (k, rk) in row.iter().enumerate() {
+                ata[j][k] += rj * rk;
+            }
+        }
+    }
+    let inv = invert3(&ata)?;
+    Some([0, 1, 2].map(|j| (0..3).map(|k| inv[j][k] * atb[k]).sum()))
+}
+
 /// Inverse of a symmetric positive-definite 3×3 matrix; `None` when (nearly) singular.
 pub(crate) fn invert3(a: &[[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
     let c00 = a[1][1] * a[2][2] - a[1][2] * a[2][1];

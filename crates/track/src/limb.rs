@@ -9,8 +9,8 @@
 //! `R`. The silhouette's mean `R` and its first harmonic round the rim are how far the fitted circles' radius
 //! and centre lie from it. A limb model is one account of the shading among others (a fuzzy felt, a seam), so
 //! the tracker uses these as uncertainties of the offset every centre shares, not as corrections. Cost: 53
-//! samples per ray per frame learned (≈ 80 µs for 128 rays), and ≈ 5 ms once per clip for the fit (measured
-//! on 2 cores, release).
+//! samples per ray per frame learned (64 µs for 128 rays), and 4.9 ms once per clip for the fit (the track
+//! bench's `limb_learn_frame` and `limb_offset`).
 
 use crate::plane::{Pixel, Plane};
 
@@ -126,31 +126,13 @@ impl LimbLearner {
         if edges.len() * 2 < self.rays {
             return None;
         }
-        let (m, a, b) = first_harmonic(&edges)?;
+        let [m, a, b] = crate::circle_fit::first_harmonic(edges.iter().map(|&(t, r)| (t.cos(), t.sin(), r)))?;
         Some(LimbOffset {
             radius_px: m,
             centre_px: (a, b),
             rays: edges.len(),
         })
     }
-}
-
-/// Least squares of `r ≈ m + a·cos θ + b·sin θ` over `(θ, r)`.
-fn first_harmonic(points: &[(f64, f64)]) -> Option<(f64, f64, f64)> {
-    let mut ata = [[0.0f64; 3]; 3];
-    let mut atb = [0.0f64; 3];
-    for &(t, r) in points {
-        let row = [1.0, t.cos(), t.sin()];
-        for j in 0..3 {
-            atb[j] += row[j] * r;
-            for k in 0..3 {
-                ata[j][k] += row[j] * row[k];
-            }
-        }
-    }
-    let inv = crate::circle_fit::invert3(&ata)?;
-    let c: Vec<f64> = (0..3).map(|j| (0..3).map(|k| inv[j][k] * atb[k]).sum()).collect();
-    Some((c[0], c[1], c[2]))
 }
 
 /// The blurred limb's two inside shapes (a step and √(R − s)) sampled at the profile's points, for every

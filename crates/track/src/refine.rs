@@ -141,21 +141,11 @@ impl RimShapeLearner {
         }
         let trig = |k: usize, i: usize| self.harmonics[k - 1][i];
         let mean = |i: usize| self.sum[i] / self.count[i] as f64;
-        // Least squares of m_i ≈ a + b·cos θ_i + c·sin θ_i over the measured rays.
-        let mut ata = [[0.0f64; 3]; 3];
-        let mut atb = [0.0f64; 3];
-        for i in (0..n).filter(|&i| self.count[i] > 0) {
+        // The mean residual per measured ray less its least-squares mean and first harmonic.
+        let coef = crate::circle_fit::first_harmonic((0..n).filter(|&i| self.count[i] > 0).map(|i| {
             let (s, c) = trig(1, i);
-            let row = [1.0, c, s];
-            for (j, rj) in row.iter().enumerate() {
-                atb[j] += rj * mean(i);
-                for (k, rk) in row.iter().enumerate() {
-                    ata[j][k] += rj * rk;
-                }
-            }
-        }
-        let inv = crate::circle_fit::invert3(&ata)?;
-        let coef: Vec<f64> = (0..3).map(|j| (0..3).map(|k| inv[j][k] * atb[k]).sum()).collect();
+            (c, s, mean(i))
+        }))?;
         let rest: Vec<f64> = (0..n)
             .map(|i| {
                 if self.count[i] == 0 {
