@@ -78,8 +78,9 @@ pub(crate) fn session_key(session: &Session) -> String {
 /// taken over by a pass tracked back from the clip's end; 10: the frames after a bounce measured again
 /// backward, a found line's level measured again from the band's mean gray; 11: the trajectory's level from
 /// the touch alone, a found line's level moved towards it by their weights; 12: the limb's silhouette in the
-/// errors of the radius and of the centres' common offset).
-const MEASUREMENT_REVISION: u32 = 12;
+/// errors of the radius and of the centres' common offset; 13: a faint texture line looked for when no clear
+/// line is found).
+const MEASUREMENT_REVISION: u32 = 13;
 
 /// Everything besides the frame files that changes a shot's track or estimate.
 fn settings_text(entry: &ClipEntry, gravity: f64) -> String {

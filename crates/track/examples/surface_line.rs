@@ -1,11 +1,14 @@
 //! `cargo run --release -p bouncelab-track --example surface_line -- [--ball X,Y,R] FRAME.png [FRAME.png …]`:
 //! the surface line each cue finds in each frame (height at the centre column, tilt, σ, roughness), for
 //! looking at a clip the line finder has trouble with. With `--ball` (the ball's centre and radius, px, as
-//! the tracker would know them) lines the ball is not above are left out, as in the tracker. With `--mean`
+//! the tracker would know them) lines the ball is not above are left out, as in the tracker, and when no line
+//! is found the faint search the tracker makes in its full stack is shown too. With `--mean`
 //! the frames given are averaged first and one result is shown, as the tracker looks for the line.
 
 use bouncelab_frames::{FrameFormat, PngDecoder, decode_bytes};
-use bouncelab_track::{Plane, ball_columns, find_surface_lines, mean_gray_level, texture_line};
+use bouncelab_track::{
+    Plane, ball_columns, find_faint_surface_lines, find_surface_lines, mean_gray_level, texture_line,
+};
 
 fn main() {
     let mut args: Vec<String> = std::env::args().skip(1).collect();
@@ -77,7 +80,13 @@ fn main() {
                     None => println!("  level by the band's mean gray: no clear step"),
                 }
             }
-            None => println!("  no line"),
+            None => {
+                println!("  no line");
+                // As the tracker does in its full stack when no clear line shows.
+                if let Some(l) = ball.and_then(|b| find_faint_surface_lines(&plane, b, (b.0, b.0))) {
+                    println!("  faint       {}", show(&l.line));
+                }
+            }
         }
         if let Some(t) = texture_line(&plane) {
             println!("  texture     {}", show(&t));

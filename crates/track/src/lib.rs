@@ -39,8 +39,10 @@ pub use plane::{Pixel, Plane};
 pub use refine::{
     EdgeSearch, Refined, RimShape, RimShapeLearner, refine_candidates, refine_circle, refined_candidates, rim_residuals,
 };
-pub use surface::{LineCue, SurfaceLine, SurfaceLines, find_surface_line, find_surface_lines};
-pub use texture::{horizontal_gradient_energy, texture_line, texture_lines};
+pub use surface::{
+    LineCue, SurfaceLine, SurfaceLines, find_faint_surface_lines, find_surface_line, find_surface_lines,
+};
+pub use texture::{faint_texture_lines, horizontal_gradient_energy, texture_line, texture_lines};
 pub use tracker::{BallFix, Status, TrackOptions, Tracker, UnknownStatus};
 pub use trajectory::{TRAJECTORY_COLUMNS, TrajectoryCell, TrajectoryRow};
 

@@ -11,7 +11,7 @@ use crate::refine::{
     EdgeSearch, Refined, RimShapeLearner, refine_circle, refine_circle_with_rays, refined_candidates, residuals_about,
     rim_residuals,
 };
-use crate::surface::{SurfaceLine, find_surface_lines};
+use crate::surface::{SurfaceLine, find_faint_surface_lines, find_surface_lines};
 use serde::{Deserialize, Serialize};
 
 /// What the tracker could say about the ball in a frame.
@@ -450,11 +450,13 @@ impl Tracker {
     /// frame's width: a ball sweeping sideways leaves a straight edge in the mean, which must not reach the
     /// half of the columns a line needs. Searches while the ball is known: first in the frames summed by then
     /// (one, for a tracker seeded with the ball), then in 8 and in [`SURFACE_STACK_MAX`] frames (or when the
-    /// frames stop being added); a line found in more frames replaces one found in fewer. Where the ball is
+    /// frames stop being added); a line found in more frames replaces one found in fewer. In the full stack,
+    /// while no line has been found, a faint texture line is looked for too ([`find_faint_surface_lines`]):
+    /// never from fewer frames, whose noise it could line up. Where the ball is
     /// expected, a line above it is not the surface; until the ball is known (a tracker never seeded, before
     /// its first fix) no line is looked for, as the rims of round things side by side can pass for the top of
     /// a band. Cost: one add per pixel per summed frame, and a line search (≈ 3 ms for 512×512) per try,
-    /// [`SURFACE_TRIES`] at most.
+    /// [`SURFACE_TRIES`] at most (two searches in a full stack that shows no clear line).
     fn look_for_surface<P: Pixel>(&mut self, t_s: f64, img: &Plane<P>) {
         if self.surface_tries >= SURFACE_TRIES {
             return;
@@ -500,7 +502,11 @@ impl Tracker {
         let scale = 1.0 / self.stacked as f32;
         let mean: Vec<f32> = self.surface_stack.iter().map(|v| v * scale).collect();
         let plane = Plane::new(&mean, img.width, img.height);
-        if let Some(lines) = find_surface_lines(&plane, ball) {
+        // A faint line only from the full stack, once no clear one has been found in it.
+        let faint = |(x, y, r)| find_faint_surface_lines(&plane, (x, y, r), self.stack_span.unwrap_or((x, x)));
+        let lines = find_surface_lines(&plane, ball)
+            .or_else(|| ball.filter(|_| full && self.surface.is_none()).and_then(faint));
+        if let Some(lines) = lines {
             let span = ball.map(|(x, _, _)| self.stack_span.unwrap_or((x, x)));
             let skip = |l: &SurfaceLine| ball.zip(span).and_then(|(b, s)| ball_columns(l, b, s));
             let level = |l: SurfaceLine| remeasured(&plane, l, skip(&l));
@@ -948,32 +954,61 @@ mod tests {
         assert_eq!(line.cue, LineCue::Texture);
     }
 
-    /// The line the tracker keeps is the one found in the mean of the first frames with its level measured
-    /// again from the band's mean gray, and it lies at the ragged edge's mean.
-    #[test]
-    fn the_tracker_s_line_has_its_level_measured_again() {
-        let scene = |k: usize| Scene {
+    /// A ball falling over a band (`band` mean and texture, 0–255) whose top runs at y = 180.4 px with
+    /// `slope`, `roughness` px ragged, under `noise`.
+    fn ball_over_band(band: (f64, f64), slope: f64, roughness: f64, noise: f64) -> impl Fn(usize) -> Scene {
+        move |k| Scene {
             ball: (120.3 + 0.3 * k as f64, 70.2 + 0.8 * k as f64, 30.0),
-            surface: Some((180.4, 0.0)),
+            surface: Some((180.4, slope)),
             backdrop: (95.0, 95.0),
-            band: (65.0, 12.0),
-            roughness: 5.0,
-            noise: 3.0,
+            band,
+            roughness,
+            noise,
             seed: k as u64,
             ..Scene::default()
-        };
-        let truth = band_edge_mean(&scene(0));
+        }
+    }
+
+    /// A tracker seeded with the ball's size after `frames` frames of `scene`, and those frames' mean.
+    fn tracked_with_mean(scene: &impl Fn(usize) -> Scene, frames: usize) -> (Tracker, Vec<f32>) {
         let mut tracker = Tracker::new(TrackOptions {
             radius_px: Some((25.0, 35.0)),
             ..TrackOptions::default()
         });
         let mut sum = vec![0.0f32; 256 * 256];
-        for k in 0..SURFACE_STACK_MAX {
+        for k in 0..frames {
             let img = render(&scene(k));
             sum.iter_mut().zip(&img).for_each(|(s, v)| *s += *v as f32);
             tracker.observe(k, k as f64 * 1e-4, &Plane::new(&img, 256, 256));
         }
-        let mean: Vec<f32> = sum.iter().map(|s| s * (1.0 / SURFACE_STACK_MAX as f32)).collect();
+        let mean = sum.iter().map(|s| s * (1.0 / frames as f32)).collect();
+        (tracker, mean)
+    }
+
+    /// A band whose grains out-texture the backdrop too weakly for a clear line even in the mean of all the
+    /// stacked frames is taken as a faint texture line, from the full stack only.
+    #[test]
+    fn a_faint_band_is_taken_from_the_full_stack_only() {
+        let scene = ball_over_band((95.0, 14.0), 0.01, 2.0, 4.0);
+        let (early, _) = tracked_with_mean(&scene, SURFACE_STACK_MAX - 1);
+        assert!(early.surface().is_none(), "a faint line before the stack is full");
+        let (tracker, mean) = tracked_with_mean(&scene, SURFACE_STACK_MAX);
+        assert!(
+            find_surface_lines(&Plane::new(&mean, 256, 256), None).is_none(),
+            "a clear line in the mean"
+        );
+        let line = tracker.surface().expect("a faint line from the full stack");
+        assert_eq!(line.cue, LineCue::Texture);
+        assert!((line.y0 - 180.4).abs() < 1.5, "{line:?}");
+    }
+
+    /// The line the tracker keeps is the one found in the mean of the first frames with its level measured
+    /// again from the band's mean gray, and it lies at the ragged edge's mean.
+    #[test]
+    fn the_tracker_s_line_has_its_level_measured_again() {
+        let scene = ball_over_band((65.0, 12.0), 0.0, 5.0, 3.0);
+        let truth = band_edge_mean(&scene(0));
+        let (tracker, mean) = tracked_with_mean(&scene, SURFACE_STACK_MAX);
         let mean = Plane::new(&mean, 256, 256);
         let found = find_surface_lines(&mean, None).expect("a line").line;
         let shift = crate::level::mean_gray_level(&mean, &found, None).expect("a clear step");
