@@ -110,7 +110,7 @@ pub fn trajectory_contact(
             phase: "incoming",
             frames: low,
             needed: 2 * MIN_FLIGHT_FRAMES,
-            which: "starts",
+            why: "the clip starts too close to the impact",
         }
     } else {
         EstimateError::NoDeparture { frames: low }

@@ -3,7 +3,7 @@
 use crate::ballistic::{BallisticFit, fit_ballistic, fit_free_acceleration};
 use crate::contact::{HeightPoint, TrajectoryContact, find_impact, trajectory_contact};
 use crate::phase::PhaseFrames;
-use bouncelab_track::{LineCue, SurfaceFrame, SurfaceLine, Track};
+use bouncelab_track::{LineCue, Status, SurfaceFrame, SurfaceLine, Track};
 use serde::{Deserialize, Serialize};
 
 /// The conditions of a shot that the video does not show.
@@ -263,14 +263,13 @@ pub enum EstimateError {
     )]
     NoImpact { frames: usize, speed_m_s: f64, se_m_s: f64 },
     /// A flight phase has too few frames to fit.
-    #[error(
-        "{phase} flight too short to fit: {frames} usable frame(s), {needed} needed (the clip {which} too close to the impact)"
-    )]
+    #[error("{phase} flight too short to fit: {frames} usable frame(s), {needed} needed ({why})")]
     FlightTooShort {
         phase: &'static str,
         frames: usize,
         needed: usize,
-        which: &'static str,
+        /// The likely reason, as a phrase.
+        why: &'static str,
     },
     /// The ball's heights before its lowest point never leave a free-flight arc clearly enough to tell when
     /// it touched (a track that wanders, or one on something other than the ball).
@@ -281,6 +280,12 @@ pub enum EstimateError {
     /// A fit failed (degenerate times).
     #[error("the {phase} flight could not be fitted")]
     FitFailed { phase: &'static str },
+    /// The shot could not be measured (`cause`) and the track holds frames the tracker could not tell from
+    /// another circle, which the estimator does not use: the likely reason.
+    #[error(
+        "{cause}; {frames} frame(s) of the track could not be told from another circle (ambiguous, see the track's warnings) and are not used"
+    )]
+    Ambiguous { frames: usize, cause: Box<EstimateError> },
 }
 
 /// Fewest frames a flight fit uses.
@@ -309,7 +314,29 @@ struct Point {
 /// it agrees), its level moved towards the trajectory's by their inverse-variance weights
 /// ([`Estimate::trajectory_share`]); the contact level the trajectory gives (see `contact.rs`). The local
 /// frame follows that line's tilt in the image.
+///
+/// Frames the tracker could not tell from another circle (`ambiguous`) are not used; when the track has
+/// any, a shot that cannot be measured says so with its reason ([`EstimateError::Ambiguous`]: they are the
+/// likely cause), and one that can gets a note.
 pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError> {
+    let ambiguous = track.fixes.iter().filter(|f| f.status == Status::Ambiguous).count();
+    match estimate_from_measured(track, c) {
+        Err(e) if ambiguous > 0 && !matches!(e, EstimateError::BadCondition { .. }) => Err(EstimateError::Ambiguous {
+            frames: ambiguous,
+            cause: Box::new(e),
+        }),
+        Ok(mut e) if ambiguous > 0 => {
+            e.notes.push(format!(
+                "{ambiguous} frame(s) the tracker could not tell from another circle (ambiguous) are not used"
+            ));
+            Ok(e)
+        }
+        other => other,
+    }
+}
+
+/// [`estimate`] from the track's measured frames alone.
+fn estimate_from_measured(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError> {
     c.check()?;
     let scale = track.scale.ok_or(EstimateError::NoScale)?;
     let s = scale.m_per_px;
@@ -490,7 +517,7 @@ fn fitted_fixes(track: &Track) -> Result<Vec<&bouncelab_track::BallFix>, Estimat
             phase: "incoming",
             frames: measured.len(),
             needed: 2 * MIN_FLIGHT_FRAMES,
-            which: "holds too few measured frames",
+            why: "the track holds too few measured frames",
         });
     }
     Ok(measured)
@@ -560,13 +587,16 @@ fn flights(points: &[Point], first: usize, last: usize) -> Result<(Vec<&Point>, 
     let near = |p: &Point| p.clearance_px <= CLEARANCE_MARGIN_PX;
     let incoming: Vec<&Point> = points[..first].iter().filter(|p| !near(p)).collect();
     let outgoing: Vec<&Point> = points[last + 1..].iter().filter(|p| !near(p)).collect();
-    for (phase, set, which) in [("incoming", &incoming, "starts"), ("outgoing", &outgoing, "ends")] {
+    for (phase, set, why) in [
+        ("incoming", &incoming, "the clip starts too close to the impact"),
+        ("outgoing", &outgoing, "the clip ends too close to the impact"),
+    ] {
         if set.len() < MIN_FLIGHT_FRAMES {
             return Err(EstimateError::FlightTooShort {
                 phase,
                 frames: set.len(),
                 needed: MIN_FLIGHT_FRAMES,
-                which,
+                why,
             });
         }
     }

@@ -188,6 +188,62 @@ fn a_clip_ending_close_to_the_impact_is_refused_with_a_reason() {
     assert!(err.to_string().contains("ends too close to the impact"), "{err}");
 }
 
+/// Frames the tracker could not tell from another circle are not used: a shot whose outgoing flight is all
+/// such frames is refused naming them as well as the short flight; one with a few in its incoming flight is
+/// measured, with a note, as it is without them.
+#[test]
+fn ambiguous_frames_are_not_used_and_are_named() {
+    let model = Model::paper(25_650.0, 14.0, 0.5);
+    let (track, truth) = shot(&model, 0.0, 0.3, 0.01, 3);
+    let after = truth.t_separation + 3e-4;
+    let doubt = |f: &BallFix, from: f64, to: f64| BallFix {
+        status: if f.t_s > from && f.t_s < to {
+            Status::Ambiguous
+        } else {
+            f.status
+        },
+        ..*f
+    };
+    let cut = Track {
+        fixes: track.fixes.iter().map(|f| doubt(f, after, f64::INFINITY)).collect(),
+        ..track.clone()
+    };
+    let err = estimate(&cut, &conditions(0.0)).unwrap_err();
+    match &err {
+        EstimateError::Ambiguous { frames, cause } => {
+            assert!(*frames > 0);
+            assert!(
+                matches!(**cause, EstimateError::FlightTooShort { phase: "outgoing", .. }),
+                "{err}"
+            );
+        }
+        other => panic!("{other}"),
+    }
+    assert!(
+        err.to_string().contains("could not be told from another circle"),
+        "{err}"
+    );
+    let t0 = track.fixes[0].t_s;
+    let early = Track {
+        fixes: track.fixes.iter().map(|f| doubt(f, t0 - 1.0, t0 + 2.5e-4)).collect(),
+        ..track.clone()
+    };
+    let with = estimate(&early, &conditions(0.0)).expect("measured");
+    assert!(
+        with.notes
+            .iter()
+            .any(|n| n.contains("3 frame(s) the tracker could not tell")),
+        "{:?}",
+        with.notes
+    );
+    let without = Track {
+        fixes: track.fixes[3..].to_vec(),
+        ..track
+    };
+    let plain = estimate(&without, &conditions(0.0)).expect("measured");
+    assert_eq!(with.cor.value, plain.cor.value);
+}
+
 /// A surface line found off by its stated σ moves both crossings the same way (the contact level is common
 /// to them), so the contact time's error is the sum of the two crossings' shifts, and its SE says so. (A
 /// σ small against the trajectory's, ≈ 0.8 px here, so that the level takes little from it.)

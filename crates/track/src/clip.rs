@@ -292,8 +292,15 @@ pub fn track_clip(
     }
     backward.surface = tracker.surface().copied();
     backward.retrack_start(&mut fixes, &mut warnings)?;
-    backward.retrack_end(&mut fixes, noise, &mut warnings)?;
+    let doubtful = backward.retrack_end(&mut fixes, noise, &mut warnings)?;
     backward.retrack_bounce(&mut fixes, &tracker, &mut warnings)?;
+    if let Some(at) = doubtful {
+        let n = doubt_from(&mut fixes, at);
+        warnings.push(format!(
+            "{n} measured frame(s) from frame {} on marked ambiguous: they may not be the ball",
+            fixes[at].frame
+        ));
+    }
     let measured = fixes.iter().filter(|f| f.status.measured()).count();
     if forward.saturated > 0 {
         warnings.push(format!(
@@ -553,10 +560,16 @@ impl Backward<'_> {
     /// place of the forward ones from where the forward track left, when the two passes met before it and
     /// that pass holds the clearer circles after it ([`take_from_end`]); the forward pass's warnings about
     /// the frames it no longer measures are then dropped. What happened is said either way. `noise` is the
-    /// first frame's noise σ.
-    fn retrack_end(&self, fixes: &mut [BallFix], noise: f32, warnings: &mut Vec<String>) -> Result<(), TrackError> {
+    /// first frame's noise σ. The index of the first fix that may not be the ball when no pass could tell
+    /// (see [`doubt_from`]).
+    fn retrack_end(
+        &self,
+        fixes: &mut [BallFix],
+        noise: f32,
+        warnings: &mut Vec<String>,
+    ) -> Result<Option<usize>, TrackError> {
         let Some(jump) = left_the_ball(fixes.iter(), 0.5 * (self.radius.0 + self.radius.1)) else {
-            return Ok(());
+            return Ok(None);
         };
         let off = fixes[jump.at].frame;
         let said = format!(
@@ -567,7 +580,7 @@ impl Backward<'_> {
             warnings.push(format!(
                 "{said}; the ball was not found again from the clip's end: frames from {off} on may not be the ball"
             ));
-            return Ok(());
+            return Ok(Some(jump.at));
         };
         match take_from_end(fixes, &from_end, jump.at) {
             Ok(replaced) => {
@@ -575,15 +588,21 @@ impl Backward<'_> {
                 warnings.push(format!(
                     "{said}: the ball found again from the clip's end and tracked back, {replaced} frame(s) re-measured from there"
                 ));
+                Ok(None)
             }
-            Err(NotTaken::NeverMet) => warnings.push(format!(
-                "{said}; the circle found from the clip's end and tracked back never meets this track before frame {off} (another object, or this track was not on the ball): frames from {off} on may not be the ball"
-            )),
-            Err(NotTaken::NoClearer) => warnings.push(format!(
-                "{said}; tracked back from the clip's end, the ball was no clearer: frames from {off} on may not be the ball"
-            )),
+            Err(NotTaken::NeverMet) => {
+                warnings.push(format!(
+                    "{said}; the circle found from the clip's end and tracked back never meets this track before frame {off} (another object, or this track was not on the ball): frames from {off} on may not be the ball"
+                ));
+                Ok(Some(jump.at))
+            }
+            Err(NotTaken::NoClearer) => {
+                warnings.push(format!(
+                    "{said}; tracked back from the clip's end, the ball was no clearer: frames from {off} on may not be the ball"
+                ));
+                Ok(Some(jump.at))
+            }
         }
-        Ok(())
     }
 
     /// Every file measured by a fresh tracker run back in time from the ball's sightings near the clip's end
@@ -639,6 +658,18 @@ struct Jump {
 
 /// How many of a track's first steps between measured fixes tell how fast its ball moves.
 const JUMP_REFERENCE_STEPS: usize = 8;
+
+/// Marks the measured fixes from `at` on `ambiguous`, and says how many there were: the track jumped there
+/// further than the ball can, and no pass could tell which side of the jump holds the ball, so no frame from
+/// there on is reported as measured on it (the estimator then has only the frames before the jump).
+fn doubt_from(fixes: &mut [BallFix], at: usize) -> usize {
+    let mut n = 0;
+    for f in fixes[at..].iter_mut().filter(|f| f.status.measured()) {
+        f.status = Status::Ambiguous;
+        n += 1;
+    }
+    n
+}
 
 /// How many times its typical step a ball's step may be ([`left_the_ball`]): it speeds up under gravity and
 /// may leave the surface faster along it than it came (spin), but not by this much within a clip.
@@ -1294,6 +1325,22 @@ mod tests {
             *f = BallFix::absent(f.frame, f.t_s, Status::Absent);
         }
         assert_eq!(left_the_ball(off.iter(), 40.0), None);
+    }
+
+    /// Frames from a jump no pass could explain are not reported as the ball: the measured ones become
+    /// `ambiguous`, frames not found stay so, and the frames before the jump are left as they were.
+    #[test]
+    fn frames_from_an_unexplained_jump_are_ambiguous() {
+        let before = on_the_ball(0..30, 0.8);
+        let mut fixes = before.clone();
+        fixes[25] = BallFix::absent(25, fixes[25].t_s, Status::Absent);
+        assert_eq!(doubt_from(&mut fixes, 20), 9);
+        assert_eq!(fixes[..20], before[..20]);
+        assert_eq!(fixes[25].status, Status::Absent);
+        for (f, b) in fixes[20..].iter().zip(&before[20..]).filter(|(f, _)| f.frame != 25) {
+            assert_eq!(f.status, Status::Ambiguous);
+            assert_eq!((f.x_px, f.y_px), (b.x_px, b.y_px));
+        }
     }
 
     /// The pass from the clip's end takes the frames from where the forward track left the ball when it holds
