@@ -502,12 +502,14 @@ impl Tracker {
         let scale = 1.0 / self.stacked as f32;
         let mean: Vec<f32> = self.surface_stack.iter().map(|v| v * scale).collect();
         let plane = Plane::new(&mean, img.width, img.height);
+        let span = ball.map(|(x, _, _)| self.stack_span.unwrap_or((x, x)));
         // A faint line only from the full stack, once no clear one has been found in it.
-        let faint = |(x, y, r)| find_faint_surface_lines(&plane, (x, y, r), self.stack_span.unwrap_or((x, x)));
-        let lines = find_surface_lines(&plane, ball)
-            .or_else(|| ball.filter(|_| full && self.surface.is_none()).and_then(faint));
+        let lines = find_surface_lines(&plane, ball).or_else(|| {
+            ball.zip(span)
+                .filter(|_| full && self.surface.is_none())
+                .and_then(|(b, s)| find_faint_surface_lines(&plane, b, s))
+        });
         if let Some(lines) = lines {
-            let span = ball.map(|(x, _, _)| self.stack_span.unwrap_or((x, x)));
             let skip = |l: &SurfaceLine| ball.zip(span).and_then(|(b, s)| ball_columns(l, b, s));
             let level = |l: SurfaceLine| remeasured(&plane, l, skip(&l));
             let line = level(lines.line);
