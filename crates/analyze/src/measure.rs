@@ -79,8 +79,10 @@ pub(crate) fn session_key(session: &Session) -> String {
 /// backward, a found line's level measured again from the band's mean gray; 11: the trajectory's level from
 /// the touch alone, a found line's level moved towards it by their weights; 12: the limb's silhouette in the
 /// errors of the radius and of the centres' common offset; 13: a faint texture line looked for when no clear
-/// line is found, the frames from a step no pass explained marked ambiguous).
-const MEASUREMENT_REVISION: u32 = 13;
+/// line is found, the frames from a step no pass explained marked ambiguous; 14: a circle taken for the
+/// ball only when its rim stands out of the noise, the frames before a lost rim taken from the pass from the
+/// clip's end).
+const MEASUREMENT_REVISION: u32 = 14;
 
 /// Everything besides the frame files that changes a shot's track or estimate.
 fn settings_text(entry: &ClipEntry, gravity: f64) -> String {

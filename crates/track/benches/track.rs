@@ -10,10 +10,12 @@
 //! "surface_level_by_mean_gray": the found line's level measured again from the band's mean gray.
 //! "detect_full_frame": the Hough transform alone. "limb_learn_frame": one frame's radial profiles added to the
 //! limb's mean (128 rays); "limb_offset": the limb model fitted to the mean of 64 frames, once per clip.
+//! "rim_evidence": whether one fix's rim stands out of the noise (128 rays), once per accepted fix.
 
 use bouncelab_track::testutil::{Scene, render};
 use bouncelab_track::{
     CircleDetection, LimbLearner, Plane, TrackOptions, Tracker, detect_circles, find_surface_lines, mean_gray_level,
+    rim_evidence,
 };
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
@@ -107,6 +109,10 @@ fn bench(c: &mut Criterion) {
         limb.add(&Plane::new(f, 512, 512), circle(i), 128);
     }
     g.bench_function("limb_offset", |b| b.iter(|| black_box(limb.offset())));
+    let frame = Plane::new(&frames[10], 512, 512);
+    g.bench_function("rim_evidence", |b| {
+        b.iter(|| black_box(rim_evidence(&frame, circle(10), 128, warm.surface(), 2.0)))
+    });
     g.finish();
 }
 

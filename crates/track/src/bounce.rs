@@ -78,6 +78,13 @@ pub(crate) fn after_bounce(fixes: &[BallFix], line: &SurfaceLine) -> Option<Afte
 /// 2,000 fps).
 const SAME_CIRCLE_PX: f64 = 1.0;
 
+/// Whether two passes' fixes `a` and `b` of one frame are the same circle: centres within
+/// [`SAME_CIRCLE_PX`] or 3 combined σ.
+pub(crate) fn same_circle(a: &BallFix, b: &BallFix) -> bool {
+    let apart = (a.x_px - b.x_px).hypot(a.y_px - b.y_px);
+    apart <= (3.0 * a.sigma_px.hypot(b.sigma_px)).max(SAME_CIRCLE_PX)
+}
+
 /// Whether the fix `back` of the backward pass replaces the forward pass's `forward` after the bounce on
 /// `line`: the forward frame was not measured, or the two are not the same circle (centres further apart
 /// than [`SAME_CIRCLE_PX`] and 3 combined σ) and
@@ -94,9 +101,7 @@ pub(crate) fn back_replaces(line: &SurfaceLine, back: &BallFix, forward: &BallFi
     if !forward.status.measured() {
         return true;
     }
-    let apart = (back.x_px - forward.x_px).hypot(back.y_px - forward.y_px);
-    let sigma = back.sigma_px.hypot(forward.sigma_px);
-    if apart <= (3.0 * sigma).max(SAME_CIRCLE_PX) {
+    if same_circle(back, forward) {
         return false;
     }
     if clear_of(line, back) {

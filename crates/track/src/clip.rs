@@ -293,6 +293,9 @@ pub fn track_clip(
     backward.surface = tracker.surface().copied();
     backward.retrack_start(&mut fixes, &mut warnings)?;
     let doubtful = backward.retrack_end(&mut fixes, noise, &mut warnings)?;
+    if doubtful.is_none() {
+        backward.retrack_after_lost_rim(&mut fixes, &tracker, noise, &mut warnings)?;
+    }
     backward.retrack_bounce(&mut fixes, &tracker, &mut warnings)?;
     if let Some(at) = doubtful {
         let n = doubt_from(&mut fixes, at);
@@ -605,6 +608,53 @@ impl Backward<'_> {
         }
     }
 
+    /// When the forward track lost the ball's rim ([`Tracker::rim_lost_at`]) but made no step the ball
+    /// cannot make ([`left_the_ball`]), it found the ball again near its path, and the frames just before
+    /// the loss may have followed the rim as it faded (into a band in contact, at a low frame rate). The
+    /// ball is then looked for from the clip's end and tracked back ([`Self::track_from_end`]), and the
+    /// frames before the loss compared, going back, until the two passes hold the same circle
+    /// ([`crate::bounce::same_circle`]): where they differ before that, the pass from the end's fix replaces
+    /// the forward one unless that is clearly the clearer ([`clearer`]), as the forward track was losing
+    /// the rim there. A pass that never meets the forward track before the loss replaces nothing. What was
+    /// replaced is said.
+    fn retrack_after_lost_rim(
+        &self,
+        fixes: &mut [BallFix],
+        forward: &Tracker,
+        noise: f32,
+        warnings: &mut Vec<String>,
+    ) -> Result<(), TrackError> {
+        let Some(at) = forward
+            .rim_lost_at()
+            .and_then(|frame| fixes.iter().position(|f| f.frame == frame))
+        else {
+            return Ok(());
+        };
+        let said = format!(
+            "frame {}: the track lost the ball's rim and found the ball again near its path",
+            fixes[at].frame
+        );
+        let outcome = match self.track_from_end(noise)? {
+            None => "the ball was not found again from the clip's end: the forward track stands".to_string(),
+            Some(from_end) => match before_the_loss(fixes, &from_end, at) {
+                None => {
+                    "the pass from the clip's end never met this track before it: the forward track stands".to_string()
+                }
+                Some(replace) => {
+                    for &k in &replace {
+                        fixes[k] = from_end[k];
+                    }
+                    format!(
+                        "tracked back from the clip's end, {} frame(s) before it re-measured where the two passes differ",
+                        replace.len()
+                    )
+                }
+            },
+        };
+        warnings.push(format!("{said}; {outcome}"));
+        Ok(())
+    }
+
     /// Every file measured by a fresh tracker run back in time from the ball's sightings near the clip's end
     /// (files up to the later sighting in reverse order, the files after it forward from it); `None` when
     /// the ball is not found there.
@@ -904,6 +954,25 @@ fn retrack_bounce(
     }))
 }
 
+/// The files before `at` (where the forward track lost the ball's rim, and found it again or not) whose fix
+/// the pass from the clip's end replaces (see [`Backward::retrack_after_lost_rim`]): going back from `at`
+/// until both passes measured the same circle, those where `from_end` is measured and the forward fix is
+/// not clearly the clearer ([`clearer`]). `None` when they never meet.
+fn before_the_loss(fixes: &[BallFix], from_end: &[BallFix], at: usize) -> Option<Vec<usize>> {
+    let mut replace = Vec::new();
+    for k in (0..at).rev() {
+        let (old, new) = (&fixes[k], &from_end[k]);
+        if old.status.measured() && new.status.measured() && crate::bounce::same_circle(new, old) {
+            return Some(replace);
+        }
+        // The forward track was losing the rim here: its fix stands only where it is clearly the clearer.
+        if new.status.measured() && !(old.status.measured() && clearer(old, new)) {
+            replace.push(k);
+        }
+    }
+    None
+}
+
 /// Whether a fix measured on another pass replaces `old`: `old` is not measured, or is a clearly weaker
 /// circle (quality lower by more than 0.1).
 fn clearer(fix: &BallFix, old: &BallFix) -> bool {
@@ -1064,6 +1133,48 @@ mod tests {
             seed: k as u64,
             ..Scene::default()
         })
+    }
+
+    /// A fix of frame `k` at (x, y) with `quality`.
+    fn fix_at(k: usize, (x, y): (f64, f64), quality: f64) -> BallFix {
+        BallFix {
+            frame: k,
+            t_s: k as f64 * 1e-4,
+            x_px: x,
+            y_px: y,
+            r_px: 40.0,
+            sigma_px: 0.05,
+            sigma_r_px: 0.05,
+            quality,
+            status: Status::Ok,
+        }
+    }
+
+    /// Before the frame where the forward track lost the rim, the frames it drifted on (down into a band)
+    /// take the pass from the end's fixes back to where the two passes meet, but where the forward fix is
+    /// clearly the clearer; frames before the meeting are left alone, and a pass that never meets the
+    /// forward track replaces nothing.
+    #[test]
+    fn frames_drifted_before_a_lost_rim_take_the_pass_from_the_end() {
+        let from_end: Vec<BallFix> = (0..12).map(|k| fix_at(k, ball_at(k), 0.7)).collect();
+        let mut forward = from_end.clone();
+        for (k, f) in forward.iter_mut().enumerate().take(9).skip(5) {
+            let (x, y) = ball_at(k);
+            *f = fix_at(k, (x, y + (k - 3) as f64), 0.5);
+        }
+        // Frame 6 drifted too, but its circle is clearly the clearer: it stands.
+        forward[6].quality = 0.85;
+        forward[9] = BallFix::absent(9, 9e-4, Status::Absent);
+        forward[2].y_px += 3.0;
+        assert_eq!(before_the_loss(&forward, &from_end, 9), Some(vec![8, 7, 5]));
+        let elsewhere: Vec<BallFix> = from_end
+            .iter()
+            .map(|f| BallFix {
+                x_px: f.x_px + 30.0,
+                ..*f
+            })
+            .collect();
+        assert_eq!(before_the_loss(&forward, &elsewhere, 9), None);
     }
 
     /// The rim shape's RMS enters the scale's error as a standard uncertainty of the radius.
@@ -1279,22 +1390,7 @@ mod tests {
 
     /// Fixes of a ball on the path `ball_at` (quality `q`), every frame measured.
     fn on_the_ball(frames: std::ops::Range<usize>, q: f64) -> Vec<BallFix> {
-        frames
-            .map(|k| {
-                let (x, y) = ball_at(k);
-                BallFix {
-                    frame: k,
-                    t_s: k as f64 * 1e-4,
-                    x_px: x,
-                    y_px: y,
-                    r_px: 40.0,
-                    sigma_px: 0.05,
-                    sigma_r_px: 0.05,
-                    quality: q,
-                    status: Status::Ok,
-                }
-            })
-            .collect()
+        frames.map(|k| fix_at(k, ball_at(k), q)).collect()
     }
 
     /// A track that moves as a ball does, through a bounce, has not left it; one that steps a quarter of a

@@ -24,6 +24,7 @@ mod motion;
 pub mod opencv;
 mod plane;
 mod refine;
+mod rim_evidence;
 mod surface;
 mod texture;
 mod tracker;
@@ -39,6 +40,7 @@ pub use plane::{Pixel, Plane};
 pub use refine::{
     EdgeSearch, Refined, RimShape, RimShapeLearner, refine_candidates, refine_circle, refined_candidates, rim_residuals,
 };
+pub use rim_evidence::{MIN_SECTORS_STANDING_OUT, RimEvidence, SECTORS, rim_evidence};
 pub use surface::{
     LineCue, SurfaceLine, SurfaceLines, find_faint_surface_lines, find_surface_line, find_surface_lines,
 };

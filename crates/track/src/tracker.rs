@@ -11,6 +11,7 @@ use crate::refine::{
     EdgeSearch, Refined, RimShapeLearner, refine_circle, refine_circle_with_rays, refined_candidates, residuals_about,
     rim_residuals,
 };
+use crate::rim_evidence::{RimEvidence, rim_evidence};
 use crate::surface::{SurfaceLine, find_faint_surface_lines, find_surface_lines};
 use serde::{Deserialize, Serialize};
 
@@ -204,6 +205,10 @@ pub struct Tracker {
     last_innovation: f64,
     /// Consecutive frames where only circles far from the prediction were found.
     missed: usize,
+    /// A circle without a rim ([`Tracker::rim_stands_out`]) has been refused and said so.
+    told_no_rim: bool,
+    /// The first frame where the circle found at the prediction had no rim (see [`Tracker::rim_lost_at`]).
+    rim_lost_at: Option<usize>,
 }
 
 /// Frames averaged at most for the surface line (see [`Tracker::look_for_surface`]).
@@ -285,6 +290,8 @@ impl Tracker {
             warnings: Vec::new(),
             last_innovation: 0.0,
             missed: 0,
+            told_no_rim: false,
+            rim_lost_at: None,
         }
     }
 
@@ -573,6 +580,7 @@ impl Tracker {
         if let Some((found, px, py, r)) = found
             && self.plausible(&found, px, py, r, max_jump)
             && self.same_rim(&found)
+            && self.continues_on_rim(frame, img, &found)
         {
             self.last_innovation = (found.fit.x - px).hypot(found.fit.y - py);
             self.note_innovation(self.last_innovation, (found.fit.x, found.fit.y));
@@ -609,6 +617,7 @@ impl Tracker {
         let gate = 0.5 * r_expected + (2.0 * self.speed_px_per_s() * self.frame_period() + 1.0) * self.missed as f64;
         let d = |c: &(Circle, Refined)| (c.1.fit.x - px).hypot(c.1.fit.y - py);
         cands.retain(|c| d(c) <= gate && self.same_rim(&c.1) && self.ball_sized(&c.1));
+        cands.retain(|c| self.rim_stands_out(frame, img, &c.1));
         if cands.is_empty() {
             self.missed += 1;
             if self.missed == 3 {
@@ -648,6 +657,7 @@ impl Tracker {
         img: &Plane<P>,
         mut cands: Vec<(Circle, Refined)>,
     ) -> BallFix {
+        cands.retain(|c| self.rim_stands_out(frame, img, &c.1));
         if cands.is_empty() {
             return BallFix::absent(frame, t_s, Status::Absent);
         }
@@ -772,6 +782,45 @@ impl Tracker {
             return true;
         }
         f.visible_quality() >= QUALITY_DROP * median(&mut self.qualities.clone())
+    }
+
+    /// [`Tracker::rim_stands_out`] for the circle found at the prediction; the first frame where a track
+    /// that had measured the ball finds none is kept ([`Tracker::rim_lost_at`]).
+    fn continues_on_rim<P: Pixel>(&mut self, frame: usize, img: &Plane<P>, f: &Refined) -> bool {
+        let on_rim = self.rim_stands_out(frame, img, f);
+        if !on_rim && self.rim_lost_at.is_none() && self.history.len() > 2 {
+            self.rim_lost_at = Some(frame);
+        }
+        on_rim
+    }
+
+    /// The first frame where the circle the track found at its prediction had no rim standing out of the
+    /// noise, after the track had measured the ball: the track had lost the ball's rim there, and may have
+    /// drifted off it over the frames before (it follows the rim as that fades).
+    pub fn rim_lost_at(&self) -> Option<usize> {
+        self.rim_lost_at
+    }
+
+    /// Whether `f`'s rim stands out of the frame's noise ([`rim_evidence`]): a refinement in noise returns
+    /// the circle it started from with a fair quality, and a track that lost the ball would follow it. The
+    /// first refusal is told in the track's warnings.
+    fn rim_stands_out<P: Pixel>(&mut self, frame: usize, img: &Plane<P>, f: &Refined) -> bool {
+        let search = &self.opts.search;
+        let e: RimEvidence = rim_evidence(
+            img,
+            (f.fit.x, f.fit.y, f.fit.r),
+            search.rays,
+            self.surface.as_ref(),
+            search.surface_margin,
+        );
+        if !e.stands_out() && !self.told_no_rim {
+            self.told_no_rim = true;
+            self.warnings.push(format!(
+                "frame {frame}: the circle at ({:.1}, {:.1}) has no rim standing out of the noise ({} of {} sectors): not taken for the ball",
+                f.fit.x, f.fit.y, e.standing_out, e.sectors
+            ));
+        }
+        e.stands_out()
     }
 
     fn plausible(&self, f: &Refined, px: f64, py: f64, r: f64, max_jump: f64) -> bool {
@@ -1215,6 +1264,52 @@ mod tests {
         let (x, y) = at(21);
         assert_eq!(fix.status, Status::Ok, "{fix:?}");
         assert!((fix.x_px - x).hypot(fix.y_px - y) < 0.3, "{fix:?}");
+    }
+
+    /// A dim ball in heavy noise that vanishes: the refinement around the prediction still returns a circle
+    /// of fair quality from the noise's strongest steps, but no rim stands out under it, so no frame after
+    /// the ball is gone is `ok`.
+    #[test]
+    fn a_circle_made_of_noise_does_not_continue_the_track() {
+        let at = |k: usize| (110.3 + 0.4 * k as f64, 90.7 + 0.9 * k as f64);
+        let scene = |k: usize, ball: bool| {
+            let (x, y) = at(k);
+            render(&Scene {
+                // Gone: drawn outside the frame.
+                ball: if ball { (x, y, 40.0) } else { (-500.0, -500.0, 40.0) },
+                ball_level: 140.0,
+                backdrop: (90.0, 90.0),
+                noise: 12.0,
+                seed: k as u64,
+                ..Scene::default()
+            })
+        };
+        let mut tracker = Tracker::new(TrackOptions {
+            radius_px: Some((36.0, 44.0)),
+            search: EdgeSearch {
+                smooth: true,
+                ..EdgeSearch::default()
+            },
+            ..TrackOptions::default()
+        });
+        follow(&mut tracker, at, |k| scene(k, true), 20, 1.5);
+        let after: Vec<Status> = (20..40)
+            .map(|k| {
+                let px = scene(k, false);
+                tracker.observe(k, k as f64 * 1e-4, &Plane::new(&px, 256, 256)).status
+            })
+            .collect();
+        assert!(after.iter().all(|s| *s != Status::Ok), "{after:?}");
+        assert!(
+            tracker.rim_lost_at().is_some_and(|k| k >= 20),
+            "{:?}",
+            tracker.rim_lost_at()
+        );
+        assert!(
+            tracker.warnings().iter().any(|w| w.contains("no rim standing out")),
+            "{:?}",
+            tracker.warnings()
+        );
     }
 
     /// A fix kept `inliers` of 128 rays at full contrast: its visible quality is `inliers`/128.
