@@ -11,7 +11,7 @@ use crate::refine::{
     EdgeSearch, Refined, RimShapeLearner, refine_circle, refine_circle_with_rays, refined_candidates, residuals_about,
     rim_residuals,
 };
-use crate::rim_evidence::{RimEvidence, rim_evidence};
+use crate::rim_evidence::rim_evidence;
 use crate::surface::{SurfaceLine, find_faint_surface_lines, find_surface_lines};
 use serde::{Deserialize, Serialize};
 
@@ -806,7 +806,7 @@ impl Tracker {
     /// first refusal is told in the track's warnings.
     fn rim_stands_out<P: Pixel>(&mut self, frame: usize, img: &Plane<P>, f: &Refined) -> bool {
         let search = &self.opts.search;
-        let e: RimEvidence = rim_evidence(
+        let e = rim_evidence(
             img,
             (f.fit.x, f.fit.y, f.fit.r),
             search.rays,
@@ -1266,9 +1266,9 @@ mod tests {
         assert!((fix.x_px - x).hypot(fix.y_px - y) < 0.3, "{fix:?}");
     }
 
-    /// A dim ball in heavy noise that vanishes: the refinement around the prediction still returns a circle
-    /// of fair quality from the noise's strongest steps, but no rim stands out under it, so no frame after
-    /// the ball is gone is `ok`.
+    /// A ball in heavy noise (12 DN) that vanishes: the refinement around the prediction can still return a
+    /// circle of fair quality from the noise's strongest steps, but no rim stands out under it, so no frame
+    /// after the ball is gone is `ok`, and the loss is kept.
     #[test]
     fn a_circle_made_of_noise_does_not_continue_the_track() {
         let at = |k: usize| (110.3 + 0.4 * k as f64, 90.7 + 0.9 * k as f64);
