@@ -81,8 +81,9 @@ pub(crate) fn session_key(session: &Session) -> String {
 /// errors of the radius and of the centres' common offset; 13: a faint texture line looked for when no clear
 /// line is found, the frames from a step no pass explained marked ambiguous; 14: a circle taken for the
 /// ball only when its rim stands out of the noise, the frames before a lost rim taken from the pass from the
-/// clip's end).
-const MEASUREMENT_REVISION: u32 = 14;
+/// clip's end; 15: a circle acquired only when its rim stands out of the noise, a circle detected before
+/// the ball's flight radius is known only within the radius range it was acquired with).
+const MEASUREMENT_REVISION: u32 = 15;
 
 /// Everything besides the frame files that changes a shot's track or estimate.
 fn settings_text(entry: &ClipEntry, gravity: f64) -> String {

@@ -828,10 +828,14 @@ impl Tracker {
         jump <= max_jump && same_size(f.fit.r, r) && f.fit.inliers * 3 >= f.rays && f.quality() > 0.2
     }
 
-    /// Whether `f` is the size of the ball in free flight so far (see [`same_size`]); true until a flight
-    /// radius is known.
+    /// Whether `f` is the size of the ball: of its radius in free flight so far (see [`same_size`]), else
+    /// within the radius range it was acquired with ([`TrackOptions::radius_px`]); true with neither.
     fn ball_sized(&self, f: &Refined) -> bool {
-        self.flight_radius().is_none_or(|r| same_size(f.fit.r, r))
+        match (self.flight_radius(), self.opts.radius_px) {
+            (Some(r), _) => same_size(f.fit.r, r),
+            (None, Some((lo, hi))) => (lo..=hi).contains(&f.fit.r),
+            (None, None) => true,
+        }
     }
 
     fn accept<P: Pixel>(&mut self, frame: usize, t_s: f64, img: &Plane<P>, f: Refined, mut status: Status) -> BallFix {
@@ -1310,6 +1314,38 @@ mod tests {
             "{:?}",
             tracker.warnings()
         );
+    }
+
+    /// Before the track has measured the ball in free flight, a circle outside the radius range it was
+    /// acquired with is not the ball: a larger circle where the ball should be (noise pulled along by part
+    /// of its rim, a shadow, a fixture) leaves the frame `absent`, while the ball itself is taken.
+    #[test]
+    fn a_circle_not_of_the_acquired_size_is_not_the_ball() {
+        let draw = |r: f64| {
+            render(&Scene {
+                ball: (121.3, 125.6, r),
+                ball_level: 170.0,
+                backdrop: (90.0, 90.0),
+                noise: 2.0,
+                ..Scene::default()
+            })
+        };
+        let observe = |r: f64| {
+            let mut tracker = Tracker::new(TrackOptions {
+                radius_px: Some((51.0, 69.0)),
+                ..TrackOptions::default()
+            });
+            // Sightings 1 ms apart that predict the circle's centre: a circle of another size is not
+            // measured at the prediction, and the frame is searched whole.
+            tracker.seed((-0.002, 101.3, 105.6), (-0.001, 111.3, 115.6));
+            let fix = tracker.observe(0, 0.0, &Plane::new(&draw(r), 256, 256));
+            (fix.status, fix.r_px)
+        };
+        let (status, r) = observe(74.0);
+        assert_eq!(status, Status::Absent, "radius {r}");
+        let (status, r) = observe(60.0);
+        assert_eq!(status, Status::Ok);
+        assert!((r - 60.0).abs() < 0.5, "{r}");
     }
 
     /// A fix kept `inliers` of 128 rays at full contrast: its visible quality is `inliers`/128.
