@@ -82,7 +82,8 @@ pub(crate) fn session_key(session: &Session) -> String {
 /// line is found, the frames from a step no pass explained marked ambiguous; 14: a circle taken for the
 /// ball only when its rim stands out of the noise, the frames before a lost rim taken from the pass from the
 /// clip's end; 15: a circle acquired only when its rim stands out of the noise, a circle detected before
-/// the ball's flight radius is known only within the radius range it was acquired with).
+/// the ball's flight radius is known only within the radius range it was acquired with, the frames after a
+/// step kept when the frames from the bounce measured again remove it).
 const MEASUREMENT_REVISION: u32 = 15;
 
 /// Everything besides the frame files that changes a shot's track or estimate.

@@ -296,13 +296,21 @@ pub fn track_clip(
     if doubtful.is_none() {
         backward.retrack_after_lost_rim(&mut fixes, &tracker, noise, &mut warnings)?;
     }
-    backward.retrack_bounce(&mut fixes, &tracker, &mut warnings)?;
-    if let Some(at) = doubtful {
-        let n = doubt_from(&mut fixes, at);
-        warnings.push(format!(
-            "{n} measured frame(s) from frame {} on marked ambiguous: they may not be the ball",
-            fixes[at].frame
-        ));
+    let remeasured = backward.retrack_bounce(&mut fixes, &tracker, &mut warnings)?;
+    if let Some(doubt) = doubtful {
+        let off = fixes[doubt.at].frame;
+        if doubt.settled_by(remeasured, &fixes, 0.5 * (radius.0 + radius.1)) {
+            warnings.push(format!(
+                "{}; the frames from the bounce, measured again backward from the clean flight after it, join the track without a step the ball cannot make: the frames from {off} on are kept",
+                doubt.said
+            ));
+        } else {
+            warnings.push(format!("{}: frames from {off} on may not be the ball", doubt.said));
+            let n = doubt_from(&mut fixes, doubt.at);
+            warnings.push(format!(
+                "{n} measured frame(s) from frame {off} on marked ambiguous: they may not be the ball"
+            ));
+        }
     }
     let measured = fixes.iter().filter(|f| f.status.measured()).count();
     if forward.saturated > 0 {
@@ -535,15 +543,16 @@ impl Backward<'_> {
     }
 
     /// The frames after the bounce that the forward track may have measured off the ball, measured again
-    /// backward ([`retrack_bounce`]); what was replaced is said.
+    /// backward ([`retrack_bounce`]); what was replaced is said, and the files measured again (from the
+    /// bounce's lowest point up to the clean flight after it) returned when any was replaced.
     fn retrack_bounce(
         &self,
         fixes: &mut [BallFix],
         forward: &Tracker,
         warnings: &mut Vec<String>,
-    ) -> Result<(), TrackError> {
+    ) -> Result<Option<std::ops::Range<usize>>, TrackError> {
         let Some(span) = retrack_bounce(fixes, forward, |tr, k, frame, t| self.measure(tr, k, frame, t))? else {
-            return Ok(());
+            return Ok(None);
         };
         if span.replaced > 0 {
             warnings.push(format!(
@@ -555,22 +564,22 @@ impl Backward<'_> {
                 span.moved_px,
             ));
         }
-        Ok(())
+        Ok((span.replaced > 0).then_some(span.lowest..span.settled))
     }
 
     /// When the forward track leaves the ball ([`left_the_ball`]), the ball is looked for again from the
     /// clip's end and tracked back through the clip ([`Self::track_from_end`]); that pass's fixes take the
     /// place of the forward ones from where the forward track left, when the two passes met before it and
     /// that pass holds the clearer circles after it ([`take_from_end`]); the forward pass's warnings about
-    /// the frames it no longer measures are then dropped. What happened is said either way. `noise` is the
-    /// first frame's noise σ. The index of the first fix that may not be the ball when no pass could tell
-    /// (see [`doubt_from`]).
+    /// the frames it no longer measures are then dropped, and what happened is said. `noise` is the first
+    /// frame's noise σ. When no pass could tell, the step is returned, with what was found, for the caller
+    /// to settle ([`Doubt`]).
     fn retrack_end(
         &self,
         fixes: &mut [BallFix],
         noise: f32,
         warnings: &mut Vec<String>,
-    ) -> Result<Option<usize>, TrackError> {
+    ) -> Result<Option<Doubt>, TrackError> {
         let Some(jump) = left_the_ball(fixes.iter(), 0.5 * (self.radius.0 + self.radius.1)) else {
             return Ok(None);
         };
@@ -579,11 +588,12 @@ impl Backward<'_> {
             "frame {off}: the track moved {:.1} px in {} frame(s), more than the ball can (≤ {:.1} px a frame from how it moved before)",
             jump.moved_px, jump.frames, jump.limit_px
         );
+        let doubt = |why: &str| Doubt {
+            at: jump.at,
+            said: format!("{said}; {why}"),
+        };
         let Some(from_end) = self.track_from_end(noise)? else {
-            warnings.push(format!(
-                "{said}; the ball was not found again from the clip's end: frames from {off} on may not be the ball"
-            ));
-            return Ok(Some(jump.at));
+            return Ok(Some(doubt("the ball was not found again from the clip's end")));
         };
         match take_from_end(fixes, &from_end, jump.at) {
             Ok(replaced) => {
@@ -593,18 +603,10 @@ impl Backward<'_> {
                 ));
                 Ok(None)
             }
-            Err(NotTaken::NeverMet) => {
-                warnings.push(format!(
-                    "{said}; the circle found from the clip's end and tracked back never meets this track before frame {off} (another object, or this track was not on the ball): frames from {off} on may not be the ball"
-                ));
-                Ok(Some(jump.at))
-            }
-            Err(NotTaken::NoClearer) => {
-                warnings.push(format!(
-                    "{said}; tracked back from the clip's end, the ball was no clearer: frames from {off} on may not be the ball"
-                ));
-                Ok(Some(jump.at))
-            }
+            Err(NotTaken::NeverMet) => Ok(Some(doubt(&format!(
+                "the circle found from the clip's end and tracked back never meets this track before frame {off} (another object, or this track was not on the ball)"
+            )))),
+            Err(NotTaken::NoClearer) => Ok(Some(doubt("tracked back from the clip's end, the ball was no clearer"))),
         }
     }
 
@@ -704,6 +706,25 @@ struct Jump {
     moved_px: f64,
     frames: usize,
     limit_px: f64,
+}
+
+/// A step the ball cannot make ([`left_the_ball`]) that no pass from the clip's end explained: the fix
+/// after it (`at`) and what was found, said.
+struct Doubt {
+    at: usize,
+    said: String,
+}
+
+impl Doubt {
+    /// Whether the frames from the bounce, measured again backward (the files `remeasured`,
+    /// [`Backward::retrack_bounce`]), settled the step: it lay among them, and the track, with them, makes
+    /// no step the ball cannot make ([`left_the_ball`], the ball of `radius` px). In contact a forward
+    /// track can slide off the ball and come back to it in one step; the pass back from the clean flight
+    /// after the bounce then measures the ball through those frames.
+    fn settled_by(&self, remeasured: Option<std::ops::Range<usize>>, fixes: &[BallFix], radius: f64) -> bool {
+        remeasured.is_some_and(|span| span.start <= self.at && self.at <= span.end)
+            && left_the_ball(fixes.iter(), radius).is_none()
+    }
 }
 
 /// How many of a track's first steps between measured fixes tell how fast its ball moves.
@@ -1421,6 +1442,28 @@ mod tests {
             *f = BallFix::absent(f.frame, f.t_s, Status::Absent);
         }
         assert_eq!(left_the_ball(off.iter(), 40.0), None);
+    }
+
+    /// A step no pass from the clip's end explained is settled by the frames from the bounce measured again
+    /// only when it lay among them and the track they leave makes no step the ball cannot make.
+    #[test]
+    fn a_step_is_settled_only_by_frames_measured_again_around_it() {
+        let doubt = Doubt {
+            at: 20,
+            said: String::new(),
+        };
+        // The frames measured again joined the track: no step left.
+        let joined = on_the_ball(0..30, 0.9);
+        assert!(doubt.settled_by(Some(15..25), &joined, 40.0));
+        // The step lay outside the frames measured again, or none was replaced.
+        assert!(!doubt.settled_by(Some(5..15), &joined, 40.0));
+        assert!(!doubt.settled_by(None, &joined, 40.0));
+        // A step is still there (a circle 22 px away from frame 24 on).
+        let mut stepped = joined.clone();
+        for f in stepped.iter_mut().skip(24) {
+            f.x_px += 22.0;
+        }
+        assert!(!doubt.settled_by(Some(15..25), &stepped, 40.0));
     }
 
     /// Frames from a jump no pass could explain are not reported as the ball: the measured ones become
