@@ -42,6 +42,15 @@ pub enum TrackError {
         "{clip}: no moving ball: the circles seen ({circles}) stay where they are between frames, so none is a ball in flight (give the scale if the ball is in view but not found)"
     )]
     NothingMoves { clip: String, circles: String },
+    /// No ball was found, and the first frame is mostly clipped: at the file's full scale or at zero.
+    #[error(
+        "{clip}: no ball found: {percent:.1} % of the first frame's pixels are {level} (an exposure or a gain far off, a lens cap, or a conversion that clipped the levels)"
+    )]
+    Clipped {
+        clip: String,
+        percent: f64,
+        level: &'static str,
+    },
 }
 
 /// Options of [`track_clip`].
@@ -256,7 +265,7 @@ pub fn track_clip(
         seed,
         file: seed_file,
         second,
-    } = crate::acquire::acquire(clip, opts, gain, noise)?;
+    } = crate::acquire::acquire(clip, opts, gain, noise).map_err(|e| clipped_instead(e, clip, opts))?;
     if let Some((frame, x, y)) = second {
         warnings.push(format!(
             "a second moving ball-like circle at ({x:.0}, {y:.0}) in frame {frame}: tracking the clearer one, at ({:.0}, {:.0}) then (crop with --roi if that is the wrong one)",
@@ -855,6 +864,46 @@ enum NotTaken {
     NeverMet,
     /// It was no clearer where the forward track left the ball.
     NoClearer,
+}
+
+/// Share of a frame's pixels at one end of the scale above which a clip where no ball was found is said to
+/// be clipped ([`clipped_instead`]).
+const CLIPPED_FRAME_SHARE: f64 = 0.5;
+
+/// `e` (acquisition's failure), or [`TrackError::Clipped`] when no ball was found and more than
+/// [`CLIPPED_FRAME_SHARE`] of the first frame's searched pixels are at the file's full scale (as
+/// [`rim_saturated`] reads it) or at zero: then nothing could be seen, and the reason is that, not the
+/// ball. A backlit ball on a clipped backdrop is still looked for: only a failed search is explained so.
+fn clipped_instead(e: TrackError, clip: &Clip, opts: &ClipTracking) -> TrackError {
+    if !matches!(e, TrackError::NoBall { .. } | TrackError::NothingMoves { .. }) {
+        return e;
+    }
+    let Some(Ok(first)) = clip.read(0, opts.read.png_decoder) else {
+        return e;
+    };
+    let first = in_region(first, opts.roi.as_ref());
+    let (full, zero, n) = match &first.pixels {
+        bouncelab_frames::GrayPixels::U8(img) => img.pixels().fold((0usize, 0usize, 0usize), |(f, z, n), p| {
+            (f + usize::from(p.0[0] == u8::MAX), z + usize::from(p.0[0] == 0), n + 1)
+        }),
+        bouncelab_frames::GrayPixels::U16(img) => img.pixels().fold((0, 0, 0), |(f, z, n), p| {
+            (f + usize::from(p.0[0] >= 0xFFC0), z + usize::from(p.0[0] == 0), n + 1)
+        }),
+    };
+    let share = |k: usize| k as f64 / n.max(1) as f64;
+    let (count, level) = if full >= zero {
+        (full, "at the file's full scale")
+    } else {
+        (zero, "at zero")
+    };
+    if share(count) <= CLIPPED_FRAME_SHARE {
+        return e;
+    }
+    TrackError::Clipped {
+        clip: clip.dir().display().to_string(),
+        percent: 100.0 * share(count),
+        level,
+    }
 }
 
 /// Share of the samples around a rim at the file's full scale above which the rim counts as saturated.

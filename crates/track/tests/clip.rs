@@ -119,6 +119,31 @@ fn a_clip_without_a_ball_is_an_error_naming_it() {
     assert!(err.to_string().contains(&dir.path().display().to_string()));
 }
 
+/// A clip whose frames are clipped white (a 12-bit-in-16 file cut down to 8 bits, an exposure far too long)
+/// or black (a lens cap) shows no ball, and the error says why rather than only that none was found.
+#[test]
+fn a_clipped_clip_says_so() {
+    for (level, said) in [(255.0, "at the file's full scale"), (0.0, "at zero")] {
+        let dir = tempfile::tempdir().unwrap();
+        write_clip(dir.path(), 5, |i| Scene {
+            ball_level: level,
+            backdrop: (level, level),
+            noise: 0.0,
+            seed: i as u64,
+            ..Scene::default()
+        });
+        let clip = Clip::open(dir.path()).unwrap();
+        let err = track_clip(&clip, &ClipTracking::default(), |_, _| {}).unwrap_err();
+        assert!(
+            matches!(err, TrackError::Clipped { percent, .. } if percent > 90.0),
+            "{err}"
+        );
+        let text = err.to_string();
+        assert!(text.contains(said), "{text}");
+        assert!(text.contains(&dir.path().display().to_string()), "{text}");
+    }
+}
+
 /// A ball at rest and a screw head cannot be told from fixtures by their motion: nothing that does not move
 /// is taken for the ball, and the error names what was seen.
 #[test]
