@@ -871,9 +871,9 @@ enum NotTaken {
 const CLIPPED_FRAME_SHARE: f64 = 0.5;
 
 /// `e` (acquisition's failure), or [`TrackError::Clipped`] when no ball was found and more than
-/// [`CLIPPED_FRAME_SHARE`] of the first frame's searched pixels are at the file's full scale (as
-/// [`rim_saturated`] reads it) or at zero: then nothing could be seen, and the reason is that, not the
-/// ball. A backlit ball on a clipped backdrop is still looked for: only a failed search is explained so.
+/// [`CLIPPED_FRAME_SHARE`] of the first frame's searched pixels are at the file's full scale or at zero
+/// ([`pixel_clipped`]): then nothing could be seen, and the reason is that, not the ball. A backlit ball
+/// on a clipped backdrop is still looked for: only a failed search is explained so.
 fn clipped_instead(e: TrackError, clip: &Clip, opts: &ClipTracking) -> TrackError {
     if !matches!(e, TrackError::NoBall { .. } | TrackError::NothingMoves { .. }) {
         return e;
@@ -882,14 +882,18 @@ fn clipped_instead(e: TrackError, clip: &Clip, opts: &ClipTracking) -> TrackErro
         return e;
     };
     let first = in_region(first, opts.roi.as_ref());
-    let (full, zero, n) = match &first.pixels {
-        bouncelab_frames::GrayPixels::U8(img) => img.pixels().fold((0usize, 0usize, 0usize), |(f, z, n), p| {
-            (f + usize::from(p.0[0] == u8::MAX), z + usize::from(p.0[0] == 0), n + 1)
-        }),
-        bouncelab_frames::GrayPixels::U16(img) => img.pixels().fold((0, 0, 0), |(f, z, n), p| {
-            (f + usize::from(p.0[0] >= 0xFFC0), z + usize::from(p.0[0] == 0), n + 1)
-        }),
-    };
+    let px = &first.pixels;
+    let (mut full, mut zero) = (0usize, 0usize);
+    for y in 0..px.height() {
+        for x in 0..px.width() {
+            match pixel_clipped(px, x, y) {
+                Some(true) => full += 1,
+                Some(false) => zero += 1,
+                None => {}
+            }
+        }
+    }
+    let n = px.width() as usize * px.height() as usize;
     let share = |k: usize| k as f64 / n.max(1) as f64;
     let (count, level) = if full >= zero {
         (full, "at the file's full scale")
@@ -906,19 +910,32 @@ fn clipped_instead(e: TrackError, clip: &Clip, opts: &ClipTracking) -> TrackErro
     }
 }
 
+/// Whether pixel (x, y) is clipped: `Some(true)` at the pixel type's full scale (255, or 0xFFC0 and above
+/// in 16-bit files, which hold 10- and 12-bit data shifted up), `Some(false)` at zero, `None` between.
+fn pixel_clipped(px: &bouncelab_frames::GrayPixels, x: u32, y: u32) -> Option<bool> {
+    let (v, full) = match px {
+        bouncelab_frames::GrayPixels::U8(img) => (u32::from(img.get_pixel(x, y).0[0]), u32::from(u8::MAX)),
+        bouncelab_frames::GrayPixels::U16(img) => (u32::from(img.get_pixel(x, y).0[0]), 0xFFC0),
+    };
+    if v >= full {
+        Some(true)
+    } else if v == 0 {
+        Some(false)
+    } else {
+        None
+    }
+}
+
 /// Share of the samples around a rim at the file's full scale above which the rim counts as saturated.
 const SATURATED_SHARE: f64 = 0.1;
 
 /// Whether the ball's rim at `fix` lies in saturated pixels: of 64 samples just inside and just outside the
-/// rim (±2 px), more than [`SATURATED_SHARE`] at the pixel type's full scale (255, or 0xFFC0 and above in
-/// 16-bit files, which holds 10- and 12-bit data shifted up). A clipped edge has no gradient where the
-/// tracker looks for one, so the centre and radius there are biased. Cost: 64 pixel reads.
+/// rim (±2 px), more than [`SATURATED_SHARE`] at the pixel type's full scale ([`pixel_clipped`]). A clipped
+/// edge has no gradient where the tracker looks for one, so the centre and radius there are biased. Cost: 64
+/// pixel reads.
 fn rim_saturated(px: &bouncelab_frames::GrayPixels, fix: &BallFix) -> bool {
     let (w, h) = (px.width() as f64, px.height() as f64);
-    let full = |x: u32, y: u32| match px {
-        bouncelab_frames::GrayPixels::U8(img) => img.get_pixel(x, y).0[0] == u8::MAX,
-        bouncelab_frames::GrayPixels::U16(img) => img.get_pixel(x, y).0[0] >= 0xFFC0,
-    };
+    let full = |x: u32, y: u32| pixel_clipped(px, x, y) == Some(true);
     let (mut seen, mut clipped) = (0u32, 0u32);
     for k in 0..32 {
         let a = std::f64::consts::TAU * k as f64 / 32.0;
