@@ -83,8 +83,9 @@ pub(crate) fn session_key(session: &Session) -> String {
 /// ball only when its rim stands out of the noise, the frames before a lost rim taken from the pass from the
 /// clip's end; 15: a circle acquired only when its rim stands out of the noise, a circle detected before
 /// the ball's flight radius is known only within the radius range it was acquired with, the frames after a
-/// step kept when the frames from the bounce measured again remove it).
-const MEASUREMENT_REVISION: u32 = 15;
+/// step kept when the frames from the bounce measured again remove it; 16: a frame off the path its
+/// neighbours give, further than the ball can stray, marked ambiguous).
+const MEASUREMENT_REVISION: u32 = 16;
 
 /// Everything besides the frame files that changes a shot's track or estimate.
 fn settings_text(entry: &ClipEntry, gravity: f64) -> String {

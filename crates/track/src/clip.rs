@@ -17,7 +17,7 @@ use crate::local::SurfaceFrame;
 use crate::plane::{Pixel, Plane};
 use crate::refine::{EdgeSearch, NOISY_SIGMA};
 use crate::surface::SurfaceLine;
-use crate::tracker::{BallFix, CLEAN_QUALITY, Status, TrackOptions, Tracker};
+use crate::tracker::{BallFix, CLEAN_QUALITY, MAX_BALL_ACCELERATION_M_S2, Status, TrackOptions, Tracker};
 use crate::trajectory::TrajectoryRow;
 use bouncelab_frames::{CameraInfo, Clip, ClipSettings, ContactLine, Frame, FramesError, GrayPixels, ReadOptions, Roi};
 use serde::Serialize;
@@ -321,6 +321,7 @@ pub fn track_clip(
             ));
         }
     }
+    mark_off_path(&mut fixes, opts.ball_diameter_m, &mut warnings);
     let measured = fixes.iter().filter(|f| f.status.measured()).count();
     if forward.saturated > 0 {
         warnings.push(format!(
@@ -370,6 +371,41 @@ pub fn track_clip(
         camera: clip.camera().clone(),
         saturated_frames: forward.saturated,
     })
+}
+
+/// Marks `ambiguous` the measured fixes the ball cannot have been at ([`crate::path::off_path`]: off the
+/// path their neighbours give by more than [`MAX_BALL_ACCELERATION_M_S2`] lets the ball stray, at the
+/// scale of the fixes' median radius and the ball's `diameter_m`), and says which.
+fn mark_off_path(fixes: &mut [BallFix], diameter_m: f64, warnings: &mut Vec<String>) {
+    let mut radii: Vec<f64> = fixes.iter().filter(|f| f.status.measured()).map(|f| f.r_px).collect();
+    if radii.is_empty() || diameter_m <= 0.0 {
+        return;
+    }
+    let px_per_m = 2.0 * crate::plane::median(&mut radii) / diameter_m;
+    let mut off = crate::path::off_path(fixes, MAX_BALL_ACCELERATION_M_S2 * px_per_m);
+    if off.is_empty() {
+        return;
+    }
+    off.sort_by_key(|o| o.index);
+    let listed: Vec<String> = off
+        .iter()
+        .take(5)
+        .map(|o| {
+            format!(
+                "{} ({:.1} px off, {:.1} px possible)",
+                fixes[o.index].frame, o.off_px, o.allowed_px
+            )
+        })
+        .collect();
+    let more = if off.len() > listed.len() { ", …" } else { "" };
+    for o in &off {
+        fixes[o.index].status = Status::Ambiguous;
+    }
+    warnings.push(format!(
+        "{} measured frame(s) off the path the frames around them give, further than the ball can stray there: frames {}{more}: marked ambiguous, not the ball",
+        off.len(),
+        listed.join(", ")
+    ));
 }
 
 /// The first frame's (searched region's) level gain ([`crate::plane::level_gain`]) and sensor noise σ

@@ -22,6 +22,7 @@ mod local;
 mod motion;
 #[cfg(feature = "opencv")]
 pub mod opencv;
+mod path;
 mod plane;
 mod refine;
 mod rim_evidence;
