@@ -748,14 +748,16 @@ fn signature(d: &Diagnosis) -> Vec<r::SignatureRow> {
             let bouncelab_diagnose::PhaseResidual {
                 phase,
                 component,
-                // The counts and the reduced χ² are in the diagnosis' own output, not the report.
+                // The counts, the reduced χ² and the worst shot are in the diagnosis' own output, not the
+                // report's table (the verdict's sentence names a shot that alone makes a phase misfit).
                 n: _,
                 rms_m,
                 systematic_m,
                 chi2_share,
                 chi2_red: _,
-            } = *p;
-            signature_row(phase, component, rms_m, systematic_m, chi2_share)
+                worst_shot: _,
+            } = p;
+            signature_row(*phase, *component, *rms_m, *systematic_m, *chi2_share)
         })
         .collect()
 }

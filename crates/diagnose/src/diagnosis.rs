@@ -162,8 +162,19 @@ pub struct Evidence {
     pub fit: FitSummary,
 }
 
+/// The shot with the largest share of a phase and component's squared residual, and the phase without it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct WorstShot {
+    /// The shot (clip) name.
+    pub shot: String,
+    /// Its RMS in that phase and component, m.
+    pub rms_m: f64,
+    /// The phase and component's systematic part over the other shots, m.
+    pub systematic_without_m: f64,
+}
+
 /// The systematic residual of one phase and component of the current model.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PhaseResidual {
     /// The phase.
     pub phase: ImpactPhase,
@@ -179,6 +190,10 @@ pub struct PhaseResidual {
     pub chi2_share: f64,
     /// χ² / n against the tracker's σ.
     pub chi2_red: f64,
+    /// The shot that weighs most here, with the systematic part without it; `None` with fewer than
+    /// [`crate::MIN_SHOTS_FOR_ONE_SHOT`] shots in the phase.
+    #[serde(default)]
+    pub worst_shot: Option<WorstShot>,
 }
 
 /// Where the current model's residual sits: what a person looks at when no candidate explains it.

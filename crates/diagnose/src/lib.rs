@@ -43,7 +43,7 @@ mod verdict;
 pub use candidates::CandidateSetup;
 pub use diagnosis::{
     Baseline, Candidate, Checks, Diagnosis, Evidence, Floor, Noise, NoiseSource, PhaseResidual, Signature, Thresholds,
-    Verdict, VerdictKind,
+    Verdict, VerdictKind, WorstShot,
 };
 pub use error::DiagnoseError;
 pub use evaluate::{FitSummary, FittedValue};
@@ -52,3 +52,4 @@ pub use model_file::add_effect_to_model_toml;
 pub use options::{SearchOptions, SearchProgress};
 pub use proposal::{ProposedTerm, TermProposal};
 pub use search::{FittedBaseline, find_missing_effect, find_missing_effect_from, find_missing_effect_with};
+pub use verdict::MIN_SHOTS_FOR_ONE_SHOT;

@@ -6,7 +6,7 @@ use crate::DiagnoseError;
 use crate::VerdictKind;
 use crate::candidates::{CandidateSetup, candidate_names, library_effect, set_values, with_candidate};
 use crate::diagnosis::{
-    Baseline, Candidate, Diagnosis, Floor, Noise, NoiseSource, PhaseResidual, Signature, Thresholds, Verdict,
+    Baseline, Candidate, Diagnosis, Floor, Noise, NoiseSource, PhaseResidual, Signature, Thresholds, Verdict, WorstShot,
 };
 use crate::evidence::evidence_of;
 use crate::options::{SearchOptions, SearchProgress};
@@ -15,7 +15,9 @@ use crate::run::{BicGate, ModelRun, Scan, Start, run_fitted, run_model};
 use crate::stats::{self, excess, rms_of};
 use crate::terms::TermSearch;
 use crate::verdict::{Inputs, decide};
-use bouncelab_compare::{Comparison, Component, DiagnoseOptions, FailureReport, ShotExtras, compare, diagnose};
+use bouncelab_compare::{
+    Comparison, Component, DiagnoseOptions, FailureReport, ImpactPhase, ShotExtras, compare, diagnose,
+};
 use bouncelab_fit::{FitResult, MeasuredShot};
 use bouncelab_model::{ModelSpec, Simulation};
 use std::time::Instant;
@@ -495,6 +497,7 @@ fn signature_from(cmp: &Comparison, report: &FailureReport, noise_m: f64) -> Sig
             systematic_m: excess(s.rms_m * s.rms_m, noise_m),
             chi2_share: if cmp.chi2 > 0.0 { s.chi2 / cmp.chi2 } else { 0.0 },
             chi2_red: s.chi2_red,
+            worst_shot: worst_shot(cmp, s.phase, s.component, noise_m),
         })
         .collect();
     phases.sort_by(|a, b| b.chi2_share.total_cmp(&a.chi2_share));
@@ -510,6 +513,34 @@ fn signature_from(cmp: &Comparison, report: &FailureReport, noise_m: f64) -> Sig
             .collect(),
         sentences: report.sentences.clone(),
     }
+}
+
+/// The shot with the largest sum of squared residuals in `phase` and `component`, and the systematic part
+/// (above `noise_m`) of the other shots' residuals there; `None` with fewer than
+/// [`crate::MIN_SHOTS_FOR_ONE_SHOT`] shots having residuals in it.
+fn worst_shot(cmp: &Comparison, phase: ImpactPhase, component: Component, noise_m: f64) -> Option<WorstShot> {
+    let sums: Vec<(&str, f64, usize)> = cmp
+        .shots
+        .iter()
+        .filter_map(|sh| {
+            let st = sh
+                .by_phase
+                .iter()
+                .find(|p| p.phase == phase && p.component == component)?;
+            (st.n > 0).then_some((sh.shot.as_str(), st.rms_m * st.rms_m * st.n as f64, st.n))
+        })
+        .collect();
+    if sums.len() < crate::MIN_SHOTS_FOR_ONE_SHOT {
+        return None;
+    }
+    let (sq, n) = sums.iter().fold((0.0, 0), |(a, m), s| (a + s.1, m + s.2));
+    let &(shot, worst_sq, worst_n) = sums.iter().max_by(|a, b| a.1.total_cmp(&b.1))?;
+    let rest = n - worst_n;
+    (rest > 0).then(|| WorstShot {
+        shot: shot.to_string(),
+        rms_m: (worst_sq / worst_n as f64).sqrt(),
+        systematic_without_m: excess((sq - worst_sq) / rest as f64, noise_m),
+    })
 }
 
 /// Each candidate's evidence against the baseline, with Holm's adjustment over the candidates that have a

@@ -1,6 +1,6 @@
 //! The decision rule: which candidates explain the residual, their ranking, and the verdict in words.
 
-use crate::diagnosis::{Baseline, Candidate, Floor, Signature, Verdict, VerdictKind};
+use crate::diagnosis::{Baseline, Candidate, Floor, PhaseResidual, Signature, Verdict, VerdictKind, WorstShot};
 use crate::options::SearchOptions;
 use crate::stats;
 use bouncelab_compare::Quantity;
@@ -78,6 +78,41 @@ pub(crate) fn phase_tolerance(o: &SearchOptions, f: &Floor) -> f64 {
 /// is about three times the floor of our clean rendered sessions.
 const PHASE_FLOORS: f64 = 3.0;
 
+/// Fewest shots with residuals in a phase for its misfit to be set down to one shot ([`one_shot_s`]): with
+/// fewer, one shot is too large a part of the evidence to set aside.
+pub const MIN_SHOTS_FOR_ONE_SHOT: usize = 6;
+
+/// The shot a phase's misfit belongs to, when the phase misfits only with it: above `phase_tol` with every
+/// shot and within it without the one that weighs most there ([`WorstShot`]). A missing effect acts on
+/// every shot of its surface and condition, so it misfits without any one of them; one shot's own misfit
+/// (its track off the ball in contact, a frame the tracker mistook) does not, and is not the model's.
+fn one_shot_s(ph: &PhaseResidual, phase_tol: f64) -> Option<&WorstShot> {
+    ph.worst_shot
+        .as_ref()
+        .filter(|w| ph.systematic_m > phase_tol && w.systematic_without_m <= phase_tol)
+}
+
+/// One sentence per phase whose misfit is one shot's ([`one_shot_s`]), naming the shot.
+fn one_shot_words(signature: &Signature, phase_tol: f64) -> String {
+    signature
+        .phases
+        .iter()
+        .filter_map(|ph| {
+            let w = one_shot_s(ph, phase_tol)?;
+            Some(format!(
+                " The {} {} residual's systematic part, {}, is one shot's: `{}` (RMS {} there); without it {}, within the {} per-phase tolerance, so it is not taken for the model's: look at that shot's track.",
+                ph.component.name(),
+                ph.phase.words(),
+                um(ph.systematic_m),
+                w.shot,
+                um(w.rms_m),
+                um(w.systematic_without_m),
+                um(phase_tol)
+            ))
+        })
+        .collect()
+}
+
 fn num(v: f64) -> String {
     let a = v.abs();
     if a != 0.0 && !(1e-3..1e5).contains(&a) {
@@ -120,7 +155,8 @@ pub(crate) fn decide(cands: &mut Vec<Candidate>, inp: Inputs<'_>) -> (Verdict, B
     let best_other = order.first().map(|&i| cands[i].clone());
     *cands = ranked;
 
-    let verdict = match names.len() {
+    let one_shot = one_shot_words(&signature, phase_tolerance(o, inp.floor));
+    let mut verdict = match names.len() {
         0 if baseline.misfit => Verdict {
             kind: VerdictKind::NoneExplains,
             effect: None,
@@ -146,6 +182,9 @@ pub(crate) fn decide(cands: &mut Vec<Candidate>, inp: Inputs<'_>) -> (Verdict, B
             sentence: ambiguous(cands, &names, &tie_words),
         },
     };
+    if matches!(verdict.kind, VerdictKind::NoMissingEffect | VerdictKind::NoneExplains) {
+        verdict.sentence += &one_shot;
+    }
     (verdict, baseline, signature)
 }
 
@@ -177,7 +216,7 @@ fn misfit_reasons(baseline: &Baseline, signature: &Signature, inp: &Inputs<'_>) 
     }
     let phase_tol = phase_tolerance(o, inp.floor);
     for ph in &signature.phases {
-        if ph.systematic_m > phase_tol {
+        if ph.systematic_m > phase_tol && one_shot_s(ph, phase_tol).is_none() {
             reasons.push(format!(
                 "{} {}: systematic residual {} (RMS {}), above the {} per-phase tolerance",
                 ph.component.name(),
