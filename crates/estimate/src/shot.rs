@@ -280,10 +280,11 @@ pub enum EstimateError {
     /// A fit failed (degenerate times).
     #[error("the {phase} flight could not be fitted")]
     FitFailed { phase: &'static str },
-    /// The shot could not be measured (`cause`) and the track holds frames the tracker could not tell from
-    /// another circle, which the estimator does not use: the likely reason.
+    /// The shot could not be measured (`cause`) and the track holds frames the tracker did not take for the
+    /// ball (another circle it could not tell from the ball, or off the ball's path), which the estimator
+    /// does not use: the likely reason.
     #[error(
-        "{cause}; {frames} frame(s) of the track could not be told from another circle (ambiguous, see the track's warnings) and are not used"
+        "{cause}; {frames} frame(s) of the track were not taken for the ball (ambiguous: another circle could be the ball, or they lie off its path; see the track's warnings) and are not used"
     )]
     Ambiguous { frames: usize, cause: Box<EstimateError> },
 }
@@ -315,7 +316,7 @@ struct Point {
 /// ([`Estimate::trajectory_share`]); the contact level the trajectory gives (see `contact.rs`). The local
 /// frame follows that line's tilt in the image.
 ///
-/// Frames the tracker could not tell from another circle (`ambiguous`) are not used; when the track has
+/// Frames the tracker did not take for the ball (`ambiguous`) are not used; when the track has
 /// any, a shot that cannot be measured says so with its reason ([`EstimateError::Ambiguous`]: they are the
 /// likely cause), and one that can gets a note.
 pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError> {
@@ -327,7 +328,7 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
         }),
         Ok(mut e) if ambiguous > 0 => {
             e.notes.push(format!(
-                "{ambiguous} frame(s) the tracker could not tell from another circle (ambiguous) are not used"
+                "{ambiguous} frame(s) the tracker did not take for the ball (ambiguous, see the track's warnings) are not used"
             ));
             Ok(e)
         }

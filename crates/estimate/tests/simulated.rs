@@ -188,7 +188,7 @@ fn a_clip_ending_close_to_the_impact_is_refused_with_a_reason() {
     assert!(err.to_string().contains("ends too close to the impact"), "{err}");
 }
 
-/// Frames the tracker could not tell from another circle are not used: a shot whose outgoing flight is all
+/// Frames the tracker did not take for the ball are not used: a shot whose outgoing flight is all
 /// such frames is refused naming them as well as the short flight; one with a few in its incoming flight is
 /// measured, with a note, as it is without them.
 #[test]
@@ -219,10 +219,7 @@ fn ambiguous_frames_are_not_used_and_are_named() {
         }
         other => panic!("{other}"),
     }
-    assert!(
-        err.to_string().contains("could not be told from another circle"),
-        "{err}"
-    );
+    assert!(err.to_string().contains("were not taken for the ball"), "{err}");
     let t0 = track.fixes[0].t_s;
     let early = Track {
         fixes: track.fixes.iter().map(|f| doubt(f, t0 - 1.0, t0 + 2.5e-4)).collect(),
@@ -232,7 +229,7 @@ fn ambiguous_frames_are_not_used_and_are_named() {
     assert!(
         with.notes
             .iter()
-            .any(|n| n.contains("3 frame(s) the tracker could not tell")),
+            .any(|n| n.contains("3 frame(s) the tracker did not take for the ball")),
         "{:?}",
         with.notes
     );

@@ -374,8 +374,9 @@ pub fn track_clip(
 }
 
 /// Marks `ambiguous` the measured fixes the ball cannot have been at ([`crate::path::off_path`]: off the
-/// path their neighbours give by more than [`MAX_BALL_ACCELERATION_M_S2`] lets the ball stray, at the
-/// scale of the fixes' median radius and the ball's `diameter_m`), and says which.
+/// path their neighbours give by more than the ball strays, by [`MAX_BALL_ACCELERATION_M_S2`] at the scale
+/// of the fixes' median radius and the ball's `diameter_m`, or by its own speed in the track), and says
+/// which.
 fn mark_off_path(fixes: &mut [BallFix], diameter_m: f64, warnings: &mut Vec<String>) {
     let mut radii: Vec<f64> = fixes.iter().filter(|f| f.status.measured()).map(|f| f.r_px).collect();
     if radii.is_empty() || diameter_m <= 0.0 {
@@ -402,7 +403,7 @@ fn mark_off_path(fixes: &mut [BallFix], diameter_m: f64, warnings: &mut Vec<Stri
         fixes[o.index].status = Status::Ambiguous;
     }
     warnings.push(format!(
-        "{} measured frame(s) off the path the frames around them give, further than the ball can stray there: frames {}{more}: marked ambiguous, not the ball",
+        "{} measured frame(s) off the path the frames around them give, further than the ball can stray there: frame(s) {}{more}: marked ambiguous, not the ball",
         off.len(),
         listed.join(", ")
     ));

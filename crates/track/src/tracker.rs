@@ -27,7 +27,8 @@ pub enum Status {
     CutByBorder,
     /// Not found.
     Absent,
-    /// More than one ball-like circle and nothing to tell which is the ball.
+    /// Not taken for the ball: more than one ball-like circle and nothing to tell which is the ball, or a
+    /// circle off the path the frames around it give, further than the ball can stray.
     Ambiguous,
 }
 
