@@ -9,14 +9,14 @@
 //! allowed. A fix further off than that, and than the track's own scatter allows, is a circle that is not the
 //! ball (a clump of clay grains, a noise ring, the band's edge) however well it fits its edge points. Each
 //! frame is judged against the lines through pairs of its nearest measured neighbours, one on each side (and
-//! near the track's ends two on the one side: the same bounds hold on the line extended), by the median over
-//! those pairs, so one wrong neighbour does not condemn a right frame; the frame furthest off is removed first and
-//! the rest judged again without it. Cost: O(n · k) per removal for n fixes, k ≤ 9 pairs each.
+//! near the track's ends two on the one side: the same bounds hold on the line extended), by the lower median
+//! over those pairs, so one wrong neighbour does not condemn a right frame; the frame furthest off is removed
+//! first and the rest judged again without it. Cost: O(n · k) per removal for n fixes, k ≤ 9 pairs each.
 
 use crate::plane::median;
 use crate::tracker::BallFix;
 
-/// How many measured neighbours on each side give the chords a frame is judged against.
+/// How many measured neighbours on each side give the lines a frame is judged against.
 const NEIGHBOURS: usize = 3;
 
 /// How many standard deviations of the track's scatter a fix may lie off a chord beyond the ball's reach.
@@ -31,7 +31,7 @@ const VELOCITY_CHANGE_SPEEDS: f64 = 3.0;
 const FAST_SPEED_PERCENTILE: f64 = 0.9;
 
 /// A measured fix the ball cannot have been at: `index` into the track, `off_px` from the line through a
-/// pair of its neighbours, where the ball and the scatter allow `allowed_px` (the pair of median ratio).
+/// pair of its neighbours, where the ball and the scatter allow `allowed_px` (the pair of lower median ratio).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct OffPath {
     pub index: usize,
@@ -42,8 +42,7 @@ pub(crate) struct OffPath {
 /// The measured fixes of `fixes` (in time order) that lie off the path their neighbours give: further from
 /// the lines through pairs of them than the ball can stray (a path of acceleration at most `max_accel_px_s2`,
 /// or of a whole change of velocity at most [`VELOCITY_CHANGE_SPEEDS`] of its fast speed, whichever strays
-/// further), plus
-/// [`SCATTER_SIGMAS`] of the centre's scatter (the larger of the fixes' own σ and the track's scatter about
+/// further), plus [`SCATTER_SIGMAS`] of the centre's scatter (the larger of the fixes' own σ and the track's scatter about
 /// the chord through each fix's two nearest neighbours, robustly from the median, so a track whose σ
 /// understates its noise is judged by the noise it shows). Worst first.
 pub(crate) fn off_path(fixes: &[BallFix], max_accel_px_s2: f64) -> Vec<OffPath> {
@@ -56,7 +55,7 @@ pub(crate) fn off_path(fixes: &[BallFix], max_accel_px_s2: f64) -> Vec<OffPath> 
         velocity_change_px_s: VELOCITY_CHANGE_SPEEDS * fast_speed_px_s(fixes, &live),
     };
     let mut found = Vec::new();
-    // Never more than half the track: past that, the neighbours are no better than the frame judged.
+    // Never more than a third of the track: past that, the neighbours are no better than the frame judged.
     while found.len() < live.len() / 2 {
         let worst = (0..live.len())
             .filter_map(|p| judged(fixes, &live, p, reach, scatter).map(|j| (p, j)))
