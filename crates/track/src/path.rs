@@ -77,7 +77,8 @@ pub(crate) fn off_path(fixes: &[BallFix], max_accel_px_s2: f64) -> Vec<OffPath> 
 /// How far the fix at `live[p]` lies from the lines through pairs of its nearest live neighbours (up to
 /// [`NEIGHBOURS`] each side: one on each side, and two on one side, the line extended to it, when the other
 /// side has fewer than two, so that a wrong last frame does not condemn the one before it), and how far it
-/// may, px: the pair with the lower median ratio of the two. `None` without such a pair.
+/// may, px: the pair with the lower median ratio of the two (pairs sharing a time skipped). `None` without
+/// such a pair.
 fn judged(fixes: &[BallFix], live: &[usize], p: usize, reach: Reach, scatter: f64) -> Option<(f64, f64)> {
     let before = &live[p.saturating_sub(NEIGHBOURS)..p];
     let after = &live[(p + 1).min(live.len())..(p + 1 + NEIGHBOURS).min(live.len())];
@@ -100,11 +101,14 @@ fn judged(fixes: &[BallFix], live: &[usize], p: usize, reach: Reach, scatter: f6
     let mut pairs: Vec<(f64, f64)> = Vec::with_capacity(pairs_of.len());
     for (i, j) in pairs_of {
         let (a, b) = (&fixes[i], &fixes[j]);
-        let (wa, wb) = line_weights(a, k, b)?;
-        let d = (k.x_px - wa * a.x_px - wb * b.x_px).hypot(k.y_px - wa * a.y_px - wb * b.y_px);
-        let reach = reach.at((k.t_s - a.t_s).abs(), (k.t_s - b.t_s).abs(), wa >= 0.0 && wb >= 0.0);
+        let Some(line) = from_line(a, k, b) else { continue };
+        let reach = reach.at(
+            (k.t_s - a.t_s).abs(),
+            (k.t_s - b.t_s).abs(),
+            line.wa >= 0.0 && line.wb >= 0.0,
+        );
         let sigma = scatter.max(a.sigma_px).max(b.sigma_px).max(k.sigma_px);
-        pairs.push((d, reach + SCATTER_SIGMAS * sigma * (1.0 + wa * wa + wb * wb).sqrt()));
+        pairs.push((line.off_px, reach + SCATTER_SIGMAS * sigma * line.noise_gain()));
     }
     if pairs.is_empty() {
         return None;
@@ -156,15 +160,36 @@ fn fast_speed_px_s(fixes: &[BallFix], live: &[usize]) -> f64 {
     *v.select_nth_unstable_by(at, f64::total_cmp).1
 }
 
-/// The weights of `a` and `b` in the point at `k`'s time of the line through them (interpolated between
-/// them, extended beyond); `None` when they share a time.
-fn line_weights(a: &BallFix, k: &BallFix, b: &BallFix) -> Option<(f64, f64)> {
+/// Where a fix lies from the line through two others at its time ([`from_line`]).
+#[derive(Debug, Clone, Copy)]
+struct FromLine {
+    /// Its distance from the line's point, px.
+    off_px: f64,
+    /// The weights of the two fixes in that point (interpolated between them, extended beyond).
+    wa: f64,
+    wb: f64,
+}
+
+impl FromLine {
+    /// How much the distance's noise exceeds one centre's: √(1 + wa² + wb²).
+    fn noise_gain(self) -> f64 {
+        (1.0 + self.wa * self.wa + self.wb * self.wb).sqrt()
+    }
+}
+
+/// Where `k` lies from the line through `a` and `b` at its time; `None` when `a` and `b` share a time.
+fn from_line(a: &BallFix, k: &BallFix, b: &BallFix) -> Option<FromLine> {
     let span = b.t_s - a.t_s;
     if span == 0.0 {
         return None;
     }
     let wb = (k.t_s - a.t_s) / span;
-    Some((1.0 - wb, wb))
+    let wa = 1.0 - wb;
+    Some(FromLine {
+        off_px: (k.x_px - wa * a.x_px - wb * b.x_px).hypot(k.y_px - wa * a.y_px - wb * b.y_px),
+        wa,
+        wb,
+    })
 }
 
 /// The track's scatter per centre coordinate, px: from the distances of each live fix from the chord
@@ -174,10 +199,8 @@ fn scatter_px(fixes: &[BallFix], live: &[usize]) -> f64 {
     let mut d: Vec<f64> = live
         .windows(3)
         .filter_map(|w| {
-            let (a, k, b) = (&fixes[w[0]], &fixes[w[1]], &fixes[w[2]]);
-            let (wa, wb) = line_weights(a, k, b)?;
-            let d = (k.x_px - wa * a.x_px - wb * b.x_px).hypot(k.y_px - wa * a.y_px - wb * b.y_px);
-            Some(d / (1.0 + wa * wa + wb * wb).sqrt())
+            let line = from_line(&fixes[w[0]], &fixes[w[1]], &fixes[w[2]])?;
+            Some(line.off_px / line.noise_gain())
         })
         .collect();
     median(&mut d) / 1.1774
@@ -207,19 +230,24 @@ mod tests {
                 y += vy * DT / 100.0;
                 x += vx * DT / 100.0;
             }
-            fixes.push(BallFix {
-                frame: f,
-                t_s: f as f64 * DT,
-                x_px: x + noise * rng.normal(),
-                y_px: y + noise * rng.normal(),
-                r_px: 40.0,
-                sigma_px: noise,
-                sigma_r_px: noise,
-                quality: 0.8,
-                status: Status::Ok,
-            });
+            fixes.push(fix_at(f, x + noise * rng.normal(), y + noise * rng.normal(), noise));
         }
         fixes
+    }
+
+    /// A measured fix of frame `f` (at f·[`DT`]) centred at (x, y) px, its σ `sigma` px.
+    fn fix_at(f: usize, x: f64, y: f64, sigma: f64) -> BallFix {
+        BallFix {
+            frame: f,
+            t_s: f as f64 * DT,
+            x_px: x,
+            y_px: y,
+            r_px: 40.0,
+            sigma_px: sigma,
+            sigma_r_px: sigma,
+            quality: 0.8,
+            status: Status::Ok,
+        }
     }
 
     /// The ball's largest acceleration in [`bouncing`], px/s², with room: what a caller passes.
@@ -282,13 +310,8 @@ mod tests {
         let fixes: Vec<BallFix> = (0..120)
             .map(|f| {
                 let t = f as f64 - 60.3;
-                let mut fix = bouncing(1, 0.0, 0)[0];
-                fix.frame = f;
-                fix.t_s = f as f64 * DT;
-                fix.x_px = 100.0 + 1.7 * f as f64 + 0.05 * rng.normal();
-                fix.y_px = 300.0 - 2.6 * t.abs() + 0.05 * rng.normal();
-                fix.sigma_px = 0.05;
-                fix
+                let (x, y) = (100.0 + 1.7 * f as f64, 300.0 - 2.6 * t.abs());
+                fix_at(f, x + 0.05 * rng.normal(), y + 0.05 * rng.normal(), 0.05)
             })
             .collect();
         assert!(off_path(&fixes, ACCEL / 25.0).is_empty());
