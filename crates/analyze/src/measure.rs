@@ -85,7 +85,7 @@ pub(crate) fn session_key(session: &Session) -> String {
 /// the ball's flight radius is known only within the radius range it was acquired with, the frames after a
 /// step kept when the frames from the bounce measured again remove it; 16: a frame off the path its
 /// neighbours give, further than the ball can stray, marked ambiguous).
-const MEASUREMENT_REVISION: u32 = 16;
+const MEASUREMENT_REVISION: u32 = 17;
 
 /// Everything besides the frame files that changes a shot's track or estimate.
 fn settings_text(entry: &ClipEntry, gravity: f64) -> String {

@@ -281,13 +281,16 @@ pub fn track_clip(
         radius,
         surface: given_line(clip, opts),
     };
-    let early = backward.before_seed(seed, seed_file)?;
+    let (early, early_radius) = backward.before_seed(seed, seed_file)?;
     let mut tracker = Tracker::new(TrackOptions {
         radius_px: Some(radius),
         ..opts.tracker.clone()
     });
     let (a, b) = forward_seed(&early, seed);
     tracker.seed(a, b);
+    if let Some(r) = early_radius {
+        tracker.expect_radius(r);
+    }
     if let Some(line) = given_line(clip, opts) {
         tracker.set_surface(line);
     }
@@ -549,11 +552,11 @@ impl Backward<'_> {
     }
 
     /// The files before the ball's first sighting (file `start`), tracked backward from its two sightings
-    /// `seed` (absent where the ball was not found).
-    fn before_seed(&self, seed: (Sighting, Sighting), start: usize) -> Result<Vec<BallFix>, TrackError> {
+    /// `seed` (absent where the ball was not found), and the radius that pass measured in free flight.
+    fn before_seed(&self, seed: (Sighting, Sighting), start: usize) -> Result<(Vec<BallFix>, Option<f64>), TrackError> {
         let mut fixes = self.unmeasured(start);
         if start == 0 {
-            return Ok(fixes);
+            return Ok((fixes, None));
         }
         let mut back = self.tracker();
         let ((ta, xa, ya), (tb, xb, yb)) = seed;
@@ -565,7 +568,7 @@ impl Backward<'_> {
             |tr, k, frame, t| self.measure(tr, k, frame, t),
             |_, _| true,
         )?;
-        Ok(fixes)
+        Ok((fixes, back.flight_radius()))
     }
 
     /// Tracks the frames before the forward track first settled again, backward from there

@@ -172,6 +172,8 @@ pub struct Tracker {
     innovations: Vec<f64>,
     /// Radii measured in free flight (the bottom clear of the surface).
     flight_radii: Vec<f64>,
+    /// The ball's radius as another pass measured it, px, until this one measures its own.
+    radius_told: Option<f64>,
     /// Edge-definition spread (see [`Refined::edge_definition_px`]) in the first free-flight frames, px.
     flight_edges: Vec<f64>,
     /// The rim's shape, learned from full-rim free-flight frames until the first partly hidden one.
@@ -274,6 +276,7 @@ impl Tracker {
             qualities: Vec::new(),
             innovations: Vec::new(),
             flight_radii: Vec::new(),
+            radius_told: None,
             flight_edges: Vec::new(),
             rim: RimShapeLearner::default(),
             rim_doubtful: RimShapeLearner::default(),
@@ -317,6 +320,20 @@ impl Tracker {
             surface_tries: SURFACE_TRIES,
             ..Tracker::new(self.opts.clone())
         }
+    }
+
+    /// The ball's radius in free flight so far, px: the median of the radii measured in free flight, else
+    /// the radius another pass over the same ball measured ([`Tracker::expect_radius`]).
+    pub fn known_radius(&self) -> Option<f64> {
+        self.flight_radius().or(self.radius_told)
+    }
+
+    /// Tells this tracker the ball's radius in px, as another pass over the same ball measured it in free flight
+    /// (the frames before the first sighting, tracked backward): until it has measured its own, each search
+    /// starts from that radius and takes only circles of that size (see [`same_size`]), not any in the
+    /// acquired range of ±15 %, where a rim joined to the ball's shadow can be as clear as the ball.
+    pub fn expect_radius(&mut self, r_px: f64) {
+        self.radius_told = Some(r_px);
     }
 
     /// Uses `line` as the surface instead of finding it.
@@ -438,7 +455,7 @@ impl Tracker {
     }
 
     fn expected_radius(&self) -> Option<f64> {
-        self.flight_radius()
+        self.known_radius()
             .or_else(|| self.opts.radius_px.map(|(a, b)| 0.5 * (a + b)))
     }
 
@@ -829,10 +846,10 @@ impl Tracker {
         jump <= max_jump && same_size(f.fit.r, r) && f.fit.inliers * 3 >= f.rays && f.quality() > 0.2
     }
 
-    /// Whether `f` is the size of the ball: of its radius in free flight so far (see [`same_size`]), else
+    /// Whether `f` is the size of the ball: of its known radius ([`Tracker::known_radius`], see [`same_size`]), else
     /// within the radius range it was acquired with ([`TrackOptions::radius_px`]); true with neither.
     fn ball_sized(&self, f: &Refined) -> bool {
-        match (self.flight_radius(), self.opts.radius_px) {
+        match (self.known_radius(), self.opts.radius_px) {
             (Some(r), _) => same_size(f.fit.r, r),
             (None, Some((lo, hi))) => (lo..=hi).contains(&f.fit.r),
             (None, None) => true,
@@ -1347,6 +1364,37 @@ mod tests {
         let (status, r) = observe(60.0);
         assert_eq!(status, Status::Ok);
         assert!((r - 60.0).abs() < 0.5, "{r}");
+    }
+
+    #[test]
+    fn a_tracker_told_the_ball_s_radius_takes_only_that_size() {
+        // A circle 10 % larger than the ball, as a rim joined to its shadow gives: inside the acquired
+        // radius range, but not the size another pass measured.
+        let img = render(&Scene {
+            ball: (121.3, 125.6, 66.0),
+            ball_level: 170.0,
+            backdrop: (90.0, 90.0),
+            noise: 2.0,
+            ..Scene::default()
+        });
+        let observe = |told: Option<f64>| {
+            let mut tracker = Tracker::new(TrackOptions {
+                radius_px: Some((51.0, 69.0)),
+                ..TrackOptions::default()
+            });
+            if let Some(r) = told {
+                tracker.expect_radius(r);
+            }
+            tracker.seed((-0.002, 101.3, 105.6), (-0.001, 111.3, 115.6));
+            tracker.observe(0, 0.0, &Plane::new(&img, 256, 256))
+        };
+        let fresh = observe(None);
+        assert_eq!(fresh.status, Status::Ok, "the range alone admits it");
+        assert!((fresh.r_px - 66.0).abs() < 0.5, "{}", fresh.r_px);
+        let told = observe(Some(60.0));
+        assert_eq!(told.status, Status::Absent, "radius {}", told.r_px);
+        let told = observe(Some(66.2));
+        assert_eq!(told.status, Status::Ok, "radius {}", told.r_px);
     }
 
     /// A fix kept `inliers` of 128 rays at full contrast: its visible quality is `inliers`/128.
