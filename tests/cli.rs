@@ -216,6 +216,37 @@ fn track_writes_the_trajectory_columns() {
     assert!((x5 - 105.0).abs() < 0.1, "{x5}");
 }
 
+/// A ball that never moves is no ball in flight: exit 1, the clip named once in the error line.
+#[test]
+fn track_names_a_still_clip_once() {
+    use bouncelab_track::testutil::{Scene, render};
+    let dir = tempfile::tempdir().unwrap();
+    let clip = dir.path().join("still_ball");
+    std::fs::create_dir_all(&clip).unwrap();
+    for i in 0..20 {
+        let s = Scene {
+            ball: (128.0, 100.0, 40.0),
+            seed: i,
+            ..Scene::default()
+        };
+        let img = image::GrayImage::from_raw(256, 256, render(&s)).unwrap();
+        img.save(clip.join(format!("img_{i:05}.png"))).unwrap();
+    }
+    let out = bouncelab()
+        .args(["track", clip.to_str().unwrap(), "--fps", "10000", "--diameter", "0.067"])
+        .assert()
+        .code(1)
+        .get_output()
+        .stderr
+        .clone();
+    let err = String::from_utf8(out).unwrap();
+    let line = err
+        .lines()
+        .find(|l| l.contains("no moving ball"))
+        .unwrap_or_else(|| panic!("{err}"));
+    assert_eq!(line.matches("still_ball").count(), 1, "{line}");
+}
+
 #[test]
 fn track_bad_inputs_exit_1_naming_the_folder() {
     let dir = tempfile::tempdir().unwrap();

@@ -56,7 +56,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let opts = ClipTracking::for_settings(clip.settings(), downslope == Some(Downslope::MinusX));
     let bar = super::progress_bar(clip.len() as u64, "tracking", "frames");
     let track = track_clip(&clip, &opts, |done, _| bar.set_position(done as u64))
-        .with_context(|| format!("tracking {}", a.clip_dir.display()))?;
+        // Every tracking error names its clip or the file it read.
+        .context("tracking")?;
     bar.finish_and_clear();
     let c = Conditions {
         incline_deg: angle,

@@ -61,7 +61,8 @@ pub fn track_clip_dir(clip_dir: &Path, a: &Tracking) -> anyhow::Result<(Clip, Tr
             progress,
         ),
     }
-    .with_context(|| format!("tracking {}", clip_dir.display()))?;
+    // Every tracking error names its clip or the file it read.
+    .context("tracking")?;
     bar.finish_and_clear();
     for w in &track.warnings {
         eprintln!("warning: {w}");
