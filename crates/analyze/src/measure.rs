@@ -84,7 +84,8 @@ pub(crate) fn session_key(session: &Session) -> String {
 /// clip's end; 15: a circle acquired only when its rim stands out of the noise, a circle detected before
 /// the ball's flight radius is known only within the radius range it was acquired with, the frames after a
 /// step kept when the frames from the bounce measured again remove it; 16: a frame off the path its
-/// neighbours give, further than the ball can stray, marked ambiguous).
+/// neighbours give, further than the ball can stray, marked ambiguous; 17: the forward track starts from
+/// the radius measured before the first sighting).
 const MEASUREMENT_REVISION: u32 = 17;
 
 /// Everything besides the frame files that changes a shot's track or estimate.

@@ -90,11 +90,18 @@ pub(crate) fn search_stage(
     Ok(Ok(d))
 }
 
-/// The key of what the search depends on: the program's version, the model, the options and every shot's
-/// measurement.
+/// The search's own revision: raised whenever the search or its verdict concludes otherwise from the same
+/// inputs, so that a diagnosis kept in an output folder is made again by a program that would conclude
+/// otherwise (the package's version alone changes only at a release). 2: a whole residual above the floor
+/// only with one shot is that shot's, not the model's.
+const DIAGNOSIS_REVISION: u32 = 2;
+
+/// The key of what the search depends on: the program's version and the search's revision, the model, the
+/// options and every shot's measurement.
 fn inputs_key(model_text: &str, options: &SearchOptions, shots: &[&ShotData]) -> String {
     let mut key = Fingerprint::new();
     key.str(env!("CARGO_PKG_VERSION"))
+        .str(&format!("diagnosis rev {DIAGNOSIS_REVISION}"))
         .str(model_text)
         .str(&format!("{options:?}"));
     crate::reuse::add_shots(&mut key, shots);

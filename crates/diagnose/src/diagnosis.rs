@@ -162,14 +162,15 @@ pub struct Evidence {
     pub fit: FitSummary,
 }
 
-/// The shot with the largest share of a phase and component's squared residual, and the phase without it.
+/// The shot with the largest share of a residual's squares (one phase and component's, or the whole
+/// position residual's), and that residual without it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct WorstShot {
     /// The shot (clip) name.
     pub shot: String,
-    /// Its RMS in that phase and component, m.
+    /// Its RMS there, m.
     pub rms_m: f64,
-    /// The phase and component's systematic part over the other shots, m.
+    /// The residual's systematic part over the other shots, m.
     pub systematic_without_m: f64,
 }
 
@@ -201,6 +202,10 @@ pub struct PhaseResidual {
 pub struct Signature {
     /// Per phase and component, largest χ² share first.
     pub phases: Vec<PhaseResidual>,
+    /// The shot that weighs most in the whole position residual, with the systematic part without it;
+    /// `None` with fewer than [`crate::MIN_SHOTS_FOR_ONE_SHOT`] shots.
+    #[serde(default)]
+    pub worst_shot: Option<WorstShot>,
     /// Significant trends across conditions (Holm-corrected), smallest p first.
     pub trends: Vec<Trend>,
     /// The compare crate's sentences: where χ² sits, then one per significant trend.

@@ -497,12 +497,13 @@ fn signature_from(cmp: &Comparison, report: &FailureReport, noise_m: f64) -> Sig
             systematic_m: excess(s.rms_m * s.rms_m, noise_m),
             chi2_share: if cmp.chi2 > 0.0 { s.chi2 / cmp.chi2 } else { 0.0 },
             chi2_red: s.chi2_red,
-            worst_shot: worst_shot(cmp, s.phase, s.component, noise_m),
+            worst_shot: worst_shot(cmp, |p, c| p == s.phase && c == s.component, noise_m),
         })
         .collect();
     phases.sort_by(|a, b| b.chi2_share.total_cmp(&a.chi2_share));
     Signature {
         phases,
+        worst_shot: worst_shot(cmp, |_, c| c != Component::Spin, noise_m),
         // A trend counts only when it is both significant and larger than the measurement resolves
         // (the compare crate's materiality: COR 0.002, contact time 0.05 ms, …).
         trends: report
@@ -515,19 +516,20 @@ fn signature_from(cmp: &Comparison, report: &FailureReport, noise_m: f64) -> Sig
     }
 }
 
-/// The shot with the largest sum of squared residuals in `phase` and `component`, and the systematic part
-/// (above `noise_m`) of the other shots' residuals there; `None` with fewer than
-/// [`crate::MIN_SHOTS_FOR_ONE_SHOT`] shots having residuals in it.
-fn worst_shot(cmp: &Comparison, phase: ImpactPhase, component: Component, noise_m: f64) -> Option<WorstShot> {
+/// The shot with the largest sum of squared residuals in the phases and components `within` takes, and the
+/// systematic part (above `noise_m`) of the other shots' residuals there; `None` with fewer than
+/// [`crate::MIN_SHOTS_FOR_ONE_SHOT`] shots having residuals in them.
+fn worst_shot(cmp: &Comparison, within: impl Fn(ImpactPhase, Component) -> bool, noise_m: f64) -> Option<WorstShot> {
     let sums: Vec<(&str, f64, usize)> = cmp
         .shots
         .iter()
         .filter_map(|sh| {
-            let st = sh
+            let (sq, n) = sh
                 .by_phase
                 .iter()
-                .find(|p| p.phase == phase && p.component == component)?;
-            (st.n > 0).then_some((sh.shot.as_str(), st.rms_m * st.rms_m * st.n as f64, st.n))
+                .filter(|p| within(p.phase, p.component))
+                .fold((0.0, 0), |(a, m), p| (a + p.rms_m * p.rms_m * p.n as f64, m + p.n));
+            (n > 0).then_some((sh.shot.as_str(), sq, n))
         })
         .collect();
     if sums.len() < crate::MIN_SHOTS_FOR_ONE_SHOT {

@@ -92,9 +92,29 @@ fn one_shot_s(ph: &PhaseResidual, phase_tol: f64) -> Option<&WorstShot> {
         .filter(|w| ph.systematic_m > phase_tol && w.systematic_without_m <= phase_tol)
 }
 
-/// One sentence per phase whose misfit is one shot's ([`one_shot_s`]), naming the shot.
-fn one_shot_words(signature: &Signature, phase_tol: f64) -> String {
+/// The shot the whole residual's systematic part belongs to: above the floor `tol` with every shot and
+/// within it without the one that weighs most ([`Signature::worst_shot`]), for the reason [`one_shot_s`] gives.
+fn whole_one_shot_s<'a>(baseline: &Baseline, signature: &'a Signature, tol: f64) -> Option<&'a WorstShot> {
     signature
+        .worst_shot
+        .as_ref()
+        .filter(|w| baseline.systematic_m > tol && w.systematic_without_m <= tol)
+}
+
+/// The sentence for a whole residual whose systematic part is one shot's ([`whole_one_shot_s`]), then one
+/// per phase whose misfit is one shot's ([`one_shot_s`]), naming the shot.
+fn one_shot_words(baseline: &Baseline, signature: &Signature, tol: f64, phase_tol: f64) -> String {
+    let whole = whole_one_shot_s(baseline, signature, tol).map(|w| {
+        format!(
+            " The whole residual's systematic part, {}, is one shot's: `{}` (RMS {}); without it {}, within the {} floor, so it is not taken for the model's: look at that shot's track.",
+            um(baseline.systematic_m),
+            w.shot,
+            um(w.rms_m),
+            um(w.systematic_without_m),
+            um(tol)
+        )
+    });
+    let phases = signature
         .phases
         .iter()
         .filter_map(|ph| {
@@ -110,7 +130,8 @@ fn one_shot_words(signature: &Signature, phase_tol: f64) -> String {
                 um(phase_tol)
             ))
         })
-        .collect()
+        .collect::<String>();
+    whole.unwrap_or_default() + &phases
 }
 
 fn num(v: f64) -> String {
@@ -155,7 +176,7 @@ pub(crate) fn decide(cands: &mut Vec<Candidate>, inp: Inputs<'_>) -> (Verdict, B
     let best_other = order.first().map(|&i| cands[i].clone());
     *cands = ranked;
 
-    let one_shot = one_shot_words(&signature, phase_tolerance(o, inp.floor));
+    let one_shot = one_shot_words(&baseline, &signature, o.tolerance_m, phase_tolerance(o, inp.floor));
     let mut verdict = match names.len() {
         0 if baseline.misfit => Verdict {
             kind: VerdictKind::NoneExplains,
@@ -167,7 +188,7 @@ pub(crate) fn decide(cands: &mut Vec<Candidate>, inp: Inputs<'_>) -> (Verdict, B
             kind: VerdictKind::NoMissingEffect,
             effect: None,
             effects: Vec::new(),
-            sentence: no_missing(&baseline, noise, best_other.as_ref(), inp.floor) + &limits(cands),
+            sentence: no_missing(&baseline, noise, best_other.as_ref(), inp.floor, o.tolerance_m) + &limits(cands),
         },
         1 => Verdict {
             kind: VerdictKind::MissingEffect,
@@ -195,7 +216,9 @@ fn misfit_reasons(baseline: &Baseline, signature: &Signature, inp: &Inputs<'_>) 
     let o = inp.options;
     let noise = inp.noise_m;
     let mut reasons = Vec::new();
-    if baseline.systematic_m > o.tolerance_m {
+    // A systematic part that is one shot's is that shot's, as a phase's is (see `one_shot_s`); the held-out
+    // error, which has no shot left out of it, is then not asked either.
+    if baseline.systematic_m > o.tolerance_m && whole_one_shot_s(baseline, signature, o.tolerance_m).is_none() {
         reasons.push(format!(
             "residual RMS {} against a noise level of {}: a systematic part of {}, above {}",
             um(baseline.fit.rms_m),
@@ -498,13 +521,18 @@ fn ambiguous(cands: &[Candidate], names: &[String], ties: &[String]) -> String {
     )
 }
 
-fn no_missing(b: &Baseline, noise: f64, best: Option<&Candidate>, floor: &Floor) -> String {
+fn no_missing(b: &Baseline, noise: f64, best: Option<&Candidate>, floor: &Floor, tol: f64) -> String {
+    // Above the floor only with one shot, whose sentence follows (`one_shot_words`).
+    let against = if b.systematic_m > tol {
+        format!("above {} only with the one shot named below", floor_words(floor))
+    } else {
+        format!("within {}", floor_words(floor))
+    };
     let mut s = format!(
-        "No missing effect: the current model fits to the measurement floor (residual RMS {} against a noise level of {} estimated from the residuals; systematic part {}, within {}; reduced χ² {:.2} against the tracker's σ).",
+        "No missing effect: the current model fits to the measurement floor (residual RMS {} against a noise level of {} estimated from the residuals; systematic part {}, {against}; reduced χ² {:.2} against the tracker's σ).",
         um(b.fit.rms_m),
         um(noise),
         um(b.systematic_m),
-        floor_words(floor),
         b.fit.chi2_red
     );
     if let Some(c) = best

@@ -339,6 +339,42 @@ fn one_shot_s_misfit_in_a_phase_is_not_the_model_s() {
     assert!(!d.verdict.sentence.contains("one shot's"), "{}", d.verdict.sentence);
 }
 
+/// A whole residual above the floor because of one shot's track (a wobble in its restitution large enough to
+/// lift the whole), and within it without that shot, is that shot's, not the model's: `no_missing_effect`,
+/// naming the shot. The same wobble in three shots is a misfit.
+#[test]
+fn one_shot_s_misfit_in_the_whole_residual_is_not_the_model_s() {
+    let mut shots = session(&truth(None), 1, Tracking::default());
+    wobble_in_restitution(&mut shots[4], 700e-6);
+    let d = run("none, one shot wobbles hard", &shots, &SearchOptions::default());
+    assert!(
+        d.baseline.systematic_m > d.thresholds.tolerance_m,
+        "the wobble lifts the whole residual above the floor: {} µm against {} µm",
+        d.baseline.systematic_m * 1e6,
+        d.thresholds.tolerance_m * 1e6
+    );
+    assert_eq!(d.verdict.kind, VerdictKind::NoMissingEffect, "{}", d.verdict.sentence);
+    assert!(
+        d.verdict.sentence.contains(&format!(
+            "The whole residual's systematic part, {:.1} µm, is one shot's: `{}`",
+            d.baseline.systematic_m * 1e6,
+            shots[4].name
+        )),
+        "{}",
+        d.verdict.sentence
+    );
+    for k in [0, 7] {
+        wobble_in_restitution(&mut shots[k], 700e-6);
+    }
+    let d = run("none, three shots wobble hard", &shots, &SearchOptions::default());
+    assert!(d.baseline.misfit, "{}", d.verdict.sentence);
+    assert!(
+        !d.verdict.sentence.contains("whole residual's systematic part"),
+        "{}",
+        d.verdict.sentence
+    );
+}
+
 #[test]
 fn no_hidden_effect_gives_no_missing_effect_on_three_seeds() {
     for seed in [1, 2, 3] {
