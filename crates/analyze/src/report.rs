@@ -721,12 +721,21 @@ pub fn verdict_headline(d: &Diagnosis) -> String {
             let names: Vec<String> = d.verdict.effects.iter().map(|e| format!("`{e}`")).collect();
             format!("these explain the misfit about equally well: {}", names.join(", "))
         }
-        VerdictKind::NoMissingEffect => format!(
-            "the model fits within the measurement floor (position RMS {:.1} µm, noise {:.1} µm, floor {:.1} µm)",
-            d.baseline.fit.rms_m * 1e6,
-            d.noise.noise_m * 1e6,
-            d.floor.floor_m * 1e6
-        ),
+        VerdictKind::NoMissingEffect => {
+            // Above the floor only with one shot: that shot's misfit, not the model's (the diagnose crate).
+            let but_for = match &d.signature.worst_shot {
+                Some(w) if d.baseline.systematic_m > d.thresholds.tolerance_m => {
+                    format!(" but for one shot, `{}`, whose track to look at", w.shot)
+                }
+                _ => String::new(),
+            };
+            format!(
+                "the model fits within the measurement floor{but_for} (position RMS {:.1} µm, noise {:.1} µm, floor {:.1} µm)",
+                d.baseline.fit.rms_m * 1e6,
+                d.noise.noise_m * 1e6,
+                d.floor.floor_m * 1e6
+            )
+        }
         VerdictKind::NoneExplains => format!(
             "no library effect explains the misfit (systematic {:.1} µm); see its signature{}",
             d.baseline.systematic_m * 1e6,
