@@ -160,31 +160,54 @@ pub(crate) fn parabola_offset(a0: f64, a1: f64, a2: f64) -> f64 {
     }
 }
 
-/// The sensor noise of a frame, σ on the 0–255 scale (after `img`'s gain), from its smoothest parts: the
-/// variance of the horizontal differences I(x+1, y) − I(x, y) in 8 × 8 blocks (their mean removed, so a
-/// lighting gradient does not count), the 20th percentile of the blocks taken (edges and texture only
-/// raise blocks), corrected for where that percentile falls for 56 degrees of freedom (× 1/0.84), and halved
-/// (a difference has twice the variance). Quantisation adds its 1/12 DN² as it does to any measurement.
+/// The sensor noise of a frame, σ on the 0–255 scale (after `img`'s gain), from its smoothest parts: in
+/// 8 × 8 blocks, the variance of the horizontal differences I(x+1, y) − I(x, y) (the block's mean
+/// difference removed, so a lighting gradient does not count), the 20th percentile of the blocks taken
+/// (edges and texture only raise blocks), corrected for where that percentile falls for 56 degrees of
+/// freedom (× 1/0.84), and halved (a difference has twice the variance). Blocks that hold no sensor noise
+/// are left out, as they would pull that percentile to 0; the vertical differences' variance tells them: a
+/// block whose variance one way is under a quarter of the other's (a border padded by repeating the
+/// frame's edge, a letterbox of repeated rows or columns, a straight edge; white noise never gives that
+/// on 55 differences a way), and a block of one level throughout (clipped, a constant border, a padded
+/// border's corner; a sensor's noise moves some pixel of 64). Quantisation adds its 1/12 DN² as it does
+/// to any measurement. 0 when no block is left (a noiseless frame of flat areas and straight edges).
 /// Cost: one read of the frame.
 pub fn noise_sigma<P: Pixel>(img: &Plane<P>) -> f32 {
     const B: usize = 8;
+    /// Least ratio of a block's smaller directional variance to its larger for it to hold sensor noise.
+    const MIN_ISOTROPY: f32 = 0.25;
     let (w, h) = (img.width, img.height);
     if w < B + 1 || h < B {
         return 0.0;
     }
+    let variance = |(s, s2, n): (f32, f32, f32)| (s2 - s * s / n) / (n - 1.0);
     let mut vars: Vec<f32> = Vec::with_capacity((w / B) * (h / B));
-    for by in (0..h - B + 1).step_by(B) {
+    for by in (0..=h - B).step_by(B) {
         for bx in (0..w - B).step_by(B) {
-            let (mut s, mut s2) = (0.0f32, 0.0f32);
+            let (mut across, mut down) = ((0.0f32, 0.0f32, 0.0f32), (0.0f32, 0.0f32, 0.0f32));
+            let (mut block_lo, mut block_hi) = (f32::INFINITY, f32::NEG_INFINITY);
             for y in by..by + B {
-                for x in bx..bx + B - 1 {
-                    let d = img.at(x + 1, y) - img.at(x, y);
-                    s += d;
-                    s2 += d * d;
+                for x in bx..bx + B {
+                    let v = img.data[y * w + x].level();
+                    (block_lo, block_hi) = (block_lo.min(v), block_hi.max(v));
+                    if x + 1 < bx + B {
+                        let d = img.at(x + 1, y) - img.at(x, y);
+                        across = (across.0 + d, across.1 + d * d, across.2 + 1.0);
+                    }
+                    if y + 1 < by + B {
+                        let d = img.at(x, y + 1) - img.at(x, y);
+                        down = (down.0 + d, down.1 + d * d, down.2 + 1.0);
+                    }
                 }
             }
-            let n = (B * (B - 1)) as f32;
-            vars.push((s2 - s * s / n) / (n - 1.0));
+            if block_lo == block_hi {
+                continue;
+            }
+            let (a, d) = (variance(across).max(0.0), variance(down).max(0.0));
+            if a.min(d) < MIN_ISOTROPY * a.max(d) {
+                continue;
+            }
+            vars.push(a);
         }
     }
     if vars.is_empty() {
@@ -193,4 +216,80 @@ pub fn noise_sigma<P: Pixel>(img: &Plane<P>) -> f32 {
     let k = vars.len() / 5;
     let p20 = *vars.select_nth_unstable_by(k, f32::total_cmp).1;
     (p20 / 0.84 / 2.0).max(0.0).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use bouncelab_testkit::Rng;
+
+    /// A `w` × `h` frame of level 120 with white noise of `sigma` DN, in 8-bit.
+    fn noisy(w: usize, h: usize, sigma: f64, seed: u64) -> Vec<u8> {
+        let mut rng = Rng::new(seed);
+        (0..w * h)
+            .map(|_| (120.0 + sigma * rng.normal()).round().clamp(0.0, 255.0) as u8)
+            .collect()
+    }
+
+    #[test]
+    fn white_noise_is_measured() {
+        for sigma in [2.0, 6.0, 10.0] {
+            let frame = noisy(256, 256, sigma, 3);
+            let measured = noise_sigma(&Plane::new(&frame, 256, 256)) as f64;
+            // Rounding to whole DN adds 1/12 DN².
+            let expected = (sigma * sigma + 1.0 / 12.0).sqrt();
+            assert!(
+                (measured / expected - 1.0).abs() < 0.05,
+                "σ {sigma}: measured {measured}"
+            );
+        }
+    }
+
+    /// A frame padded by repeating its edge columns (as a camera's or a converter's border does), with a
+    /// black letterbox above and a clipped white one below, has the noise of the picture inside: the
+    /// repeated and constant blocks hold none, and without leaving them out (a third of the blocks) the
+    /// 20th percentile is 0.
+    #[test]
+    fn padded_and_letterboxed_borders_do_not_hide_the_noise() {
+        let (w, h, pad, bar) = (192, 160, 64, 24);
+        let inner = noisy(w, h, 6.0, 5);
+        let (pw, ph) = (w + 2 * pad, h + 2 * bar);
+        let mut frame = vec![0u8; pw * ph];
+        for y in 0..ph {
+            for x in 0..pw {
+                frame[y * pw + x] = if y < bar {
+                    0
+                } else if y >= bar + h {
+                    255
+                } else {
+                    inner[(y - bar) * w + x.clamp(pad, pad + w - 1) - pad]
+                };
+            }
+        }
+        let alone = noise_sigma(&Plane::new(&inner, w, h));
+        let padded = noise_sigma(&Plane::new(&frame, pw, ph));
+        assert!((padded / alone - 1.0).abs() < 0.05, "alone {alone}, padded {padded}");
+    }
+
+    /// A border padded by repeating the frame's edge has corners of one level, whose blocks are a quarter
+    /// of the border's when it is as wide as the picture is high (here more than a fifth of all blocks).
+    #[test]
+    fn a_wide_padded_border_s_corners_do_not_hide_the_noise() {
+        let (w, pad) = (96, 96);
+        let inner = noisy(w, w, 6.0, 9);
+        let pw = w + 2 * pad;
+        let at = |v: usize| v.clamp(pad, pad + w - 1) - pad;
+        let frame: Vec<u8> = (0..pw * pw).map(|i| inner[at(i / pw) * w + at(i % pw)]).collect();
+        let alone = noise_sigma(&Plane::new(&inner, w, w));
+        let padded = noise_sigma(&Plane::new(&frame, pw, pw));
+        assert!((padded / alone - 1.0).abs() < 0.05, "alone {alone}, padded {padded}");
+    }
+
+    #[test]
+    fn a_noiseless_frame_has_no_noise() {
+        let mut frame = vec![90u8; 64 * 64];
+        frame[..64 * 8].fill(0);
+        frame[64 * 56..].fill(200);
+        assert_eq!(noise_sigma(&Plane::new(&frame, 64, 64)), 0.0);
+    }
 }
