@@ -253,6 +253,7 @@ pub fn track_clip(
     let mut warnings = Vec::new();
     // The stream starts decoding at once, so its first frames are ready when acquisition is done.
     let frames = clip.frames_with(&opts.read)?;
+    let opts = &without_border(clip, opts, &mut warnings)?;
     let (gain, noise) = first_frame_levels(clip, opts)?;
     let opts = &for_noise(opts, noise);
     if gain >= 2.0 {
@@ -426,6 +427,51 @@ fn first_frame_levels(clip: &Clip, opts: &ClipTracking) -> Result<(f32, f32), Tr
         |p| on_plane!(p, p => crate::plane::noise_sigma(&p)),
     );
     Ok((gain, noise))
+}
+
+/// Sensor noise σ (0–255 scale) below which a frame's repeated outer rows and columns are not taken for a
+/// padded border ([`crate::border::picture_box`]): a noiseless render's smooth margins repeat too.
+const MIN_NOISE_FOR_BORDER: f32 = 0.5;
+
+/// Least width and height of a picture inside a border, px: a smaller one is not taken for the picture.
+const MIN_PICTURE_PX: usize = 32;
+
+/// The options with the region of interest set to the picture inside a border padded by repeating the
+/// frame's edge ([`crate::border::picture_box`]), when the user gave no region, the first frame has such a
+/// border and its sensor noise shows that the repeats cannot be the scene's; a warning says so. The track's
+/// results stay in the whole frame's pixels, as with a region given.
+fn without_border(clip: &Clip, opts: &ClipTracking, warnings: &mut Vec<String>) -> Result<ClipTracking, TrackError> {
+    if opts.roi.is_some() {
+        return Ok(opts.clone());
+    }
+    let Some(first) = clip.read(0, opts.read.png_decoder) else {
+        return Ok(opts.clone());
+    };
+    let first = first?;
+    let (w, h) = (first.pixels.width() as usize, first.pixels.height() as usize);
+    let gain = with_plane(&first.pixels, 1.0, |p| on_plane!(p, p => crate::plane::level_gain(&p)));
+    let (noise, (x, y, bw, bh)) = with_plane(
+        &first.pixels,
+        gain,
+        |p| on_plane!(p, p => (crate::plane::noise_sigma(&p), crate::border::picture_box(&p))),
+    );
+    if noise < MIN_NOISE_FOR_BORDER || (bw, bh) == (w, h) || bw.min(bh) < MIN_PICTURE_PX {
+        return Ok(opts.clone());
+    }
+    warnings.push(format!(
+        "the frames are padded by repeating their edges (left {x}, right {}, top {y}, bottom {} px): only the picture inside is searched (--roi chooses another region)",
+        w - x - bw,
+        h - y - bh
+    ));
+    Ok(ClipTracking {
+        roi: Some(Roi {
+            x: x as u32,
+            y: y as u32,
+            width: bw as u32,
+            height: bh as u32,
+        }),
+        ..opts.clone()
+    })
 }
 
 /// The options with the ball's diameter given to the tracker and, in heavy sensor noise (a ray's largest

@@ -12,6 +12,7 @@
 
 mod acquire;
 mod ball_search;
+mod border;
 mod bounce;
 mod circle_fit;
 mod clip;
