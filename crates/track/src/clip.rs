@@ -253,9 +253,8 @@ pub fn track_clip(
     let mut warnings = Vec::new();
     // The stream starts decoding at once, so its first frames are ready when acquisition is done.
     let frames = clip.frames_with(&opts.read)?;
-    let opts = &without_border(clip, opts, &mut warnings)?;
-    let (gain, noise) = first_frame_levels(clip, opts)?;
-    let opts = &for_noise(opts, noise);
+    let (opts, gain, noise) = first_frame_levels(clip, opts, &mut warnings)?;
+    let opts = &for_noise(&opts, noise);
     if gain >= 2.0 {
         warnings.push(format!(
             "the frames use little of their gray scale: levels stretched {gain:.1}× for the ball and line searches"
@@ -414,19 +413,38 @@ fn mark_off_path(fixes: &mut [BallFix], diameter_m: f64, warnings: &mut Vec<Stri
 }
 
 /// The first frame's (searched region's) level gain ([`crate::plane::level_gain`]) and sensor noise σ
-/// (0–255 scale) at that gain; (1, 0) for an empty clip.
-fn first_frame_levels(clip: &Clip, opts: &ClipTracking) -> Result<(f32, f32), TrackError> {
+/// (0–255 scale) at that gain, with the options that search it: the region of interest set to the picture
+/// inside a border padded by repeating the frame's edge ([`picture_inside_border`]), when the user gave no
+/// region; (1, 0) for an empty clip. One decode of the first frame.
+fn first_frame_levels(
+    clip: &Clip,
+    opts: &ClipTracking,
+    warnings: &mut Vec<String>,
+) -> Result<(ClipTracking, f32, f32), TrackError> {
     let Some(first) = clip.read(0, opts.read.png_decoder) else {
-        return Ok((1.0, 0.0));
+        return Ok((opts.clone(), 1.0, 0.0));
     };
     let first = in_region(first?, opts.roi.as_ref());
-    let gain = with_plane(&first.pixels, 1.0, |p| on_plane!(p, p => crate::plane::level_gain(&p)));
-    let noise = with_plane(
-        &first.pixels,
-        gain,
-        |p| on_plane!(p, p => crate::plane::noise_sigma(&p)),
-    );
-    Ok((gain, noise))
+    let (gain, noise) = levels(&first.pixels);
+    if opts.roi.is_some() || noise < MIN_NOISE_FOR_BORDER {
+        return Ok((opts.clone(), gain, noise));
+    }
+    let Some(roi) = picture_inside_border(&first.pixels, gain, warnings) else {
+        return Ok((opts.clone(), gain, noise));
+    };
+    let (gain, noise) = levels(&in_region(first, Some(&roi)).pixels);
+    let opts = ClipTracking {
+        roi: Some(roi),
+        ..opts.clone()
+    };
+    Ok((opts, gain, noise))
+}
+
+/// The level gain of `pixels` and their sensor noise at that gain.
+fn levels(pixels: &GrayPixels) -> (f32, f32) {
+    let gain = with_plane(pixels, 1.0, |p| on_plane!(p, p => crate::plane::level_gain(&p)));
+    let noise = with_plane(pixels, gain, |p| on_plane!(p, p => crate::plane::noise_sigma(&p)));
+    (gain, noise)
 }
 
 /// Sensor noise σ (0–255 scale) below which a frame's repeated outer rows and columns are not taken for a
@@ -436,41 +454,26 @@ const MIN_NOISE_FOR_BORDER: f32 = 0.5;
 /// Least width and height of a picture inside a border, px: a smaller one is not taken for the picture.
 const MIN_PICTURE_PX: usize = 32;
 
-/// The options with the region of interest set to the picture inside a border padded by repeating the
-/// frame's edge ([`crate::border::picture_box`]), when the user gave no region, the first frame has such a
-/// border and its sensor noise shows that the repeats cannot be the scene's; a warning says so. The track's
-/// results stay in the whole frame's pixels, as with a region given.
-fn without_border(clip: &Clip, opts: &ClipTracking, warnings: &mut Vec<String>) -> Result<ClipTracking, TrackError> {
-    if opts.roi.is_some() {
-        return Ok(opts.clone());
-    }
-    let Some(first) = clip.read(0, opts.read.png_decoder) else {
-        return Ok(opts.clone());
-    };
-    let first = first?;
-    let (w, h) = (first.pixels.width() as usize, first.pixels.height() as usize);
-    let gain = with_plane(&first.pixels, 1.0, |p| on_plane!(p, p => crate::plane::level_gain(&p)));
-    let (noise, (x, y, bw, bh)) = with_plane(
-        &first.pixels,
-        gain,
-        |p| on_plane!(p, p => (crate::plane::noise_sigma(&p), crate::border::picture_box(&p))),
-    );
-    if noise < MIN_NOISE_FOR_BORDER || (bw, bh) == (w, h) || bw.min(bh) < MIN_PICTURE_PX {
-        return Ok(opts.clone());
+/// The picture inside a border padded by repeating the frame's edge ([`crate::border::picture_box`]), as a
+/// region of interest, when the frame (whose sensor noise shows that the repeats cannot be the scene's)
+/// has one; a warning says so. The track's results stay in the whole frame's pixels, as with a region
+/// given.
+fn picture_inside_border(pixels: &GrayPixels, gain: f32, warnings: &mut Vec<String>) -> Option<Roi> {
+    let (w, h) = (pixels.width() as usize, pixels.height() as usize);
+    let (x, y, bw, bh) = with_plane(pixels, gain, |p| on_plane!(p, p => crate::border::picture_box(&p)));
+    if (bw, bh) == (w, h) || bw.min(bh) < MIN_PICTURE_PX {
+        return None;
     }
     warnings.push(format!(
         "the frames are padded by repeating their edges (left {x}, right {}, top {y}, bottom {} px): only the picture inside is searched (--roi chooses another region)",
         w - x - bw,
         h - y - bh
     ));
-    Ok(ClipTracking {
-        roi: Some(Roi {
-            x: x as u32,
-            y: y as u32,
-            width: bw as u32,
-            height: bh as u32,
-        }),
-        ..opts.clone()
+    Some(Roi {
+        x: x as u32,
+        y: y as u32,
+        width: bw as u32,
+        height: bh as u32,
     })
 }
 
