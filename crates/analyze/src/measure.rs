@@ -86,8 +86,9 @@ pub(crate) fn session_key(session: &Session) -> String {
 /// step kept when the frames from the bounce measured again remove it; 16: a frame off the path its
 /// neighbours give, further than the ball can stray, marked ambiguous; 17: the forward track starts from
 /// the radius measured before the first sighting; 18: the sensor noise measured without the blocks that
-/// hold none, and a border padded by repeating the frame's edge taken off).
-const MEASUREMENT_REVISION: u32 = 18;
+/// hold none, and a border padded by repeating the frame's edge taken off; 19: dark letterbox bars that keep
+/// one level through the clip taken off too).
+const MEASUREMENT_REVISION: u32 = 19;
 
 /// Everything besides the frame files that changes a shot's track or estimate.
 fn settings_text(entry: &ClipEntry, gravity: f64) -> String {

@@ -414,8 +414,8 @@ fn mark_off_path(fixes: &mut [BallFix], diameter_m: f64, warnings: &mut Vec<Stri
 
 /// The first frame's (searched region's) level gain ([`crate::plane::level_gain`]) and sensor noise σ
 /// (0–255 scale) at that gain, with the options that search it: the region of interest set to the picture
-/// inside a border padded by repeating the frame's edge ([`picture_inside_border`]), when the user gave no
-/// region; (1, 0) for an empty clip. One decode of the first frame.
+/// inside a border that holds none ([`picture_inside_border`]), when the user gave no region; (1, 0) for an
+/// empty clip. One decode of the first frame, and of [`STEADY_SAMPLES`] more when it may have a bar.
 fn first_frame_levels(
     clip: &Clip,
     opts: &ClipTracking,
@@ -429,7 +429,8 @@ fn first_frame_levels(
     if opts.roi.is_some() || noise < MIN_NOISE_FOR_BORDER {
         return Ok((opts.clone(), gain, noise));
     }
-    let Some(roi) = picture_inside_border(&first.pixels, gain, warnings) else {
+    let steady = steady_lines(clip, opts, &first.pixels);
+    let Some(roi) = picture_inside_border(&first.pixels, gain, steady.as_ref(), warnings) else {
         return Ok((opts.clone(), gain, noise));
     };
     let (gain, noise) = levels(&in_region(first, Some(&roi)).pixels);
@@ -447,25 +448,62 @@ fn levels(pixels: &GrayPixels) -> (f32, f32) {
     (gain, noise)
 }
 
-/// Sensor noise σ (0–255 scale) below which a frame's repeated outer rows and columns are not taken for a
-/// padded border ([`crate::border::picture_box`]): a noiseless render's smooth margins repeat too.
+/// Sensor noise σ (0–255 scale) below which a frame's repeated or one-level outer rows and columns are
+/// not taken for a border ([`crate::border::picture_box`]): a noiseless render's smooth margins repeat too.
 const MIN_NOISE_FOR_BORDER: f32 = 0.5;
 
 /// Least width and height of a picture inside a border, px: a smaller one is not taken for the picture.
 const MIN_PICTURE_PX: usize = 32;
 
-/// The picture inside a border padded by repeating the frame's edge ([`crate::border::picture_box`]), as a
-/// region of interest, when the frame (whose sensor noise shows that the repeats cannot be the scene's)
-/// has one; a warning says so. The track's results stay in the whole frame's pixels, as with a region
-/// given.
-fn picture_inside_border(pixels: &GrayPixels, gain: f32, warnings: &mut Vec<String>) -> Option<Roi> {
+/// Frames looked at through the clip, besides the first, before a row or column of one level is taken for
+/// a bar ([`crate::border::SteadyLines`]): a clipped field the ball crosses changes in some of them.
+const STEADY_SAMPLES: usize = 16;
+
+/// The rows and columns of one level throughout in `first` (the clip's first frame) and in
+/// [`STEADY_SAMPLES`] frames spread evenly over the rest of the clip; `None` when `first` cannot have a
+/// pair of bars (its opposite edges not both of one level) or the clip has no other frame. A frame that fails to decode is passed over: the track
+/// reports it when it gets there.
+fn steady_lines(clip: &Clip, opts: &ClipTracking, first: &GrayPixels) -> Option<crate::border::SteadyLines> {
+    let of = |px: &GrayPixels| with_plane(px, 1.0, |p| on_plane!(p, p => crate::border::SteadyLines::of(&p)));
+    let mut steady = of(first);
+    let n = clip.len();
+    if !steady.may_have_bars() || n < 2 {
+        return None;
+    }
+    let samples = STEADY_SAMPLES.min(n - 1);
+    for k in 1..=samples {
+        let index = k * (n - 1) / samples;
+        if let Some(Ok(frame)) = clip.read(index, opts.read.png_decoder) {
+            steady.and(&of(&frame.pixels));
+        }
+        if !steady.may_have_bars() {
+            return None;
+        }
+    }
+    Some(steady)
+}
+
+/// The picture inside a border that holds none ([`crate::border::picture_box`]: edges padded by repeating
+/// the frame's, or bars of one level in every frame of `steady`), as a region of interest, when the frame
+/// (whose sensor noise shows that such lines cannot be the scene's) has one; a warning says so. The track's
+/// results stay in the whole frame's pixels, as with a region given.
+fn picture_inside_border(
+    pixels: &GrayPixels,
+    gain: f32,
+    steady: Option<&crate::border::SteadyLines>,
+    warnings: &mut Vec<String>,
+) -> Option<Roi> {
     let (w, h) = (pixels.width() as usize, pixels.height() as usize);
-    let (x, y, bw, bh) = with_plane(pixels, gain, |p| on_plane!(p, p => crate::border::picture_box(&p)));
+    let (x, y, bw, bh) = with_plane(
+        pixels,
+        gain,
+        |p| on_plane!(p, p => crate::border::picture_box(&p, steady)),
+    );
     if (bw, bh) == (w, h) || bw.min(bh) < MIN_PICTURE_PX {
         return None;
     }
     warnings.push(format!(
-        "the frames are padded by repeating their edges (left {x}, right {}, top {y}, bottom {} px): only the picture inside is searched (--roi chooses another region)",
+        "the frames have a border with no picture in it (repeated edges or bars of one level): left {x}, right {}, top {y}, bottom {} px; only the picture inside is searched (--roi chooses another region)",
         w - x - bw,
         h - y - bh
     ));
