@@ -9,17 +9,15 @@
 //! a picture exactly, so an outer row or column that is the same as the next one in is border. A row or
 //! column of one level throughout may be a bar, but it may as well be a clipped band or a backlit field
 //! the ball will cross: it is border only when it keeps that level in every frame looked at through the
-//! clip ([`SteadyLines`]), that level is below the frame's highest, and a bar as wide faces it across the
-//! frame. A saturated field stays picture however still it is: the real Photron recording's top 46 rows
-//! are at full scale in all 15 frames, and the falling ball's rim touches them in the first. A dark tape
-//! clipped black lies on one side: an independent renderer's tape clip through `perturb.py --gain 0.5
-//! --offset -45` has its bottom 101 rows at 0 in every frame, its top edge straight along a row, and cut
-//! there the ball was lost in 350 of 380 frames. The picture is what is left.
+//! clip ([`SteadyLines`]), that level is below the frame's highest (a saturated backlit field stays
+//! picture however still it is: the ball may enter it), and a bar as wide faces it across the frame (a
+//! dark tape clipped black lies on one side, and its top edge must stay in the picture).
+//! `docs/accuracy.md` ("Letterbox bars") has the clips behind each rule. The picture is what is left.
 
 use crate::plane::{Pixel, Plane};
 
 /// The rows and columns of a clip's frames that are one level throughout, each with that level, in every
-/// frame looked at: a letterbox or pillarbox bar, which nothing in the clip ever crosses.
+/// frame looked at: what a letterbox or pillarbox bar is, as nothing in the clip crosses it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SteadyLines {
     rows: Vec<Option<f32>>,

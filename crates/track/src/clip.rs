@@ -461,8 +461,8 @@ const STEADY_SAMPLES: usize = 16;
 
 /// The rows and columns of one level throughout in `first` (the clip's first frame) and in
 /// [`STEADY_SAMPLES`] frames spread evenly over the rest of the clip; `None` when `first` cannot have a
-/// pair of bars (its opposite edges not both of one level) or the clip has no other frame. A frame that fails to decode is passed over: the track
-/// reports it when it gets there.
+/// pair of bars (its opposite edges not both of one level) or the clip has no other frame. A frame that
+/// fails to decode is passed over: the track reports it when it gets there.
 fn steady_lines(clip: &Clip, opts: &ClipTracking, first: &GrayPixels) -> Option<crate::border::SteadyLines> {
     let of = |px: &GrayPixels| with_plane(px, 1.0, |p| on_plane!(p, p => crate::border::SteadyLines::of(&p)));
     let mut steady = of(first);
