@@ -87,8 +87,9 @@ pub(crate) fn session_key(session: &Session) -> String {
 /// neighbours give, further than the ball can stray, marked ambiguous; 17: the forward track starts from
 /// the radius measured before the first sighting; 18: the sensor noise measured without the blocks that
 /// hold none, and a border padded by repeating the frame's edge taken off; 19: dark letterbox bars that keep
-/// one level through the clip taken off too).
-const MEASUREMENT_REVISION: u32 = 19;
+/// one level through the clip taken off too; 20: a shot whose flights scatter beyond a tenth of the ball's
+/// radius flagged).
+const MEASUREMENT_REVISION: u32 = 20;
 
 /// Everything besides the frame files that changes a shot's track or estimate.
 fn settings_text(entry: &ClipEntry, gravity: f64) -> String {

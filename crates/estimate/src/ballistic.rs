@@ -115,13 +115,27 @@ pub fn fit_ballistic(points: &[(f64, f64, f64, f64)], a: [f64; 2]) -> Option<Bal
     Some(fit)
 }
 
+/// A flight fitted with its acceleration free (see [`fit_free_acceleration`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FreeArc {
+    /// The acceleration (x, y), m/s².
+    pub a: [f64; 2],
+    /// Its standard errors (x, y), m/s².
+    pub se: [f64; 2],
+    /// The root-mean-square distance of the points from the fitted arc, m: the track's own scatter,
+    /// whatever the flight's acceleration.
+    pub rms_m: f64,
+    /// The reduced χ² of that scatter against the points' σ, both coordinates together.
+    pub chi2_red: f64,
+}
+
 /// Fits `points` (t s, x m, y m, σ m) with the acceleration free: a weighted quadratic per coordinate.
-/// Returns the acceleration (x, y), m/s², and its standard errors: from the given σ, or from the scatter
-/// when that is larger, counted as √(χ²_red·(1+ρ)/(1−ρ)) with ρ the lag-1 correlation of the residuals in
-/// time order (a tracker's error drifts with the rim's look from frame to frame, so neighbouring residuals
-/// are not independent and an acceleration would otherwise look more certain than it is); `None` with
-/// fewer than 6 points or degenerate times.
-pub fn fit_free_acceleration(points: &[(f64, f64, f64, f64)]) -> Option<([f64; 2], [f64; 2])> {
+/// Returns the acceleration with its standard errors: from the given σ, or from the scatter when that is
+/// larger, counted as √(χ²_red·(1+ρ)/(1−ρ)) with ρ the lag-1 correlation of the residuals in time order (a
+/// tracker's error drifts with the rim's look from frame to frame, so neighbouring residuals are not
+/// independent and an acceleration would otherwise look more certain than it is), and the points' scatter
+/// about the arc; `None` with fewer than 6 points or degenerate times. Cost: O(n).
+pub fn fit_free_acceleration(points: &[(f64, f64, f64, f64)]) -> Option<FreeArc> {
     if points.len() < 6 {
         return None;
     }
@@ -133,6 +147,7 @@ pub fn fit_free_acceleration(points: &[(f64, f64, f64, f64)]) -> Option<([f64; 2
     }
     let mut a = [0.0; 2];
     let mut se = [0.0; 2];
+    let (mut sum_sq_m, mut chi2_all) = (0.0, 0.0);
     for k in 0..2 {
         // Normal equations of z = c0 + c1·u + c2·u² in u = (t − t_ref)/span.
         let mut m = [[0.0f64; 3]; 3];
@@ -163,8 +178,20 @@ pub fn fit_free_acceleration(points: &[(f64, f64, f64, f64)]) -> Option<([f64; 2
         let inflate = (chi2 / (points.len() as f64 - 3.0) * ar1_factor(&residuals)).max(1.0);
         a[k] = 2.0 * c[2] / (span * span);
         se[k] = 2.0 * (inv[2][2] * inflate).sqrt() / (span * span);
+        sum_sq_m += residuals
+            .iter()
+            .zip(points)
+            .map(|(r, p)| (r * p.3).powi(2))
+            .sum::<f64>();
+        chi2_all += chi2;
     }
-    Some((a, se))
+    let n = points.len() as f64;
+    Some(FreeArc {
+        a,
+        se,
+        rms_m: (sum_sq_m / n).sqrt(),
+        chi2_red: chi2_all / (2.0 * (n - 3.0)),
+    })
 }
 
 /// The variance factor (1+ρ)/(1−ρ) of a mean of AR(1) residuals with lag-1 correlation ρ (measured,
@@ -215,10 +242,23 @@ mod tests {
                     (t, 0.1 + 0.5 * t, 0.2 - 2.0 * t - 4.905 * t * t + e, 1e-6)
                 })
                 .collect();
-            fit_free_acceleration(&pts).unwrap().1[1]
+            fit_free_acceleration(&pts).unwrap().se[1]
         };
         let (drift, white) = (fit(&errors), fit(&shuffled));
         assert!(drift > 2.0 * white, "drift SE {drift}, shuffled SE {white}");
+    }
+
+    #[test]
+    fn a_free_fit_measures_the_scatter_about_its_arc() {
+        // Errors of ±3 µm alternating in y, reported as 1 µm: about 3 µm RMS from the arc, χ²_red ≈ 9/2
+        // (both coordinates counted, x exact).
+        let pts: Vec<_> = (0..40)
+            .map(|i| (i as f64 * 1e-4, if i % 2 == 0 { 3e-6 } else { -3e-6 }))
+            .map(|(t, e)| (t, 0.1 + 0.5 * t, 0.2 - 2.0 * t - 4.905 * t * t + e, 1e-6))
+            .collect();
+        let arc = fit_free_acceleration(&pts).unwrap();
+        assert!((arc.rms_m - 3e-6).abs() < 0.1e-6, "{arc:?}");
+        assert!((arc.chi2_red - 4.5 * 40.0 / 37.0).abs() < 0.3, "{arc:?}");
     }
 
     #[test]
@@ -227,8 +267,9 @@ mod tests {
             .map(|i| i as f64 * 1e-4)
             .map(|t| (t, 0.1 + 0.5 * t + 0.6 * t * t, 0.2 - 2.0 * t - 4.905 * t * t, 1e-6))
             .collect();
-        let (a, se) = fit_free_acceleration(&pts).unwrap();
+        let FreeArc { a, se, rms_m, .. } = fit_free_acceleration(&pts).unwrap();
         assert!((a[0] - 1.2).abs() < 1e-6 && (a[1] + 9.81).abs() < 1e-6, "{a:?}");
+        assert!(rms_m < 1e-12, "{rms_m}");
         // 40 frames over 3.9 ms at 1 µm: the acceleration is known to about ±0.27 m/s² (the same for x and y).
         assert!((se[1] - 0.27).abs() < 0.03 && se[0] == se[1], "{se:?}");
     }

@@ -1,6 +1,6 @@
 //! One shot: phases, velocities, restitution, friction, contact time and penetration from a track.
 
-use crate::ballistic::{BallisticFit, fit_ballistic, fit_free_acceleration};
+use crate::ballistic::{BallisticFit, FreeArc, fit_ballistic, fit_free_acceleration};
 use crate::contact::{HeightPoint, TrajectoryContact, find_impact, trajectory_contact};
 use crate::phase::PhaseFrames;
 use bouncelab_track::{LineCue, Status, SurfaceFrame, SurfaceLine, Track};
@@ -364,7 +364,11 @@ fn estimate_from_measured(track: &Track, c: &Conditions) -> Result<Estimate, Est
     };
     let fin = fit(&incoming, "incoming")?;
     let fout = fit(&outgoing, "outgoing")?;
-    let gravity = gravity_check(&incoming, &outgoing, a, c.gravity);
+    let free_arcs = [&incoming, &outgoing].map(|set| {
+        let pts: Vec<_> = set.iter().map(|p| (p.t, p.x, p.y, p.sigma)).collect();
+        fit_free_acceleration(&pts)
+    });
+    let gravity = gravity_check(&free_arcs, a, c.gravity);
     let mut notes = choice.notes;
     let mut level = LevelErrors::of(&line, &scale, radius, choice.trajectory_share);
     if line.cue == LineCue::Trajectory
@@ -403,6 +407,7 @@ fn estimate_from_measured(track: &Track, c: &Conditions) -> Result<Estimate, Est
         t_sep.value,
     );
     flags.extend(saturation_flag(track));
+    flags.extend(off_one_ball(&free_arcs, s, scale.radius_px));
     if let Some(g) = &gravity {
         note_gravity(g, c.incline_deg, c.gravity, &mut flags, &mut notes);
     }
@@ -778,6 +783,35 @@ fn note_scatter(fin: &BallisticFit, fout: &BallisticFit, notes: &mut Vec<String>
     }
 }
 
+/// Largest scatter of a flight's centres about one free-fall arc, in ball radii, for them to follow one ball.
+/// A tracker on the ball's rim places its centre to a small fraction of the radius even in heavy noise (at
+/// most 0.028 r over the harder copies in `docs/accuracy.md`); a tenth of the radius is beyond any rim.
+pub const FLIGHT_SCATTER_MAX_RADII: f64 = 0.1;
+
+/// Least reduced χ² of that scatter against the tracker's σ for the flag: a tracker that reports its
+/// centres as that uncertain (a small ball in heavy noise) has said so, and the errors carry it.
+const FLIGHT_SCATTER_MIN_CHI2: f64 = 9.0;
+
+/// Why the flights' centres are not one ball's, when a flight scatters more than
+/// [`FLIGHT_SCATTER_MAX_RADII`] of the ball's radius (`radius_px`) about its own free-fall arc and far beyond
+/// the tracker's σ: the track jumps between the ball and other objects, and nothing measured from it is
+/// the ball's. `free_arcs` are the incoming and outgoing flights' fits, `m_per_px` the scale.
+fn off_one_ball(free_arcs: &[Option<FreeArc>; 2], m_per_px: f64, radius_px: f64) -> Option<String> {
+    let (name, rms_px) = ["incoming", "outgoing"]
+        .into_iter()
+        .zip(free_arcs)
+        .filter_map(|(name, arc)| arc.as_ref().map(|a| (name, a.rms_m / m_per_px, a.chi2_red)))
+        .filter(|&(_, rms_px, chi2_red)| {
+            rms_px > FLIGHT_SCATTER_MAX_RADII * radius_px && chi2_red > FLIGHT_SCATTER_MIN_CHI2
+        })
+        .map(|(name, rms_px, _)| (name, rms_px))
+        .max_by(|a, b| a.1.total_cmp(&b.1))?;
+    Some(format!(
+        "the {name} flight's centres scatter {rms_px:.1} px RMS about one free-fall arc ({:.2} of the ball's {radius_px:.1} px radius; {FLIGHT_SCATTER_MAX_RADII} at most for one ball): the track jumps between the ball and something else, and cannot tell the ball's bounce",
+        rms_px / radius_px
+    ))
+}
+
 /// Share of a shot's measured frames whose rim may be saturated before the shot is flagged: a few frames
 /// passing a hot spot bias a few centres, which the flight fits' scatter absorbs.
 const SATURATED_FRAMES_SHARE: f64 = 0.05;
@@ -822,13 +856,11 @@ fn impossible(v_in_n: f64, v_out_n: f64, cor: f64, mu: f64, t_touch: f64, t_sep:
 
 /// The flights fitted with their acceleration free, weighted together, against gravity's `expected`
 /// (m/s², local frame); `None` when neither flight has enough frames for a free fit.
-fn gravity_check(incoming: &[&Point], outgoing: &[&Point], expected: [f64; 2], g: f64) -> Option<GravityCheck> {
-    let fits: Vec<[Measured; 2]> = [incoming, outgoing]
+fn gravity_check(free_arcs: &[Option<FreeArc>; 2], expected: [f64; 2], g: f64) -> Option<GravityCheck> {
+    let fits: Vec<[Measured; 2]> = free_arcs
         .iter()
-        .filter_map(|set| {
-            let pts: Vec<_> = set.iter().map(|p| (p.t, p.x, p.y, p.sigma)).collect();
-            fit_free_acceleration(&pts).map(|(a, se)| [0, 1].map(|k| Measured::new(a[k], se[k])))
-        })
+        .flatten()
+        .map(|f| [0, 1].map(|k| Measured::new(f.a[k], f.se[k])))
         .collect();
     if fits.is_empty() {
         return None;

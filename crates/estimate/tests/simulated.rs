@@ -674,3 +674,25 @@ fn a_reversed_down_slope_is_named_by_gravity() {
     };
     assert!(loose.downslope_evidence(9.81).is_none(), "{loose:?}");
 }
+
+/// A track that jumps in flight between the ball and a still circle (another object taken for it in every
+/// fourth frame) is not one ball's: flagged with the scatter measured. The same jumps reported by the
+/// tracker as that uncertain are carried by the errors instead, and a track on the ball is not flagged.
+#[test]
+fn a_track_jumping_to_another_object_in_flight_is_flagged() {
+    let model = Model::paper(25_650.0, 14.0, 0.5);
+    let jumping = |sigma_px: f64| {
+        let (mut track, _) = shot(&model, 0.0, 0.3, 0.02, 6);
+        for f in track.fixes.iter_mut().take(120).step_by(4) {
+            (f.x_px, f.y_px, f.sigma_px) = (190.0, 300.0, sigma_px);
+        }
+        track
+    };
+    let e = estimate(&jumping(0.05), &conditions(0.0)).unwrap();
+    let flag = e.flags.iter().find(|f| f.contains("jumps between")).expect("flagged");
+    assert!(flag.starts_with("the incoming flight's centres scatter"), "{flag}");
+    let (track, _) = shot(&model, 0.0, 0.3, 0.02, 6);
+    assert!(estimate(&track, &conditions(0.0)).unwrap().flags.is_empty());
+    let e = estimate(&jumping(60.0), &conditions(0.0)).unwrap();
+    assert!(!e.flags.iter().any(|f| f.contains("jumps between")), "{:?}", e.flags);
+}

@@ -1,0 +1,66 @@
+#!/usr/bin/env python3
+"""Each shot's flight scatter, in pixels and in ball radii, from `bouncelab analyze` outputs.
+
+    python3 tools/flight_scatter.py OUT [OUT ...] [--top N]
+
+For every shot in OUT/estimates.csv with a touch and a separation time, the `ok` frames of its trajectory
+more than 0.3 ms before the touch and after the separation are fitted by a quadratic in time per
+coordinate; the root-mean-square distance of the centres from that arc is printed per flight, with the
+worse flight over the ball's median radius. The shots of each folder come worst first (the first N with
+--top). This is the measure behind the estimator's `FLIGHT_SCATTER_MAX_RADII` (docs/accuracy.md), computed
+independently of it. Needs numpy.
+"""
+import argparse
+import csv
+import os
+
+import numpy as np
+
+
+def flight_rms_px(frames):
+    if len(frames) < 6:
+        return float("nan")
+    t = np.array([float(f["t_s"]) for f in frames])
+    t -= t.mean()
+    sq = 0.0
+    for key in ("x_px", "y_px"):
+        v = np.array([float(f[key]) for f in frames])
+        sq = sq + (v - np.polyval(np.polyfit(t, v, 2), t)) ** 2
+    return float(np.sqrt(np.mean(sq)))
+
+
+def shots(out):
+    with open(os.path.join(out, "estimates.csv")) as f:
+        rows = list(csv.DictReader(f))
+    for e in rows:
+        if not e["t_touch_s"] or not e["t_sep_s"]:
+            continue
+        touch, sep = float(e["t_touch_s"]), float(e["t_sep_s"])
+        with open(os.path.join(out, e["trajectory_file"])) as f:
+            ok = [r for r in csv.DictReader(f) if r["status"] == "ok"]
+        flights = (
+            [r for r in ok if float(r["t_s"]) < touch - 3e-4],
+            [r for r in ok if float(r["t_s"]) > sep + 3e-4],
+        )
+        rms = [flight_rms_px(fl) for fl in flights]
+        radius = float(np.median([float(r["r_px"]) for r in ok]))
+        yield float(np.nanmax(rms)) / radius, e["clip"], rms, radius, bool(e["flags"])
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("out", nargs="+")
+    p.add_argument("--top", type=int, default=0)
+    a = p.parse_args()
+    for out in a.out:
+        ranked = sorted(shots(out), reverse=True)
+        for ratio, clip, rms, radius, flagged in ranked[: a.top or None]:
+            mark = "\tflagged" if flagged else ""
+            print(
+                f"{out}\t{clip}\tin {rms[0]:.3f} px\tout {rms[1]:.3f} px\tradius {radius:.1f} px"
+                f"\tworst {ratio:.4f} r{mark}"
+            )
+
+
+if __name__ == "__main__":
+    main()
