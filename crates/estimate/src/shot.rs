@@ -254,6 +254,18 @@ pub enum EstimateError {
     /// The ball never came within a pixel of the surface.
     #[error("no impact in the clip: the ball comes no closer than {clearance_px:.1} px to the surface")]
     NoContact { clearance_px: f64 },
+    /// The ball's track comes down and goes up again, yet its rim never comes within a pixel of the contact
+    /// line: the radius measured is not the ball's edge, or the line is not the surface.
+    #[error(
+        "the ball turns back {clearance_px:.1} px above the {line} without reaching it: either the rim measured is not the ball's edge (its radius reads {radius_lo_px:.1}–{radius_hi_px:.1} px over the frames, 10th–90th percentile) or the line is not the surface, so the contact cannot be told; give the scale (--scale or [camera] scale_m_per_px: the radius then follows from the ball's diameter) or the contact line (--line or [surface] line_y_px)"
+    )]
+    TurnsAboveLine {
+        clearance_px: f64,
+        /// Which line, as a phrase ("surface line found (brightness cue)").
+        line: String,
+        radius_lo_px: f64,
+        radius_hi_px: f64,
+    },
     /// The trajectory never comes down and goes up again.
     #[error(
         "no impact in the clip: the ball {} through all {frames} measured frames ({:.3} ± {:.3} m/s along the normal at the last)",
@@ -354,7 +366,7 @@ fn estimate_from_measured(track: &Track, c: &Conditions) -> Result<Estimate, Est
     )?;
     let line = choice.line;
     let (frame, points) = local_points(track, &measured, &line, &scale);
-    let (first, last) = contact_run(&points, choice.no_impact)?;
+    let (first, last) = contact_run(&points, choice.no_impact, &line)?;
     let (incoming, outgoing) = flights(&points, first, last)?;
     let beta = c.incline_deg.to_radians();
     let a = [c.gravity * beta.sin(), -c.gravity * beta.cos()];
@@ -565,16 +577,44 @@ fn local_points(
 }
 
 /// The contact: the run of points (first, last) around the lowest one within [`CLEARANCE_MARGIN_PX`] of the
-/// surface; an error when even the lowest is above it (the trajectory's own `no_impact`, a fall with its
-/// speed, says more than the clearance).
-fn contact_run(points: &[Point], no_impact: Option<EstimateError>) -> Result<(usize, usize), EstimateError> {
+/// surface `line`; an error when even the lowest is above it: the trajectory's own `no_impact` (a fall with
+/// its speed) says more than the clearance, and a track that comes down and goes up again above the line
+/// has an impact that its rim or the line misplaces.
+fn contact_run(
+    points: &[Point],
+    no_impact: Option<EstimateError>,
+    line: &SurfaceLine,
+) -> Result<(usize, usize), EstimateError> {
     let low = (0..points.len())
         .min_by(|&a, &b| points[a].clearance_px.total_cmp(&points[b].clearance_px))
         .expect("measured frames");
-    if points[low].clearance_px > CLEARANCE_MARGIN_PX {
-        return Err(no_impact.unwrap_or(EstimateError::NoContact {
-            clearance_px: points[low].clearance_px,
-        }));
+    let clearance_px = points[low].clearance_px;
+    if clearance_px > CLEARANCE_MARGIN_PX {
+        let heights: Vec<HeightPoint> = points
+            .iter()
+            .map(|p| HeightPoint {
+                t: p.t,
+                h: p.clearance_px,
+                sigma: p.sigma,
+            })
+            .collect();
+        // Only whether the track turns back is asked, so the fall speed's terms are not needed.
+        let turns_back = find_impact(&heights, 0.0, 1.0).is_ok();
+        return Err(match no_impact {
+            Some(e) => e,
+            None if turns_back => {
+                let mut radii: Vec<f64> = points.iter().map(|p| p.r_px).filter(|r| r.is_finite()).collect();
+                radii.sort_by(f64::total_cmp);
+                let at = |q: f64| radii.get(((radii.len() - 1) as f64 * q).round() as usize).copied();
+                EstimateError::TurnsAboveLine {
+                    clearance_px,
+                    line: line_phrase(line),
+                    radius_lo_px: at(0.1).unwrap_or(f64::NAN),
+                    radius_hi_px: at(0.9).unwrap_or(f64::NAN),
+                }
+            }
+            None => EstimateError::NoContact { clearance_px },
+        });
     }
     let near = |p: &Point| p.clearance_px <= CLEARANCE_MARGIN_PX;
     let (mut first, mut last) = (low, low);
@@ -585,6 +625,15 @@ fn contact_run(points: &[Point], no_impact: Option<EstimateError>) -> Result<(us
         last += 1;
     }
     Ok((first, last))
+}
+
+/// What `line` is, as a phrase for a sentence.
+fn line_phrase(line: &SurfaceLine) -> String {
+    match line.cue {
+        LineCue::Brightness | LineCue::Texture => format!("surface line found ({} cue)", line.cue.name()),
+        LineCue::Given => "contact line given".to_string(),
+        LineCue::Trajectory => "contact level from the ball's trajectory".to_string(),
+    }
 }
 
 /// The flight points before and after the contact run (first, last), clear of the surface; an error when

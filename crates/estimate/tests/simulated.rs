@@ -696,3 +696,26 @@ fn a_track_jumping_to_another_object_in_flight_is_flagged() {
     let e = estimate(&jumping(60.0), &conditions(0.0)).unwrap();
     assert!(!e.flags.iter().any(|f| f.contains("jumps between")), "{:?}", e.flags);
 }
+
+/// A ball that comes down and goes up again above the contact line (a line given 12 px too low here, 5.4 px
+/// beyond the ball's 6.6 px compression; a rim read inside the ball's dark lower limb does the same) has an
+/// impact the line or the rim misplaces: the error says so, with the radius read, rather than "no impact
+/// in the clip".
+#[test]
+fn a_ball_turning_back_above_the_line_is_not_called_no_impact() {
+    let model = Model::paper(25_650.0, 14.0, 0.5);
+    let (mut track, _) = shot(&model, 0.0, 0.3, 0.02, 7);
+    track.surface = Some(SurfaceLine::given(255.5, SURFACE_Y + 12.0, 0.0));
+    match estimate(&track, &conditions(0.0)) {
+        Err(e @ EstimateError::TurnsAboveLine { clearance_px, .. }) => {
+            assert!((clearance_px - 5.4).abs() < 1.0, "{clearance_px}");
+            let text = e.to_string();
+            let radius = format!("{0:.1}–{0:.1} px", model.ball.radius_m / SCALE);
+            assert!(text.contains("contact line given") && text.contains(&radius), "{text}");
+        }
+        other => panic!("{other:?}"),
+    }
+    // A line 5 px too low is still reached: the ball compresses by more.
+    track.surface = Some(SurfaceLine::given(255.5, SURFACE_Y + 5.0, 0.0));
+    assert!(estimate(&track, &conditions(0.0)).is_ok());
+}
