@@ -1,5 +1,7 @@
 //! Weighted least-squares fit of a ballistic arc with known acceleration.
 
+use nalgebra::{DMatrix, DVector};
+
 /// A fitted arc `p(t) = p0 + v0·(t − t_ref) + ½·a·(t − t_ref)²` per coordinate, with covariances.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BallisticFit {
@@ -136,6 +138,30 @@ pub struct FreeArc {
 /// independent and an acceleration would otherwise look more certain than it is), and the points' scatter
 /// about the arc; `None` with fewer than 6 points or degenerate times. Cost: O(n).
 pub fn fit_free_acceleration(points: &[(f64, f64, f64, f64)]) -> Option<FreeArc> {
+    free_fit(points, None)
+}
+
+/// [`fit_free_acceleration`] with the measured radius `radius_m` of each point (m) as one more term per
+/// coordinate, its coefficient free: a rigid ball's radius does not change in flight, so a change is the
+/// rim read differently as the ball's look changes (a lit side clipping, a shading), and a rim read
+/// differently on one side moves the centre by up to as much. The acceleration is then what the centres
+/// show beyond that, with its error grown by how much the radius's change resembles a fall. A radius that
+/// does not change (to 10⁻⁴ of its scale) adds no term. `None` as there, when the lengths differ, or when
+/// the radius changes exactly as a fall would (a quadratic in time), which leaves the fall unmeasurable.
+pub fn fit_free_acceleration_beyond_rim(points: &[(f64, f64, f64, f64)], radius_m: &[f64]) -> Option<FreeArc> {
+    (radius_m.len() == points.len()).then_some(())?;
+    let mean = radius_m.iter().sum::<f64>() / radius_m.len() as f64;
+    let spread = radius_m.iter().map(|r| (r - mean).abs()).fold(0.0, f64::max);
+    if spread <= 1e-4 * mean.abs() {
+        return free_fit(points, None);
+    }
+    let rim: Vec<f64> = radius_m.iter().map(|r| (r - mean) / spread).collect();
+    free_fit(points, Some(&rim))
+}
+
+/// The weighted fit of `z = c0 + c1·u + c2·u² (+ c3·rim)` per coordinate, u = (t − t_ref)/span; see
+/// [`fit_free_acceleration`].
+fn free_fit(points: &[(f64, f64, f64, f64)], rim: Option<&[f64]>) -> Option<FreeArc> {
     if points.len() < 6 {
         return None;
     }
@@ -145,39 +171,34 @@ pub fn fit_free_acceleration(points: &[(f64, f64, f64, f64)]) -> Option<FreeArc>
     if span.is_nan() || span <= 0.0 {
         return None;
     }
+    let terms = if rim.is_some() { 4 } else { 3 };
+    // Rows of the design, each weighted by 1/σ.
+    let design = DMatrix::from_fn(points.len(), terms, |i, j| {
+        let u = (points[i].0 - t_ref) / span;
+        let basis = match j {
+            0 => 1.0,
+            1 => u,
+            2 => u * u,
+            _ => rim.map_or(0.0, |r| r[i]),
+        };
+        basis / points[i].3
+    });
+    let inv = (design.transpose() * &design).try_inverse()?;
     let mut a = [0.0; 2];
     let mut se = [0.0; 2];
     let (mut sum_sq_m, mut chi2_all) = (0.0, 0.0);
     for k in 0..2 {
-        // Normal equations of z = c0 + c1·u + c2·u² in u = (t − t_ref)/span.
-        let mut m = [[0.0f64; 3]; 3];
-        let mut b = [0.0f64; 3];
-        for p in points {
-            let u = (p.0 - t_ref) / span;
-            let w = 1.0 / (p.3 * p.3);
-            let z = if k == 0 { p.1 } else { p.2 };
-            let basis = [1.0, u, u * u];
-            for i in 0..3 {
-                b[i] += w * basis[i] * z;
-                for j in 0..3 {
-                    m[i][j] += w * basis[i] * basis[j];
-                }
-            }
-        }
-        let inv = invert3(m)?;
-        let c: Vec<f64> = (0..3).map(|i| (0..3).map(|j| inv[i][j] * b[j]).sum()).collect();
-        let residuals: Vec<f64> = points
-            .iter()
-            .map(|p| {
-                let u = (p.0 - t_ref) / span;
-                let z = if k == 0 { p.1 } else { p.2 };
-                (z - (c[0] + c[1] * u + c[2] * u * u)) / p.3
-            })
-            .collect();
+        let z = DVector::from_iterator(
+            points.len(),
+            points.iter().map(|p| if k == 0 { p.1 } else { p.2 } / p.3),
+        );
+        let c = &inv * (design.transpose() * &z);
+        // Residuals in units of σ.
+        let residuals: Vec<f64> = (&z - &design * &c).iter().copied().collect();
         let chi2: f64 = residuals.iter().map(|r| r * r).sum();
-        let inflate = (chi2 / (points.len() as f64 - 3.0) * ar1_factor(&residuals)).max(1.0);
+        let inflate = (chi2 / (points.len() - terms) as f64 * ar1_factor(&residuals)).max(1.0);
         a[k] = 2.0 * c[2] / (span * span);
-        se[k] = 2.0 * (inv[2][2] * inflate).sqrt() / (span * span);
+        se[k] = 2.0 * (inv[(2, 2)] * inflate).max(0.0).sqrt() / (span * span);
         sum_sq_m += residuals
             .iter()
             .zip(points)
@@ -186,11 +207,12 @@ pub fn fit_free_acceleration(points: &[(f64, f64, f64, f64)]) -> Option<FreeArc>
         chi2_all += chi2;
     }
     let n = points.len() as f64;
-    Some(FreeArc {
+    // A rim whose change is the fall's own shape leaves nothing to tell them apart.
+    a.iter().chain(&se).all(|v| v.is_finite()).then_some(FreeArc {
         a,
         se,
         rms_m: (sum_sq_m / n).sqrt(),
-        chi2_red: chi2_all / (2.0 * (n - 3.0)),
+        chi2_red: chi2_all / (2.0 * (n - terms as f64)),
     })
 }
 
@@ -203,26 +225,6 @@ pub(crate) fn ar1_factor(residuals: &[f64]) -> f64 {
     let lag: f64 = residuals.windows(2).map(|w| (w[0] - m) * (w[1] - m)).sum();
     let rho = (lag / var.max(1e-300)).clamp(0.0, 0.9);
     (1.0 + rho) / (1.0 - rho)
-}
-
-/// The inverse of a symmetric 3×3 matrix by cofactors, `None` when singular.
-fn invert3(m: [[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
-    let cof = |r: usize, c: usize| {
-        let (r1, r2) = ((r + 1) % 3, (r + 2) % 3);
-        let (c1, c2) = ((c + 1) % 3, (c + 2) % 3);
-        m[r1][c1] * m[r2][c2] - m[r1][c2] * m[r2][c1]
-    };
-    let det = m[0][0] * cof(0, 0) + m[0][1] * cof(0, 1) + m[0][2] * cof(0, 2);
-    if det.is_nan() || det.abs() <= 1e-300 {
-        return None;
-    }
-    let mut inv = [[0.0; 3]; 3];
-    for (r, row) in inv.iter_mut().enumerate() {
-        for (c, v) in row.iter_mut().enumerate() {
-            *v = cof(c, r) / det;
-        }
-    }
-    Some(inv)
 }
 
 #[cfg(test)]
@@ -259,6 +261,44 @@ mod tests {
         let arc = fit_free_acceleration(&pts).unwrap();
         assert!((arc.rms_m - 3e-6).abs() < 0.1e-6, "{arc:?}");
         assert!((arc.chi2_red - 4.5 * 40.0 / 37.0).abs() < 0.3, "{arc:?}");
+    }
+
+    /// A fall whose rim is read differently along the flight (its radius bulging by 0.5 mm mid-flight, one
+    /// side's edge moving with it, so the centre by 0.8 of that): the plain fit takes the bulge for a
+    /// different fall; beyond the rim, gravity is found within its error. A radius that does not change
+    /// gives the plain fit.
+    #[test]
+    fn a_rim_read_differently_in_flight_is_not_taken_for_the_fall() {
+        let n = 150;
+        let times: Vec<f64> = (0..n).map(|i| i as f64 * 1e-4).collect();
+        let mid = times[n / 2];
+        let bulge = |t: f64| 5e-4 * (1.0 - ((t - mid) / mid).powi(2));
+        let noise = |i: usize| 4e-6 * ((i * 7919 % 13) as f64 / 6.0 - 1.0);
+        let pts: Vec<_> = times
+            .iter()
+            .enumerate()
+            .map(|(i, &t)| {
+                (
+                    t,
+                    0.1 + 0.5 * t + noise(i),
+                    0.2 - 2.0 * t - 4.905 * t * t + 0.8 * bulge(t),
+                    1e-5,
+                )
+            })
+            .collect();
+        let radius: Vec<f64> = times
+            .iter()
+            .enumerate()
+            .map(|(i, &t)| 0.0335 + bulge(t) + noise(i + 3))
+            .collect();
+        let plain = fit_free_acceleration(&pts).unwrap();
+        assert!((plain.a[1] + 9.81).abs() > 10.0 * plain.se[1], "{plain:?}");
+        let beyond = fit_free_acceleration_beyond_rim(&pts, &radius).unwrap();
+        assert!((beyond.a[1] + 9.81).abs() < 3.0 * beyond.se[1], "{beyond:?}");
+        assert!(beyond.a[0].abs() < 3.0 * beyond.se[0], "{beyond:?}");
+        let still = vec![0.0335; n];
+        assert_eq!(fit_free_acceleration_beyond_rim(&pts, &still), Some(plain));
+        assert_eq!(fit_free_acceleration_beyond_rim(&pts, &still[1..]), None);
     }
 
     #[test]

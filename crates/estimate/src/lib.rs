@@ -17,7 +17,7 @@ mod shot;
 mod spin;
 mod with_frames;
 
-pub use ballistic::{BallisticFit, FreeArc, fit_ballistic, fit_free_acceleration};
+pub use ballistic::{BallisticFit, FreeArc, fit_ballistic, fit_free_acceleration, fit_free_acceleration_beyond_rim};
 pub use contact::{HeightPoint, TrajectoryContact, find_impact, trajectory_contact};
 pub use phase::{Phase, PhaseFrames};
 pub use roll::session_tilt_deg;

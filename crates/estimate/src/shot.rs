@@ -1,6 +1,6 @@
 //! One shot: phases, velocities, restitution, friction, contact time and penetration from a track.
 
-use crate::ballistic::{BallisticFit, FreeArc, fit_ballistic, fit_free_acceleration};
+use crate::ballistic::{BallisticFit, FreeArc, fit_ballistic, fit_free_acceleration, fit_free_acceleration_beyond_rim};
 use crate::contact::{HeightPoint, TrajectoryContact, find_impact, trajectory_contact};
 use crate::phase::PhaseFrames;
 use bouncelab_track::{LineCue, Status, SurfaceFrame, SurfaceLine, Track};
@@ -380,7 +380,12 @@ fn estimate_from_measured(track: &Track, c: &Conditions) -> Result<Estimate, Est
         let pts: Vec<_> = set.iter().map(|p| (p.t, p.x, p.y, p.sigma)).collect();
         fit_free_acceleration(&pts)
     });
-    let gravity = gravity_check(&free_arcs, a, c.gravity);
+    let falls = [&incoming, &outgoing].map(|set| {
+        let pts: Vec<_> = set.iter().map(|p| (p.t, p.x, p.y, p.sigma)).collect();
+        let radii: Vec<f64> = set.iter().map(|p| p.r_px * s).collect();
+        fit_free_acceleration_beyond_rim(&pts, &radii)
+    });
+    let gravity = gravity_check(&falls, a, c.gravity);
     let mut notes = choice.notes;
     let mut level = LevelErrors::of(&line, &scale, radius, choice.trajectory_share);
     if line.cue == LineCue::Trajectory
@@ -834,7 +839,7 @@ fn note_scatter(fin: &BallisticFit, fout: &BallisticFit, notes: &mut Vec<String>
 
 /// Largest scatter of a flight's centres about one free-fall arc, in ball radii, for them to follow one ball.
 /// A tracker on the ball's rim places its centre to a small fraction of the radius even in heavy noise (at
-/// most 0.028 r over the harder copies in `docs/accuracy.md`); a tenth of the radius is beyond any rim.
+/// most 0.030 r over the harder copies in `docs/accuracy.md`); a tenth of the radius is beyond any rim.
 pub const FLIGHT_SCATTER_MAX_RADII: f64 = 0.1;
 
 /// Least reduced χ² of that scatter against the tracker's σ for the flag: a tracker that reports its
@@ -903,10 +908,11 @@ fn impossible(v_in_n: f64, v_out_n: f64, cor: f64, mu: f64, t_touch: f64, t_sep:
     flags
 }
 
-/// The flights fitted with their acceleration free, weighted together, against gravity's `expected`
-/// (m/s², local frame); `None` when neither flight has enough frames for a free fit.
-fn gravity_check(free_arcs: &[Option<FreeArc>; 2], expected: [f64; 2], g: f64) -> Option<GravityCheck> {
-    let fits: Vec<[Measured; 2]> = free_arcs
+/// The flights fitted with their acceleration free (beyond what their rim's change explains, see
+/// [`fit_free_acceleration_beyond_rim`]), weighted together, against gravity's `expected` (m/s², local
+/// frame); `None` when neither flight has enough frames for a free fit.
+fn gravity_check(falls: &[Option<FreeArc>; 2], expected: [f64; 2], g: f64) -> Option<GravityCheck> {
+    let fits: Vec<[Measured; 2]> = falls
         .iter()
         .flatten()
         .map(|f| [0, 1].map(|k| Measured::new(f.a[k], f.se[k])))
