@@ -1,4 +1,4 @@
-//! Weighted least-squares fit of a ballistic arc with known acceleration.
+//! Weighted least-squares fits of a flight arc: with the acceleration known (gravity), or free to check it.
 
 use nalgebra::{DMatrix, DVector};
 

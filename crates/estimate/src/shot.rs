@@ -376,16 +376,19 @@ fn estimate_from_measured(track: &Track, c: &Conditions) -> Result<Estimate, Est
     };
     let fin = fit(&incoming, "incoming")?;
     let fout = fit(&outgoing, "outgoing")?;
-    let free_arcs = [&incoming, &outgoing].map(|set| {
-        let pts: Vec<_> = set.iter().map(|p| (p.t, p.x, p.y, p.sigma)).collect();
-        fit_free_acceleration(&pts)
-    });
-    let falls = [&incoming, &outgoing].map(|set| {
+    // Each flight with its acceleration free: as it is, for the centres' scatter about one arc, and beyond
+    // what the rim's change explains, for the fall.
+    let free = |set: &[&Point]| {
         let pts: Vec<_> = set.iter().map(|p| (p.t, p.x, p.y, p.sigma)).collect();
         let radii: Vec<f64> = set.iter().map(|p| p.r_px * s).collect();
-        fit_free_acceleration_beyond_rim(&pts, &radii)
-    });
-    let gravity = gravity_check(&falls, a, c.gravity);
+        (
+            fit_free_acceleration(&pts),
+            fit_free_acceleration_beyond_rim(&pts, &radii),
+        )
+    };
+    let ((arc_in, fall_in), (arc_out, fall_out)) = (free(&incoming), free(&outgoing));
+    let free_arcs = [arc_in, arc_out];
+    let gravity = gravity_check(&[fall_in, fall_out], a, c.gravity);
     let mut notes = choice.notes;
     let mut level = LevelErrors::of(&line, &scale, radius, choice.trajectory_share);
     if line.cue == LineCue::Trajectory
@@ -610,7 +613,11 @@ fn contact_run(
             None if turns_back => {
                 let mut radii: Vec<f64> = points.iter().map(|p| p.r_px).filter(|r| r.is_finite()).collect();
                 radii.sort_by(f64::total_cmp);
-                let at = |q: f64| radii.get(((radii.len() - 1) as f64 * q).round() as usize).copied();
+                let at = |q: f64| {
+                    radii
+                        .get((radii.len().saturating_sub(1) as f64 * q).round() as usize)
+                        .copied()
+                };
                 EstimateError::TurnsAboveLine {
                     clearance_px,
                     line: line_phrase(line),
