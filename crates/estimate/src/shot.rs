@@ -366,7 +366,7 @@ fn estimate_from_measured(track: &Track, c: &Conditions) -> Result<Estimate, Est
     )?;
     let line = choice.line;
     let (frame, points) = local_points(track, &measured, &line, &scale);
-    let (first, last) = contact_run(&points, choice.no_impact, &line)?;
+    let (first, last) = contact_run(&points, choice.no_impact, &line, s)?;
     let (incoming, outgoing) = flights(&points, first, last)?;
     let beta = c.incline_deg.to_radians();
     let a = [c.gravity * beta.sin(), -c.gravity * beta.cos()];
@@ -587,11 +587,12 @@ fn local_points(
 /// The contact: the run of points (first, last) around the lowest one within [`CLEARANCE_MARGIN_PX`] of the
 /// surface `line`; an error when even the lowest is above it: the trajectory's own `no_impact` (a fall with
 /// its speed) says more than the clearance, and a track that comes down and goes up again above the line
-/// has an impact that its rim or the line misplaces.
+/// has an impact that its rim or the line misplaces. `m_per_px` is the scale.
 fn contact_run(
     points: &[Point],
     no_impact: Option<EstimateError>,
     line: &SurfaceLine,
+    m_per_px: f64,
 ) -> Result<(usize, usize), EstimateError> {
     let low = (0..points.len())
         .min_by(|&a, &b| points[a].clearance_px.total_cmp(&points[b].clearance_px))
@@ -603,7 +604,7 @@ fn contact_run(
             .map(|p| HeightPoint {
                 t: p.t,
                 h: p.clearance_px,
-                sigma: p.sigma,
+                sigma: p.sigma / m_per_px,
             })
             .collect();
         // Only whether the track turns back is asked, so the fall speed's terms are not needed.
