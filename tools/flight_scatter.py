@@ -3,7 +3,8 @@
 
     python3 tools/flight_scatter.py OUT [OUT ...] [--top N]
 
-For every shot in OUT/estimates.csv with a touch and a separation time, the `ok` frames of its trajectory
+For every shot in OUT/estimates.csv with a touch and a separation time (and a flight of six frames or
+more), the `ok` frames of its trajectory
 more than 0.3 ms before the touch and after the separation are fitted by a quadratic in time per
 coordinate; the root-mean-square distance of the centres from that arc is printed per flight, with the
 worse flight over the ball's median radius. The shots of each folder come worst first (the first N with
@@ -43,6 +44,8 @@ def shots(out):
             [r for r in ok if float(r["t_s"]) > sep + 3e-4],
         )
         rms = [flight_rms_px(fl) for fl in flights]
+        if all(np.isnan(rms)):
+            continue  # neither flight has the six frames a quadratic needs
         radius = float(np.median([float(r["r_px"]) for r in ok]))
         yield float(np.nanmax(rms)) / radius, e["clip"], rms, radius, bool(e["flags"])
 
