@@ -89,8 +89,9 @@ pub(crate) fn session_key(session: &Session) -> String {
 /// hold none, and a border padded by repeating the frame's edge taken off; 19: dark letterbox bars that keep
 /// one level through the clip taken off too; 20: a shot whose flights scatter beyond a tenth of the ball's
 /// radius flagged, and a track that turns back above the contact line told from one with no impact; 21: the
-/// gravity check's fall measured beyond what the rim's change explains).
-const MEASUREMENT_REVISION: u32 = 21;
+/// gravity check's fall measured beyond what the rim's change explains; 22: a texture line's tilt measured
+/// again on every column's edge in a 3 × 3 box's map of both gradients).
+const MEASUREMENT_REVISION: u32 = 22;
 
 /// Everything besides the frame files that changes a shot's track or estimate.
 fn settings_text(entry: &ClipEntry, gravity: f64) -> String {

@@ -106,6 +106,14 @@ fn ragged_edge(scene: &Scene) -> Vec<f64> {
     ragged.iter().map(|v| scene.roughness * v / peak).collect()
 }
 
+/// The band's top edge as drawn in column `x`, px (its pixels are half covered there); NaN without a band.
+pub fn band_edge_at(scene: &Scene, x: usize) -> f64 {
+    let xc = (scene.size.0 as f64 - 1.0) / 2.0;
+    scene.surface.map_or(f64::NAN, |(y0, slope)| {
+        y0 + slope * (x as f64 - xc) + ragged_edge(scene)[x]
+    })
+}
+
 /// The mean over the image's columns of the band's top edge as drawn, at the centre column, px: the level
 /// of the band's line (its `surface.0` plus the ragged edge's mean offset).
 pub fn band_edge_mean(scene: &Scene) -> f64 {
