@@ -408,7 +408,7 @@ fn estimate_from_measured(track: &Track, c: &Conditions) -> Result<Estimate, Est
     let with_level = |c: &Crossing| Measured::new(c.t.value, c.t.se.hypot(c.dt_dlevel * level.sigma));
     let (t_touch, t_sep) = (with_level(&touch), with_level(&sep));
     // The rim's bias drifting along a flight moves its velocities by as much (see `RadiusLine`).
-    let radius_lines = (RadiusLine::of(&incoming), RadiusLine::of(&outgoing));
+    let radius_lines = (RadiusLine::of(&incoming, s), RadiusLine::of(&outgoing, s));
     let drift = |l: &Option<RadiusLine>| l.as_ref().map_or(0.0, |l| l.centre_drift() * s);
     let vin = velocity_parts(&fin, &touch, &level, drift(&radius_lines.0));
     let vout = velocity_parts(&fout, &sep, &level, drift(&radius_lines.1));
@@ -428,6 +428,7 @@ fn estimate_from_measured(track: &Track, c: &Conditions) -> Result<Estimate, Est
     );
     flags.extend(saturation_flag(track));
     flags.extend(off_one_ball(&free_arcs, s, scale.radius_px));
+    flags.extend(rim_wanders(&radius_lines, scale.radius_px));
     if let Some(g) = &gravity {
         note_gravity(g, c.incline_deg, c.gravity, &mut flags, &mut notes);
     }
@@ -480,6 +481,10 @@ fn rim_change(lines: &(Option<RadiusLine>, Option<RadiusLine>)) -> Option<Measur
 /// The measured radius through one flight as a line in time, px.
 struct RadiusLine {
     mean: f64,
+    /// The radii's RMS about the line, px (n − 2 degrees of freedom).
+    rms_px: f64,
+    /// The median of the flight's centres' σ, px: the tracker's noise, which the radius shares.
+    sigma_px: f64,
     /// The mean's variance, px², with the variance factor of the residuals' correlation
     /// (`ballistic::ar1_factor`; a drift along the flight is not counted as correlated noise).
     var_mean: f64,
@@ -488,8 +493,9 @@ struct RadiusLine {
 }
 
 impl RadiusLine {
-    /// The least-squares line of the finite radii of `set`; `None` with fewer than four.
-    fn of(set: &[&Point]) -> Option<Self> {
+    /// The least-squares line of the finite radii of `set`; `None` with fewer than four. `m_per_px` turns
+    /// the centres' σ into px.
+    fn of(set: &[&Point], m_per_px: f64) -> Option<Self> {
         let tr: Vec<(f64, f64)> = set
             .iter()
             .map(|p| (p.t, p.r_px))
@@ -512,8 +518,16 @@ impl RadiusLine {
         let residuals: Vec<f64> = tr.iter().map(|p| p.1 - mr - slope * (p.0 - mt)).collect();
         let var = residuals.iter().map(|x| x * x).sum::<f64>() / (n - 2.0);
         let factor = crate::ballistic::ar1_factor(&residuals);
+        let mut sigmas: Vec<f64> = set
+            .iter()
+            .map(|p| p.sigma / m_per_px)
+            .filter(|v| v.is_finite())
+            .collect();
+        sigmas.sort_by(f64::total_cmp);
         Some(RadiusLine {
             mean: mr,
+            rms_px: var.sqrt(),
+            sigma_px: sigmas.get(sigmas.len() / 2).copied().unwrap_or(f64::NAN),
             var_mean: var / n * factor,
             slope: Measured::new(slope, (var / stt.max(f64::MIN_POSITIVE) * factor).sqrt()),
         })
@@ -871,6 +885,36 @@ fn off_one_ball(free_arcs: &[Option<FreeArc>; 2], m_per_px: f64, radius_px: f64)
     Some(format!(
         "the {name} flight's centres scatter {rms_px:.1} px RMS about one free-fall arc ({:.2} of the ball's {radius_px:.1} px radius; {FLIGHT_SCATTER_MAX_RADII} at most for one ball): the track jumps between the ball and something else, and cannot tell the ball's bounce",
         rms_px / radius_px
+    ))
+}
+
+/// Largest scatter of a flight's measured radius about a steady change, in ball radii, for the rim followed
+/// to be the ball's silhouette. A rigid ball's outline changes in flight only as smoothly as its distance
+/// or its light does; a rim read on the shading inside a dark limb, or on a seam, moves from frame to frame
+/// as the noise and the felt do. Over `looks`, its 8 DN copy and the independent renderer's sessions and
+/// their copies to 14 DN (`docs/accuracy.md`), tracks on the ball scatter at most 0.0053 r about such a
+/// line; tracks on an edge inside the ball, 0.0133 and 0.0165 r.
+pub const RIM_WANDER_MAX_RADII: f64 = 0.01;
+
+/// Least ratio of that scatter to the tracker's median σ for the flag: a tracker that reports its fixes as
+/// that uncertain has said so, and the errors carry it.
+const RIM_WANDER_MIN_SIGMAS: f64 = 3.0;
+
+/// Why the rim followed is not the ball's silhouette, when a flight's measured radius scatters more than
+/// [`RIM_WANDER_MAX_RADII`] of the ball's radius (`radius_px`) about a line in time and more than
+/// [`RIM_WANDER_MIN_SIGMAS`] of the tracker's σ: the centres of such a rim are offset from the ball's by an
+/// amount that changes with it, and the velocities with them.
+fn rim_wanders(lines: &(Option<RadiusLine>, Option<RadiusLine>), radius_px: f64) -> Option<String> {
+    let (name, line) = [("incoming", &lines.0), ("outgoing", &lines.1)]
+        .into_iter()
+        .filter_map(|(name, l)| l.as_ref().map(|l| (name, l)))
+        .filter(|(_, l)| l.rms_px > RIM_WANDER_MAX_RADII * radius_px && l.rms_px > RIM_WANDER_MIN_SIGMAS * l.sigma_px)
+        .max_by(|a, b| a.1.rms_px.total_cmp(&b.1.rms_px))?;
+    Some(format!(
+        "the {name} flight's measured radius wanders {:.2} px RMS about a steady change ({:.3} of the ball's {radius_px:.1} px radius, {:.1}× the tracker's σ; {RIM_WANDER_MAX_RADII} at most for a ball's silhouette): the track follows an edge inside or around the ball that changes from frame to frame, so its centres are off the ball's by a changing amount",
+        line.rms_px,
+        line.rms_px / radius_px,
+        line.rms_px / line.sigma_px
     ))
 }
 
