@@ -239,8 +239,8 @@ fn autocorrelation_time(res: &[f64], wts: &[f64], max_lag: usize) -> f64 {
     tau
 }
 
-/// The log of the local energy of both gradients over rows `rows.0 .. rows.1` of the image: ln(mean over
-/// a 3 × 3 box of |∂I/∂x| + |∂I/∂y| + the floor), central differences on the 0–255 scale. The band's
+/// The log of the local energy of both gradients over rows `top .. bottom` of an image: ln(mean over a
+/// 3 × 3 box of |∂I/∂x| + |∂I/∂y| + the floor), central differences on the 0–255 scale. The band's
 /// brightness step adds to it where the texture does, at the same edge.
 struct FineMap {
     log_energy: Vec<f32>,
@@ -256,6 +256,14 @@ impl FineMap {
     fn new<P: Pixel>(img: &Plane<P>, top: usize, bottom: usize) -> FineMap {
         let (w, h) = (img.width, img.height);
         let (top, bottom) = (top.min(h), bottom.min(h).max(top.min(h)));
+        if top == bottom {
+            return FineMap {
+                log_energy: Vec::new(),
+                width: w,
+                top,
+                bottom,
+            };
+        }
         let (lo, hi) = (top.saturating_sub(2), (bottom + 2).min(h));
         let gray: Gray32 = ImageBuffer::from_fn(w as u32, (hi - lo) as u32, |x, y| {
             Luma([img.at(x as usize, lo + y as usize)])
@@ -565,6 +573,20 @@ mod tests {
                 f < 0.7 * c,
                 "seed {seed}: fine edges {f:.2} px RMS off the drawn one, coarse {c:.2}"
             );
+        }
+    }
+
+    /// A line whose reach leaves the image (a band at the frame's bottom edge, or a line beyond it) is left
+    /// as it was: no column's window fits, and nothing is read outside the image.
+    #[test]
+    fn a_line_at_or_beyond_the_image_s_edge_keeps_its_tilt() {
+        let s = ragged_band(2, 0.5);
+        let px = render(&s);
+        let img = Plane::new(&px, s.size.0, s.size.1);
+        let line = texture_line(&img).expect("a texture line");
+        for y0 in [250.0, 255.9, 400.0, -300.0] {
+            let moved = SurfaceLine { y0, ..line };
+            assert_eq!(refit_on_fine_edges(&img, moved, &|_| true), moved, "y0 {y0}");
         }
     }
 
