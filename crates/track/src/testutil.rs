@@ -106,12 +106,17 @@ fn ragged_edge(scene: &Scene) -> Vec<f64> {
     ragged.iter().map(|v| scene.roughness * v / peak).collect()
 }
 
-/// The band's top edge as drawn in column `x`, px (its pixels are half covered there); NaN without a band.
-pub fn band_edge_at(scene: &Scene, x: usize) -> f64 {
+/// The band's top edge as drawn in each column, px (its pixels are half covered there); NaN without a band.
+pub fn band_edge(scene: &Scene) -> Vec<f64> {
     let xc = (scene.size.0 as f64 - 1.0) / 2.0;
-    scene.surface.map_or(f64::NAN, |(y0, slope)| {
-        y0 + slope * (x as f64 - xc) + ragged_edge(scene)[x]
-    })
+    let ragged = ragged_edge(scene);
+    (0..scene.size.0)
+        .map(|x| {
+            scene
+                .surface
+                .map_or(f64::NAN, |(y0, slope)| y0 + slope * (x as f64 - xc) + ragged[x])
+        })
+        .collect()
 }
 
 /// The mean over the image's columns of the band's top edge as drawn, at the centre column, px: the level

@@ -101,12 +101,9 @@ fn lines_of_strength<P: Pixel>(img: &Plane<P>, min_strength: f64, unseen: Option
         .collect();
     let cands = column_edges(&energy, w, h, &cols);
     let leans = vec![0.0; cands.len()];
-    let found: Vec<SurfaceLine> = lines_through(&cands, &leans, cols.len(), w, TOLERANCE_PX, min_strength, 0.0)
+    let mut lines: Vec<SurfaceLine> = lines_through(&cands, &leans, cols.len(), w, TOLERANCE_PX, min_strength, 0.0)
         .into_iter()
         .map(|line| robust_refit(&cands, line, MAX_LAG))
-        .collect();
-    let mut lines: Vec<SurfaceLine> = found
-        .into_iter()
         .map(|line| refit_on_fine_edges(img, line, &seen))
         .map(|line| {
             crate::surface::ragged(SurfaceLine {
@@ -438,7 +435,7 @@ fn half_way_edge(profile: &[f32], y: usize) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::testutil::{Scene, band_edge_at, render};
+    use crate::testutil::{Scene, band_edge, render};
 
     /// A band whose mean gray equals the backdrop's is found by its grains alone, to within its roughness.
     #[test]
@@ -538,7 +535,11 @@ mod tests {
     fn drawn_edge_line(s: &Scene) -> (f64, f64) {
         let w = s.size.0;
         let xc = (w as f64 - 1.0) / 2.0;
-        let pts: Vec<(f64, f64)> = (0..w).map(|x| (x as f64 - xc, band_edge_at(s, x))).collect();
+        let pts: Vec<(f64, f64)> = band_edge(s)
+            .into_iter()
+            .enumerate()
+            .map(|(x, y)| (x as f64 - xc, y))
+            .collect();
         let n = pts.len() as f64;
         let (mx, my) = pts.iter().fold((0.0, 0.0), |a, p| (a.0 + p.0 / n, a.1 + p.1 / n));
         let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
@@ -561,8 +562,9 @@ mod tests {
                     .into_iter()
                     .map(|p| (p.0 + line.x0, p.1))
                     .collect();
+            let edge = band_edge(&s);
             let rms = |e: &mut dyn Iterator<Item = (f64, f64)>| {
-                let d: Vec<f64> = e.map(|(x, y)| y - band_edge_at(&s, x as usize)).collect();
+                let d: Vec<f64> = e.map(|(x, y)| y - edge[x as usize]).collect();
                 let m = d.iter().sum::<f64>() / d.len() as f64;
                 (d.iter().map(|v| (v - m).powi(2)).sum::<f64>() / d.len() as f64).sqrt()
             };
@@ -602,13 +604,14 @@ mod tests {
         let img = Plane::new(&px, s.size.0, s.size.1);
         let line = texture_line(&img).expect("a texture line");
         let edges = fine_edges(&FineMap::around(&img, &line), &line, &|_| true);
+        let edge = band_edge(&s);
         let under: Vec<&(f64, f64, f64)> = edges
             .iter()
             .filter(|e| s.distractors.iter().any(|d| (e.0 - d.0).abs() < 4.0))
             .collect();
         assert!(under.len() >= 12, "{} columns under the marks", under.len());
         for e in under {
-            let d = e.1 - band_edge_at(&s, e.0 as usize);
+            let d = e.1 - edge[e.0 as usize];
             assert!(
                 d > -3.0,
                 "column {}: edge {:.2} px above the band's, at the marks",
