@@ -88,12 +88,17 @@ for clip, t in T.items():
     if not os.path.exists(fn):
         continue
     tr = {int(r["frame"]): r for r in csv.DictReader(open(os.path.join(truth_dir, clip + "_frames.csv")))}
+    # Matched by time, so that a copy keeping every Nth frame (`perturb.py --every N`) meets its truth.
+    truth_dt = f(tr[1]["t_s"]) - f(tr[0]["t_s"]) if 0 in tr and 1 in tr else float("nan")
     fl, co, st = [], [], {}
     for r in csv.DictReader(open(fn)):
         st[r["status"]] = st.get(r["status"], 0) + 1
         if r["status"] not in ("ok", "occluded") or r["x_px"] == "":
             continue
-        g = tr[int(r["frame"])]
+        k = int(round(f(r["t_s"]) / truth_dt)) if truth_dt > 0 and r.get("t_s") else int(r["frame"])
+        if k not in tr:
+            continue
+        g = tr[k]
         d = (f(r["x_px"]) - f(g["x_px"]), f(r["y_px"]) - f(g["y_px"]))
         (co if int(g["in_contact"]) else fl).append(d)
     fl, co = np.array(fl), np.array(co)
