@@ -458,8 +458,7 @@ impl Tracker {
     /// every one of `fixes` is clear of the surface line the ball is in flight, where only gravity (and drag)
     /// act, and [`MAX_DOWNWARD_ACCELERATION_M_S2`] bounds it in every direction.
     fn max_accel_px_s2(&self, fixes: &[(f64, f64, f64)]) -> Option<f64> {
-        let flying = !fixes.is_empty() && fixes.iter().all(|&(_, x, y)| self.clear_of_surface(x, y));
-        let limit = if flying {
+        let limit = if self.all_clear(fixes) {
             MAX_DOWNWARD_ACCELERATION_M_S2
         } else {
             MAX_BALL_ACCELERATION_M_S2
@@ -467,10 +466,16 @@ impl Tracker {
         Some(limit * self.px_per_m()?)
     }
 
-    /// Whether every fix the prediction is fitted to has the ball's whole disc clear of the surface line
-    /// (by 2 px beyond the band's ragged reach); false while no line is known.
+    /// Whether every recent fix has the ball's whole disc clear of the surface line (by 2 px beyond the
+    /// band's ragged reach); false while no line is known.
     fn in_flight(&self) -> bool {
-        !self.history.is_empty() && self.history.iter().all(|&(_, x, y)| self.clear_of_surface(x, y))
+        self.all_clear(&self.history)
+    }
+
+    /// Whether `fixes` are some and each has the ball's whole disc clear of the surface line
+    /// ([`Self::clear_of_surface`]).
+    fn all_clear(&self, fixes: &[(f64, f64, f64)]) -> bool {
+        !fixes.is_empty() && fixes.iter().all(|&(_, x, y)| self.clear_of_surface(x, y))
     }
 
     /// Whether a fix at (x, y) px continues free flight: the fixes the prediction is fitted to and this one
