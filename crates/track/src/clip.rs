@@ -113,11 +113,12 @@ pub struct Scale {
     /// The rim shape's RMS, px (see `scale_from`): the Type-B standard uncertainty of the radius, and of
     /// the centre's offset common to every frame, which moves the ball's lowest point as the radius does.
     pub rim_shape_px: f64,
-    /// How far the limb's silhouette lies from the fitted circles' centres, px (see [`crate::LimbOffset`]):
-    /// a further standard uncertainty of the centre's common offset. 0 when not measured.
+    /// How far the limb's silhouette lay from the fitted circles' centres, px (see [`crate::LimbOffset`]),
+    /// before the track's circles were moved onto it: the standard uncertainty of that correction of the
+    /// centre's common offset. 0 when not measured.
     pub limb_centre_px: f64,
-    /// How far it lies outside their radius, px: a further standard uncertainty of the radius. 0 when not
-    /// measured.
+    /// How far it lay outside their radius, px: the standard uncertainty of that correction of the radius.
+    /// 0 when not measured.
     pub limb_radius_px: f64,
     /// Mean free-flight radius, px.
     pub radius_px: f64,
@@ -343,13 +344,17 @@ pub fn track_clip(
     if absent > 0 {
         warnings.push(format!("ball not found in {absent} of {} frames", fixes.len()));
     }
+    let limb = tracker.limb_offset();
+    if let Some(l) = limb {
+        to_silhouette(&mut fixes, &l);
+    }
     let scale = scale_from(
         &fixes,
         tracker.surface(),
         opts.ball_diameter_m,
         tracker.edge_definition_px(),
         tracker.rim_shape_rms_px(),
-        tracker.limb_offset(),
+        limb,
     );
     let (ox, oy) = roi_origin(opts.roi.as_ref());
     // Back to the whole frame's pixels.
@@ -374,6 +379,18 @@ pub fn track_clip(
         camera: clip.camera().clone(),
         saturated_frames: forward.saturated,
     })
+}
+
+/// Moves every measured circle onto the limb's silhouette (see [`LimbOffset`](crate::LimbOffset)): its
+/// centre by the silhouette's first harmonic and its radius by their mean. Frames whose rim is partly hidden
+/// were measured on the same rim as in flight (the learned [`RimShape`](crate::RimShape)), so one shift
+/// serves them all.
+fn to_silhouette(fixes: &mut [BallFix], limb: &crate::LimbOffset) {
+    for f in fixes.iter_mut().filter(|f| f.status.measured()) {
+        f.x_px += limb.centre_px.0;
+        f.y_px += limb.centre_px.1;
+        f.r_px += limb.radius_px;
+    }
 }
 
 /// Marks `ambiguous` the measured fixes the ball cannot have been at ([`crate::path::off_path`]: off the
