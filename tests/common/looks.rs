@@ -19,8 +19,11 @@ pub struct ClipResult {
     pub families: Vec<String>,
     /// Frames with the ball measured `ok`/`occluded` and visible in truth, and frames visible in truth.
     pub frames_found: (usize, usize),
-    /// Measured frames further than 1 px from the truth (another object taken for the ball).
-    pub frames_wrong: usize,
+    /// Measured frames whose centre lies more than 1 px from the truth: a rim misread, or another object.
+    pub frames_over_1px: usize,
+    /// Measured frames whose centre lies more than a quarter of the ball's radius from the truth: another
+    /// object taken for the ball (no misread rim moves a centre that far).
+    pub frames_off_ball: usize,
     /// Centre RMS error in flight and in contact, px (the clip's constant offset included).
     pub centre_rms_px: (f64, f64),
     /// The clip's constant offset: the mean centre error (x, y) in flight, px. On the `looks` preset's lit
@@ -139,7 +142,8 @@ fn evaluate_clip(
         clip: name.clone(),
         families,
         frames_found: (0, 0),
-        frames_wrong: 0,
+        frames_over_1px: 0,
+        frames_off_ball: 0,
         centre_rms_px: (f64::NAN, f64::NAN),
         flight_offset_px: (f64::NAN, f64::NAN),
         flight_rms_about_offset_px: f64::NAN,
@@ -190,7 +194,10 @@ fn evaluate_clip(
         let (ex, ey) = (f.x_px - num(t, "x_px"), f.y_px - num(t, "y_px"));
         let e = ex.hypot(ey);
         if e > 1.0 {
-            result.frames_wrong += 1;
+            result.frames_over_1px += 1;
+        }
+        if e > 0.25 * num(t, "r_px") {
+            result.frames_off_ball += 1;
         }
         if t["phase"] == "flight" {
             flight_xy.push((ex, ey));
@@ -247,16 +254,17 @@ fn evaluate_clip(
 /// One Markdown table row per clip.
 pub fn clip_table(results: &[ClipResult]) -> String {
     let mut s = String::from(
-        "| clip | frames found | wrong | flight RMS px | flight offset px | about it px | contact RMS px | line | level err px | COR err | μ err | tilt err ° | failure |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| clip | frames found | over 1 px off | on another object | flight RMS px | flight offset px | about it px | contact RMS px | line | level err px | COR err | μ err | tilt err ° | failure |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in results {
         let f = |v: Option<f64>, d: usize| v.map_or("–".to_string(), |v| format!("{v:+.d$}"));
         s += &format!(
-            "| {} | {}/{} | {} | {:.3} | ({:+.2}, {:+.2}) | {:.3} | {:.3} | {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {}/{} | {} | {} | {:.3} | ({:+.2}, {:+.2}) | {:.3} | {:.3} | {} | {} | {} | {} | {} | {} |\n",
             r.clip,
             r.frames_found.0,
             r.frames_found.1,
-            r.frames_wrong,
+            r.frames_over_1px,
+            r.frames_off_ball,
             r.centre_rms_px.0,
             r.flight_offset_px.0,
             r.flight_offset_px.1,
@@ -277,7 +285,8 @@ pub fn clip_table(results: &[ClipResult]) -> String {
 }
 
 /// One Markdown table row per look family: clips, shots lost (no estimate), shots flagged (an estimate the
-/// estimator says not to trust), frames found, the frames on another object, centre RMS in flight (and
+/// estimator says not to trust), frames found, the frames over 1 px off and those on another object (see
+/// [`ClipResult::frames_off_ball`]), centre RMS in flight (and
 /// about each clip's constant offset, see [`ClipResult::flight_offset_px`]) and in contact, contact level
 /// RMS error, and COR and μ RMS and worst error over the shots estimated without a
 /// flag.
@@ -290,7 +299,7 @@ pub fn family_table(results: &[ClipResult]) -> String {
         fams.entry("(all)".into()).or_default().push(r);
     }
     let mut s = String::from(
-        "| family | clips | lost | flagged | frames found | on another object | flight RMS px | about offsets px | contact RMS px | level RMS px | COR RMS / worst | μ RMS / worst |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| family | clips | lost | flagged | frames found | over 1 px off | on another object | flight RMS px | about offsets px | contact RMS px | level RMS px | COR RMS / worst | μ RMS / worst |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for (fam, rs) in &fams {
         let flagged = |r: &&&ClipResult| r.failure.as_deref().is_some_and(|f| f.starts_with("flagged"));
@@ -298,14 +307,15 @@ pub fn family_table(results: &[ClipResult]) -> String {
         let trusted = || rs.iter().filter(|r| r.failure.is_none());
         let found: usize = rs.iter().map(|r| r.frames_found.0).sum();
         let vis: usize = rs.iter().map(|r| r.frames_found.1).sum();
-        let wrong: usize = rs.iter().map(|r| r.frames_wrong).sum();
+        let over_1px: usize = rs.iter().map(|r| r.frames_over_1px).sum();
+        let off_ball: usize = rs.iter().map(|r| r.frames_off_ball).sum();
         let all =
             |k: fn(&ClipResult) -> f64| -> Vec<f64> { rs.iter().map(|r| k(r)).filter(|v| v.is_finite()).collect() };
         let cor: Vec<f64> = trusted().filter_map(|r| r.cor.map(|c| c.0 - c.2)).collect();
         let mu: Vec<f64> = trusted().filter_map(|r| r.mu.map(|c| c.0 - c.2)).collect();
         let worst = |v: &[f64]| v.iter().fold(0.0f64, |a, b| a.max(b.abs()));
         s += &format!(
-            "| {fam} | {} | {lost} | {} | {found}/{vis} | {wrong} | {:.3} | {:.3} | {:.3} | {:.2} | {:.4} / {:.4} | {:.4} / {:.4} |\n",
+            "| {fam} | {} | {lost} | {} | {found}/{vis} | {over_1px} | {off_ball} | {:.3} | {:.3} | {:.3} | {:.2} | {:.4} / {:.4} | {:.4} / {:.4} |\n",
             rs.len(),
             rs.iter().filter(flagged).count(),
             rms(&all(|r| r.centre_rms_px.0)),

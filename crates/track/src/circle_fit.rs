@@ -117,14 +117,19 @@ pub fn fit_circle(points: &[[f64; 2]], x: f64, y: f64, r: f64) -> Option<CircleF
 /// harmonic of values round a circle (what a circle fit absorbs as its radius and centre). `None` when the
 /// angles cannot tell them apart.
 pub(crate) fn first_harmonic(points: impl IntoIterator<Item = (f64, f64, f64)>) -> Option<[f64; 3]> {
+    weighted_first_harmonic(points.into_iter().map(|(c, s, v)| (c, s, v, 1.0)))
+}
+
+/// [`first_harmonic`] weighted: over `(cos θ, sin θ, v, weight)`.
+pub(crate) fn weighted_first_harmonic(points: impl IntoIterator<Item = (f64, f64, f64, f64)>) -> Option<[f64; 3]> {
     let mut ata = [[0.0f64; 3]; 3];
     let mut atb = [0.0f64; 3];
-    for (c, s, v) in points {
+    for (c, s, v, w) in points {
         let row = [1.0, c, s];
         for (j, rj) in row.iter().enumerate() {
-            atb[j] += rj * v;
+            atb[j] += w * rj * v;
             for (k, rk) in row.iter().enumerate() {
-                ata[j][k] += rj * rk;
+                ata[j][k] += w * rj * rk;
             }
         }
     }

@@ -4,7 +4,9 @@
 //! ball was lost); from then on each frame costs tens of microseconds: the centre predicted from the
 //! previous frames seeds edge searches along rays, and a robust geometric circle fit (Tukey-weighted
 //! Gauss–Newton) turns the edge points into a centre, a radius and their uncertainty, ignoring the part of
-//! the rim hidden by or pressed into the surface. Frames where the ball is cut by the border, absent or
+//! the rim hidden by or pressed into the surface. Once the clip is tracked, every circle is measured again
+//! against its neighbouring frames' mean profile across the rim, which an ambiguous edge does not make jump.
+//! Frames where the ball is cut by the border, absent or
 //! ambiguous are flagged, never invented. The same crate finds the surface line and its tilt, and turns the
 //! ball's apparent radius in free flight into the clip's scale.
 //!
@@ -25,6 +27,7 @@ mod motion;
 pub mod opencv;
 mod path;
 mod plane;
+mod realign;
 mod refine;
 mod rim_evidence;
 mod surface;

@@ -51,6 +51,21 @@ fn sample_at(k: usize) -> f64 {
     -INNER_PX + k as f64 * STEP_PX
 }
 
+/// Samples of a profile across the rim as the learner takes it.
+pub(crate) fn profile_samples() -> usize {
+    samples()
+}
+
+/// Where such a profile's first sample lies from the circle it is taken along, px (inward negative).
+pub(crate) fn profile_offset_px() -> f64 {
+    sample_at(0)
+}
+
+/// The step between such a profile's samples, px.
+pub(crate) fn profile_step_px() -> f64 {
+    STEP_PX
+}
+
 /// The limb model's silhouette against the fitted circles (see the module's description).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LimbOffset {
