@@ -383,14 +383,13 @@ pub fn track_clip(
     })
 }
 
-/// Measures every measured circle again against its neighbours' mean rim ([`NeighbourRims`]): one more
-/// pass over the clip's frames (decoded ahead on the stream's threads), each frame's profiles across the rim taken along its circle (rays clear of
-/// the surface band and inside the image), the `ok` frames' teaching their neighbours' templates, and each
-/// measured frame's circle moved by its slides onto its own template, where enough rays allow. The circles'
-/// standard errors stay the edge search's: the moved circles share their neighbours' mean circle, whose
-/// error runs smoothly over the window and so acts on a fit of the flight as a slow drift, not as scatter
-/// (stated as the slides' and that mean's, the contact levels the trajectory gives came out at 1.3 of their
-/// standard errors on the `looks` sweep; as the edge search's, at 0.8).
+/// Measures every measured circle again against its neighbours' mean rim ([`NeighbourRims`]) in one more
+/// pass over the clip's frames: each frame's profiles across the rim are taken along its circle (rays clear
+/// of the surface band and inside the image), the `ok` frames teach their neighbours' templates, and each
+/// measured frame's circle moves by its slides onto its own template where enough rays allow. The circles'
+/// standard errors stay the edge search's: a moved circle shares its neighbours' mean circle, whose error
+/// runs smoothly over the window, so a flight's fit takes it for motion, not scatter (stated as the
+/// slides' own, the trajectory's contact levels read 1.3 of their standard errors on the `looks` sweep).
 fn remeasure_on_neighbours(
     clip: &Clip,
     opts: &ClipTracking,
@@ -403,7 +402,8 @@ fn remeasure_on_neighbours(
     let mut moved = Vec::new();
     // Decoded ahead on the stream's threads, as for the forward pass.
     let mut frames = clip.frames_with(&opts.read)?;
-    let mut k = 0;
+    // Frame `next` is measured once every frame up to `HALF_WINDOW` after it was pushed.
+    let (mut k, mut next) = (0, 0);
     while let Some(frame) = frames.next() {
         let frame = frame?;
         if let Some(f) = fixes.get(k).filter(|f| f.status.measured()) {
@@ -424,12 +424,13 @@ fn remeasure_on_neighbours(
             rims.push(k, profiles, f.status == Status::Ok);
         }
         frames.recycle(frame);
-        if let Some(j) = k.checked_sub(HALF_WINDOW) {
-            moved.push((j, rims.realign(j)));
+        while next + HALF_WINDOW <= k && next < fixes.len() {
+            moved.push((next, rims.realign(next)));
+            next += 1;
         }
         k += 1;
     }
-    for j in fixes.len().saturating_sub(HALF_WINDOW)..fixes.len() {
+    for j in next..fixes.len() {
         moved.push((j, rims.realign(j)));
     }
     for (j, m) in moved {
