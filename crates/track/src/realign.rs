@@ -52,16 +52,11 @@ fn extended() -> usize {
     profile_samples() + 2 * reach()
 }
 
-/// Whether the point (x, y) px lies clear of the surface band: 2 px above its line beyond the band's ragged
-/// reach. A profile reaching into the band sees the band's texture rather than the backdrop, and the ball
-/// pressed into it.
-pub fn clear_of_band(surface: Option<&SurfaceLine>, x: f64, y: f64) -> bool {
-    surface.is_none_or(|l| l.height_of(x, y) >= 2.0 + l.ragged_reach_px())
-}
-
 /// The profiles of `img` across the circle (x, y, r) px along `rays` rays (ray i at angle 2πi/rays, y down),
 /// each [`extended`] samples [`profile_step_px`] apart, from `reach` samples inside the limb learner's
-/// first; a ray leaving the image or reaching the surface band is all NaN. Cost: rays × 73 bilinear reads.
+/// first; a ray leaving the image or reaching the surface band (a point that does not clear it as a disc of
+/// no radius would, [`SurfaceLine::clears_disc`]: the band's texture, and the ball pressed into it) is all
+/// NaN. Cost: rays × 73 bilinear reads.
 pub fn profiles_along<P: Pixel>(
     img: &Plane<P>,
     (x, y, r): (f64, f64, f64),
@@ -77,7 +72,8 @@ pub fn profiles_along<P: Pixel>(
         let seen = ray.iter_mut().enumerate().all(|(k, v)| {
             let d = d0 + k as f64 * step;
             let (px, py) = (x + c * d, y + s * d);
-            clear_of_band(surface, px, py) && img.sample(px as f32, py as f32).map(|g| *v = g).is_some()
+            surface.is_none_or(|l| l.clears_disc(px, py, 0.0))
+                && img.sample(px as f32, py as f32).map(|g| *v = g).is_some()
         });
         if !seen {
             ray.fill(f32::NAN);
@@ -95,8 +91,6 @@ pub struct Realigned {
     pub dy: f64,
     /// Radius change, px.
     pub dr: f64,
-    /// Rays weighed in.
-    pub rays: usize,
 }
 
 struct Entry {
@@ -286,7 +280,6 @@ fn fit_slides(slides: &[(f64, f64, f64, f64)]) -> Option<Realigned> {
         dx: coef[1],
         dy: coef[2],
         dr: coef[0],
-        rays: kept,
     })
 }
 
