@@ -92,8 +92,9 @@ pub(crate) fn session_key(session: &Session) -> String {
 /// gravity check's fall measured beyond what the rim's change explains; 22: a texture line's tilt measured
 /// again on every column's edge in a 3 × 3 box's map of both gradients; 23: a flight whose measured radius
 /// wanders beyond a hundredth of the ball's about a steady change flagged; 24: every circle measured again
-/// against its neighbouring frames' mean rim, and moved onto the limb's silhouette).
-const MEASUREMENT_REVISION: u32 = 24;
+/// against its neighbouring frames' mean rim, and moved onto the limb's silhouette; 25: a lost ball looked
+/// for again frame by frame after a seed, not by its sightings' gap).
+const MEASUREMENT_REVISION: u32 = 25;
 
 /// Everything besides the frame files that changes a shot's track or estimate.
 fn settings_text(entry: &ClipEntry, gravity: f64) -> String {

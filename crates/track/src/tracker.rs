@@ -218,6 +218,10 @@ pub struct Tracker {
     last_innovation: f64,
     /// Consecutive frames where only circles far from the prediction were found.
     missed: usize,
+    /// Time of the frame observed last, s (negated when tracking backward).
+    last_observed_t_s: Option<f64>,
+    /// Time between the last two frames observed, s.
+    observed_period_s: Option<f64>,
     /// A circle without a rim ([`Tracker::rim_stands_out`]) has been refused and said so.
     told_no_rim: bool,
     /// The first frame where the circle found at the prediction had no rim (see [`Tracker::rim_lost_at`]).
@@ -312,6 +316,8 @@ impl Tracker {
             warnings: Vec::new(),
             last_innovation: 0.0,
             missed: 0,
+            last_observed_t_s: None,
+            observed_period_s: None,
             told_no_rim: false,
             rim_lost_at: None,
         }
@@ -594,6 +600,10 @@ impl Tracker {
 
     /// Measures the ball in one frame. Frames must come in time order.
     pub fn observe<P: Pixel>(&mut self, frame: usize, t_s: f64, img: &Plane<P>) -> BallFix {
+        if let Some(dt) = self.last_observed_t_s.map(|t| (t_s - t).abs()).filter(|&dt| dt > 0.0) {
+            self.observed_period_s = Some(dt);
+        }
+        self.last_observed_t_s = Some(t_s);
         self.look_for_surface(t_s, img);
         if let Some(fix) = self.around_prediction(frame, t_s, img) {
             return fix;
@@ -882,8 +892,13 @@ impl Tracker {
         .map_or(0.0, |m| m.speed())
     }
 
-    /// The time between the last two fixes, s (the frame period while none are missed).
+    /// The time between the last two frames observed, s; before two, between the last two fixes (a seed's
+    /// two sightings lie ten frames apart: taken for the frame period, it let the search for a lost ball
+    /// widen ten times too fast, onto a still ring 157 px off the path within 11 frames).
     fn frame_period(&self) -> f64 {
+        if let Some(dt) = self.observed_period_s {
+            return dt;
+        }
         let h = &self.history;
         if h.len() < 2 {
             return 0.0;
@@ -1615,6 +1630,34 @@ mod tests {
             "{:?}",
             tracker.warnings()
         );
+    }
+
+    /// A track seeded with two sightings ten frames apart (as acquisition gives them) that loses the ball
+    /// widens its search by the ground the ball covers in a frame, not in the sightings' gap: a still disc
+    /// of the ball's size 100 px off the path is not taken for the ball in the 20 frames after.
+    #[test]
+    fn a_lost_ball_is_looked_for_frame_by_frame_after_a_seed() {
+        let at = |k: usize| (60.3 + 0.3 * k as f64, 60.7 + 0.8 * k as f64);
+        let ring = (at(50).0 + 100.0, at(50).1, 40.0, 200.0);
+        let mut tracker = Tracker::new(TrackOptions {
+            radius_px: Some((36.0, 44.0)),
+            ..TrackOptions::default()
+        });
+        let sighting = |k: usize| (k as f64 * 1e-4, at(k).0, at(k).1);
+        tracker.seed(sighting(30), sighting(40));
+        let statuses: Vec<(usize, Status, f64)> = (41..61)
+            .map(|k| {
+                let px = render(&Scene {
+                    ball: (-500.0, -500.0, 40.0),
+                    distractors: vec![ring],
+                    seed: k as u64,
+                    ..Scene::default()
+                });
+                let fix = tracker.observe(k, k as f64 * 1e-4, &Plane::new(&px, 256, 256));
+                (k, fix.status, fix.x_px)
+            })
+            .collect();
+        assert!(statuses.iter().all(|s| s.1 != Status::Ok), "{statuses:?}");
     }
 
     /// Before the track has measured the ball in free flight, a circle outside the radius range it was
