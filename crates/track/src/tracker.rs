@@ -892,9 +892,9 @@ impl Tracker {
         .map_or(0.0, |m| m.speed())
     }
 
-    /// The time between the last two frames observed, s; before two, between the last two fixes (a seed's
-    /// two sightings lie ten frames apart: taken for the frame period, it let the search for a lost ball
-    /// widen ten times too fast, onto a still ring 157 px off the path within 11 frames).
+    /// The time between the last two frames observed, s; before two, between the last two fixes. Not the
+    /// fixes' spacing after that: a seed's two sightings lie ten frames apart, and a lost ball's search
+    /// widens per frame missed.
     fn frame_period(&self) -> f64 {
         if let Some(dt) = self.observed_period_s {
             return dt;
