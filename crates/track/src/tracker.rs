@@ -892,18 +892,11 @@ impl Tracker {
         .map_or(0.0, |m| m.speed())
     }
 
-    /// The time between the last two frames observed, s; before two, between the last two fixes. Not the
-    /// fixes' spacing after that: a seed's two sightings lie ten frames apart, and a lost ball's search
-    /// widens per frame missed.
+    /// The time between the last two frames observed, s (0 before two: no frame has been missed yet). Not
+    /// the fixes' spacing: a seed's two sightings lie ten frames apart, and a lost ball's search widens per
+    /// frame missed.
     fn frame_period(&self) -> f64 {
-        if let Some(dt) = self.observed_period_s {
-            return dt;
-        }
-        let h = &self.history;
-        if h.len() < 2 {
-            return 0.0;
-        }
-        (h[h.len() - 1].0 - h[h.len() - 2].0).abs()
+        self.observed_period_s.unwrap_or(0.0)
     }
 
     /// Keeps `innovation` (px, the distance of a fix from its prediction) among the recent ones; when it is
