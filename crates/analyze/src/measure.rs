@@ -93,8 +93,9 @@ pub(crate) fn session_key(session: &Session) -> String {
 /// again on every column's edge in a 3 × 3 box's map of both gradients; 23: a flight whose measured radius
 /// wanders beyond a hundredth of the ball's about a steady change flagged; 24: every circle measured again
 /// against its neighbouring frames' mean rim, and moved onto the limb's silhouette; 25: a lost ball looked
-/// for again frame by frame after a seed, not by its sightings' gap).
-const MEASUREMENT_REVISION: u32 = 25;
+/// for again frame by frame after a seed, not by its sightings' gap; 26: in noisy frames, a lost ball looked
+/// for by its rim's strength around the prediction).
+const MEASUREMENT_REVISION: u32 = 26;
 
 /// Everything besides the frame files that changes a shot's track or estimate.
 fn settings_text(entry: &ClipEntry, gravity: f64) -> String {

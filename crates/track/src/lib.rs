@@ -45,7 +45,7 @@ pub use plane::{Pixel, Plane};
 pub use refine::{
     EdgeSearch, Refined, RimShape, RimShapeLearner, refine_candidates, refine_circle, refined_candidates, rim_residuals,
 };
-pub use rim_evidence::{MIN_SECTORS_STANDING_OUT, RimEvidence, SECTORS, rim_evidence};
+pub use rim_evidence::{MIN_SECTORS_STANDING_OUT, RimEvidence, SECTORS, rim_evidence, rim_strength, strongest_rim};
 pub use surface::{
     LineCue, SurfaceLine, SurfaceLines, find_faint_surface_lines, find_surface_line, find_surface_lines,
 };
