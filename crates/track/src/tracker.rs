@@ -178,6 +178,8 @@ pub struct Tracker {
     history: Vec<(f64, f64, f64)>,
     /// Qualities of the recent fixes measured `ok` with their whole rim in view, at most [`QUALITY_FIXES`].
     qualities: Vec<f64>,
+    /// The history holds only the sightings the tracker was seeded with: no fix measured since.
+    seed_only: bool,
     /// Distances between the recent predictions and their fixes, px, at most [`QUALITY_FIXES`].
     innovations: Vec<f64>,
     /// Radii measured in free flight (the bottom clear of the surface).
@@ -296,6 +298,7 @@ impl Tracker {
             opts,
             history: Vec::new(),
             qualities: Vec::new(),
+            seed_only: false,
             innovations: Vec::new(),
             flight_radii: Vec::new(),
             radius_told: None,
@@ -327,6 +330,7 @@ impl Tracker {
     /// acquisition that told the ball from static circles by its motion.
     pub fn seed(&mut self, a: (f64, f64, f64), b: (f64, f64, f64)) {
         self.history = vec![a, b];
+        self.seed_only = true;
     }
 
     /// A tracker with no history that reads the ball as this one now does: on its surface line, with the
@@ -823,7 +827,7 @@ impl Tracker {
             // through it and this fix would carry its offset on as a false velocity. A measured path stands:
             // the ball may have bounced away from it.
             let (dx, dy) = (found.1.fit.x - px, found.1.fit.y - py);
-            if self.history.len() <= 2 && dx.hypot(dy) > WIDE_HALF_WIDTH {
+            if self.seed_only && dx.hypot(dy) > WIDE_HALF_WIDTH {
                 for fix in &mut self.history {
                     fix.1 += dx;
                     fix.2 += dy;
@@ -1120,6 +1124,7 @@ impl Tracker {
 
     fn accept<P: Pixel>(&mut self, frame: usize, t_s: f64, img: &Plane<P>, f: Refined, mut status: Status) -> BallFix {
         self.missed = 0;
+        self.seed_only = false;
         let fit = f.fit;
         let (w, h) = (img.width as f64, img.height as f64);
         if fit.x - fit.r < -0.5 || fit.y - fit.r < -0.5 || fit.x + fit.r > w - 0.5 || fit.y + fit.r > h - 0.5 {
