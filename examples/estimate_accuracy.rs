@@ -9,7 +9,7 @@
 #[path = "../tests/common/rendered.rs"]
 mod rendered;
 
-use bouncelab_estimate::{Conditions, estimate_with_frames};
+use bouncelab_estimate::{Conditions, estimate_with_frames, fall_se_deg};
 use bouncelab_frames::Session;
 use bouncelab_track::{ClipTracking, track_clip};
 use std::collections::BTreeMap;
@@ -57,6 +57,7 @@ fn main() {
             gravity: 9.81,
             ball_diameter_m: session.ball.diameter_m,
             surface_tilt_deg: None,
+            fall_se_deg: fall_se_deg(entry.settings.dropped_from_rest, entry.settings.incline_se_deg),
         };
         let est = match estimate_with_frames(&track, &clip, &c) {
             Ok(e) => e,

@@ -2,7 +2,7 @@
 //! standard errors.
 
 use anyhow::Context;
-use bouncelab_estimate::{Conditions, Estimate, estimate_finding_downslope, estimate_with_frames};
+use bouncelab_estimate::{Conditions, Estimate, estimate_finding_downslope, estimate_with_frames, fall_se_deg};
 use bouncelab_frames::{Clip, Downslope, Session};
 use bouncelab_track::{ClipTracking, track_clip};
 use std::path::{Path, PathBuf};
@@ -64,6 +64,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         gravity: a.gravity,
         ball_diameter_m: diameter,
         surface_tilt_deg: clip.settings().surface_tilt_deg,
+        fall_se_deg: fall_se_deg(clip.settings().dropped_from_rest, clip.settings().incline_se_deg),
     };
     // Without a down-slope direction given, the flights' fall is checked against the default.
     let e = match downslope {

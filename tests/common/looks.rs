@@ -5,7 +5,7 @@
 
 #![allow(dead_code)]
 
-use bouncelab_estimate::{Conditions, estimate_finding_downslope, estimate_with_frames};
+use bouncelab_estimate::{Conditions, estimate_finding_downslope, estimate_with_frames, fall_se_deg};
 use bouncelab_frames::Session;
 use bouncelab_track::{ClipTracking, Status, track_clip};
 use std::collections::BTreeMap;
@@ -220,6 +220,7 @@ fn evaluate_clip(
         gravity: 9.81,
         ball_diameter_m: session.ball.diameter_m,
         surface_tilt_deg: None,
+        fall_se_deg: fall_se_deg(entry.settings.dropped_from_rest, entry.settings.incline_se_deg),
     };
     // As `analyze` does: without a down-slope given, the flights' fall is checked against the default.
     let estimate = if entry.downslope_given {

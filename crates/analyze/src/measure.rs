@@ -6,7 +6,9 @@
 //! run killed at any instant leaves each shot complete or absent and the next run resumes.
 
 use crate::{AnalyzeError, Progress, Stage};
-use bouncelab_estimate::{Conditions, Estimate, estimate_finding_downslope, estimate_with_frames, saturation_flag};
+use bouncelab_estimate::{
+    Conditions, Estimate, estimate_finding_downslope, estimate_with_frames, fall_se_deg, saturation_flag,
+};
 use bouncelab_frames::{ClipEntry, Downslope, ReadOptions, Session};
 use bouncelab_store::{
     ClipFingerprint, EstimateRecord, Fingerprint, SessionRecord, ShotRecord, Store, TrackRecord, ValueSe,
@@ -94,13 +96,14 @@ pub(crate) fn session_key(session: &Session) -> String {
 /// wanders beyond a hundredth of the ball's about a steady change flagged; 24: every circle measured again
 /// against its neighbouring frames' mean rim, and moved onto the limb's silhouette; 25: a lost ball looked
 /// for again frame by frame after a seed, not by its sightings' gap; 26: in noisy frames, a lost ball looked
-/// for by its rim's strength around the prediction).
-const MEASUREMENT_REVISION: u32 = 26;
+/// for by its rim's strength around the prediction; 27: the surface's tilt weighed with the one the ball's
+/// fall from rest implies).
+const MEASUREMENT_REVISION: u32 = 27;
 
 /// Everything besides the frame files that changes a shot's track or estimate.
 fn settings_text(entry: &ClipEntry, gravity: f64) -> String {
     format!(
-        "bouncelab {} rev {MEASUREMENT_REVISION} | fps {} ({:?}) | downslope {:?} (given {}) | diameter {} | scale {:?} | roi {:?} | line {:?} | tilt {:?} | angle {} | gravity {} | tracker {:?}",
+        "bouncelab {} rev {MEASUREMENT_REVISION} | fps {} ({:?}) | downslope {:?} (given {}) | diameter {} | scale {:?} | roi {:?} | line {:?} | tilt {:?} | incline se {:?} | dropped {:?} | angle {} | gravity {} | tracker {:?}",
         env!("CARGO_PKG_VERSION"),
         entry.fps,
         entry.fps_source,
@@ -111,6 +114,8 @@ fn settings_text(entry: &ClipEntry, gravity: f64) -> String {
         entry.settings.roi,
         entry.settings.contact_line,
         entry.settings.surface_tilt_deg,
+        entry.settings.incline_se_deg,
+        entry.settings.dropped_from_rest,
         entry.angle_deg,
         gravity,
         bouncelab_track::TrackOptions::default(),
@@ -300,6 +305,7 @@ fn measure_clip(entry: &ClipEntry, gravity: f64) -> Measured {
         gravity,
         ball_diameter_m: settings.ball_diameter_m,
         surface_tilt_deg: settings.surface_tilt_deg,
+        fall_se_deg: fall_se_deg(settings.dropped_from_rest, settings.incline_se_deg),
     };
     // Without a down-slope direction given, the flights' fall is checked against the default.
     let estimate = if entry.downslope_given {

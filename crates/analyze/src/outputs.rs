@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 /// dimensionless. A standard error is `<quantity>_se_<unit>` (see `docs/outputs.md`). The measured quantities'
 /// columns are the store's `estimates` columns ([`Q`], `bouncelab_store::ESTIMATE_QUANTITIES`), so the file
 /// and the table name them alike.
-pub const ESTIMATE_COLUMNS: [&str; 44] = [
+pub const ESTIMATE_COLUMNS: [&str; 48] = [
     "clip",
     "surface",
     "angle_deg",
@@ -56,6 +56,10 @@ pub const ESTIMATE_COLUMNS: [&str; 44] = [
     "trajectory_share",
     "surface_tilt_deg",
     "surface_tilt_se_deg",
+    "line_tilt_deg",
+    "line_tilt_se_deg",
+    "fall_tilt_deg",
+    "fall_tilt_se_deg",
     "flags",
     "notes",
     "trajectory_file",
@@ -212,7 +216,9 @@ fn estimate_cells(s: &ShotData, ball_mass_kg: f64, gravity: f64, files: &Traject
     cells.push(num(worst_chi2));
     cells.push(e.contact_line.map_or(String::new(), |l| l.cue.name().to_string()));
     cells.push(num(e.trajectory_share));
-    cells.extend(value_se_cells(e.surface_tilt_deg.map(|t| (t.value, Some(t.se)))));
+    for tilt in [e.surface_tilt_deg, e.line_tilt_deg, e.fall_tilt_deg] {
+        cells.extend(value_se_cells(tilt.map(|t| (t.value, Some(t.se)))));
+    }
     cells.push(e.flags.join("; "));
     cells.push(e.notes.join("; "));
     cells.push(

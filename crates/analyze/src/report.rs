@@ -456,7 +456,7 @@ pub(crate) fn build(a: &Analysis, p: &Predictions, description: Option<&str>, wa
     let tilts: Vec<_> = a.shots.iter().filter_map(|s| s.estimate.surface_tilt_deg).collect();
     if let Some(t) = bouncelab_estimate::session_tilt_deg(&tilts) {
         notes.push(format!(
-            "the surface lies tilted by {} ± {:.3}° in the image over {} shot(s) (counter-clockwise as seen: a camera roll, or the surface's own slope across the view); each shot is measured along its own line, so the tilt is taken out of its velocities",
+            "the surface lies tilted by {} ± {:.3}° in the image over {} shot(s) (counter-clockwise as seen: a camera roll, or the surface's own slope across the view); each shot is measured along its own tilt (its line's, weighed with its fall's), so the tilt is taken out of its velocities",
             format!("{:+.3}", t.value).replace('-', "\u{2212}"),
             t.se,
             tilts.len()
@@ -1041,6 +1041,18 @@ fn contact_source(e: &bouncelab_estimate::Estimate) -> Option<String> {
     }
     if let Some(t) = e.surface_tilt_deg {
         text += &format!(", tilt {:+.3} ± {:.3}°", t.value, t.se).replace('-', "\u{2212}");
+        let same = |a: bouncelab_estimate::Measured| (a.value - t.value).abs() < 1e-6 && (a.se - t.se).abs() < 1e-6;
+        match (e.line_tilt_deg, e.fall_tilt_deg) {
+            (Some(l), Some(f)) if !same(l) => {
+                text += &format!(
+                    " (the line's {:+.3} ± {:.3}°, the fall's {:+.3} ± {:.3}°)",
+                    l.value, l.se, f.value, f.se
+                )
+                .replace('-', "\u{2212}");
+            }
+            (None, Some(f)) if same(f) => text += " (from the ball's fall)",
+            _ => {}
+        }
     }
     if line.cue != LineCue::Trajectory
         && let Some(level) = e.trajectory_level_px

@@ -10,6 +10,7 @@
 
 mod ballistic;
 mod contact;
+mod fall;
 mod phase;
 mod refit_level;
 mod roll;
@@ -22,8 +23,8 @@ pub use contact::{HeightPoint, TrajectoryContact, find_impact, trajectory_contac
 pub use phase::{Phase, PhaseFrames};
 pub use roll::session_tilt_deg;
 pub use shot::{
-    Conditions, DOWNSLOPE_SIGMAS, Estimate, EstimateError, GravityCheck, LEVEL_BY_EYE_DEG, MIN_FLIGHT_FRAMES,
-    MIN_SIGMA_PX, Measured, estimate, saturation_flag,
+    Conditions, DOWNSLOPE_SIGMAS, Estimate, EstimateError, FALL_SE_DEG, GravityCheck, LEVEL_BY_EYE_DEG,
+    MIN_FLIGHT_FRAMES, MIN_SIGMA_PX, Measured, estimate, fall_se_deg, saturation_flag,
 };
 pub use spin::{Rotation, Spin, SpinImage, SpinOptions, measure_spin, rotation_between, spin_from_frames};
 pub use with_frames::{estimate_finding_downslope, estimate_with_frames};

@@ -18,6 +18,22 @@ pub struct Conditions {
     /// The surface's tilt in the image, degrees counter-clockwise as seen, where no line shows it (a known
     /// camera roll, `[surface] tilt_deg`); `None`: the image's axes, taken as level to [`LEVEL_BY_EYE_DEG`].
     pub surface_tilt_deg: Option<f64>,
+    /// How well the direction of the ball's fall is known beforehand, degrees (a standard error): a ball
+    /// released at rest falls along gravity, at `incline_deg` from the surface's normal, to within the
+    /// incline's own error and the release's sideways push ([`FALL_SE_DEG`] by default). The fall then
+    /// measures the surface's tilt in the image too, and it is combined with a line's where the two agree
+    /// (`[surface] incline_se_deg`). `None`: the ball was not dropped from rest, the line's tilt alone is used.
+    pub fall_se_deg: Option<f64>,
+}
+
+/// How well a dropped ball's fall direction is known by default, degrees: the precision of the paper's
+/// digital angle gauge that set its inclines (±0.5°).
+pub const FALL_SE_DEG: f64 = 0.5;
+
+/// [`Conditions::fall_se_deg`] from a session's settings: whether the ball was released at rest (`None`:
+/// not said, taken as dropped) and the incline's standard error (`None`: [`FALL_SE_DEG`]).
+pub fn fall_se_deg(dropped_from_rest: Option<bool>, incline_se_deg: Option<f64>) -> Option<f64> {
+    (dropped_from_rest != Some(false)).then(|| incline_se_deg.unwrap_or(FALL_SE_DEG))
 }
 
 impl Conditions {
@@ -47,6 +63,11 @@ impl Conditions {
         {
             return bad("surface tilt", t, "a tilt in the image lies between −45 and 45 degrees");
         }
+        if let Some(s) = self.fall_se_deg
+            && !(s.is_finite() && s > 0.0)
+        {
+            return bad("incline's standard error", s, "must be a positive number of degrees");
+        }
         Ok(())
     }
 }
@@ -58,6 +79,7 @@ impl Default for Conditions {
             gravity: 9.81,
             ball_diameter_m: 0.067,
             surface_tilt_deg: None,
+            fall_se_deg: Some(FALL_SE_DEG),
         }
     }
 }
@@ -126,10 +148,21 @@ pub struct Estimate {
     #[serde(default)]
     pub frame: Option<SurfaceFrame>,
     /// The surface's tilt in the image, degrees counter-clockwise as seen, with its standard error, when the
-    /// frame follows a line found in the image (a camera rolled by φ shows the surface tilted by −φ for
-    /// down-slope +x); none when the line found was rejected, whose tilt is no measurement.
+    /// frame follows a line found in the image or the ball's fall (a camera rolled by φ shows the surface
+    /// tilted by −φ for down-slope +x); none when neither measured it (a line found but rejected, whose tilt
+    /// is no measurement, and no fall from rest).
     #[serde(default)]
     pub surface_tilt_deg: Option<Measured>,
+    /// The contact line's own tilt in the image, degrees, with its standard error, when the ball's fall was
+    /// weighed with it (`surface_tilt_deg` is then the two combined, or the line's alone when they disagreed).
+    #[serde(default)]
+    pub line_tilt_deg: Option<Measured>,
+    /// The surface's tilt in the image that the ball's fall implies, degrees, with its standard error (a ball
+    /// released at rest falls along gravity: see [`Conditions::fall_se_deg`]), also when it disagreed with
+    /// the line and was not used (a note says so); `None` when it was not measured (a line or tilt given, a
+    /// ball not dropped from rest, a down-slope not known or that the fall fits as well the other way).
+    #[serde(default)]
+    pub fall_tilt_deg: Option<Measured>,
     /// Where the ball's own trajectory puts the contact level, px above the contact line used (≈ 0 when the
     /// two agree), with its standard error; `None` where the trajectory could not tell.
     #[serde(default)]
@@ -348,8 +381,103 @@ pub fn estimate(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError
     }
 }
 
-/// [`estimate`] from the track's measured frames alone.
+/// [`estimate`] from the track's measured frames alone: measured in the contact line's frame, then, when the
+/// ball fell from rest ([`Conditions::fall_se_deg`]) and the line's tilt was not given, measured again in the
+/// frame of the tilt the line and the fall agree on (see `fall.rs`).
 fn estimate_from_measured(track: &Track, c: &Conditions) -> Result<Estimate, EstimateError> {
+    let (mut first, fall) = measure(track, c, None)?;
+    let Some(fall) = fall else {
+        return Ok(first);
+    };
+    let incline = c.incline_deg;
+    if crate::fall::other_way_fits_as_well(fall.line, fall.tilt, fall.reversed_tilt_deg) {
+        first.notes.push(format!(
+            "the ball's fall onto the {incline}° incline agrees with {} ({:.2} ± {:.2}°) no worse with the down-slope the other way: the fall is not used",
+            fall.what, fall.line.value, fall.line.se
+        ));
+        return Ok(first);
+    }
+    // The image's axes are no measurement of the surface, only a bound on how far off it they may be.
+    let tilt = if fall.measured_line {
+        crate::fall::combine(fall.line, fall.tilt)
+    } else {
+        crate::fall::agree(fall.line, fall.tilt).map(|()| fall.tilt)
+    };
+    match tilt {
+        Ok(tilt) => {
+            let turn = Turn {
+                pivot_x: fall.pivot_x,
+                tilt,
+            };
+            let mut e = match measure(track, c, Some(turn)) {
+                Ok((e, _)) => e,
+                Err(err) => {
+                    first.notes.push(format!(
+                        "measured along the tilt {:.2} ± {:.2}° that the ball's fall gives with {}, the shot could not be measured ({err}): the first tilt is kept",
+                        tilt.value, tilt.se, fall.what
+                    ));
+                    return Ok(first);
+                }
+            };
+            e.notes.push(if fall.measured_line {
+                format!(
+                    "the surface's tilt in the image, {:.2} ± {:.2}°, weighs the line's ({:.2} ± {:.2}°) with the ball's fall onto the {incline}° incline ({:.2} ± {:.2}°)",
+                    tilt.value, tilt.se, fall.line.value, fall.line.se, fall.tilt.value, fall.tilt.se
+                )
+            } else {
+                format!(
+                    "the surface's tilt in the image, {:.2} ± {:.2}°, is the ball's fall's onto the {incline}° incline (the image's axes taken as level to ± {:.1}°)",
+                    tilt.value, tilt.se, fall.line.se
+                )
+            });
+            e.line_tilt_deg = fall.measured_line.then_some(fall.line);
+            e.fall_tilt_deg = Some(fall.tilt);
+            Ok(e)
+        }
+        Err(z) => {
+            let mut e = first;
+            e.notes.push(format!(
+                "the ball's fall onto the {incline}° incline puts the surface's tilt in the image at {:.2} ± {:.2}°, {:.1} standard errors from {} ({:.2} ± {:.2}°): a ball not dropped from rest, another incline, or a line that is not the surface's; the fall is not used",
+                fall.tilt.value, fall.tilt.se, z.abs(), fall.what, fall.line.value, fall.line.se
+            ));
+            e.line_tilt_deg = fall.measured_line.then_some(fall.line);
+            e.fall_tilt_deg = Some(fall.tilt);
+            Ok(e)
+        }
+    }
+}
+
+/// A turn of the contact line to a tilt measured with the fall: about `pivot_x`, px, to `tilt`, degrees.
+struct Turn {
+    pivot_x: f64,
+    tilt: Measured,
+}
+
+/// What the ball's fall says of the frame's tilt, from a shot measured in its contact line's frame.
+struct FallEvidence {
+    /// The frame's tilt and its standard error, degrees: the line's, or the image's axes when no line's tilt
+    /// was measured.
+    line: Measured,
+    /// Whether `line` was measured in the image (a found line) rather than assumed (the image's axes).
+    measured_line: bool,
+    /// What `line` is, for notes.
+    what: &'static str,
+    /// The tilt the fall implies, degrees.
+    tilt: Measured,
+    /// The tilt it would imply were the down-slope the other way, degrees.
+    reversed_tilt_deg: f64,
+    /// Where the contact level is known best, px: about there the line is turned, so that the level stays.
+    pivot_x: f64,
+}
+
+/// One shot measured in the frame of its contact line, turned by `turn` when given; with what its fall
+/// says of the frame's tilt when that can be used (not turned yet, a ball dropped from rest, a tilt not
+/// given).
+fn measure(
+    track: &Track,
+    c: &Conditions,
+    turn: Option<Turn>,
+) -> Result<(Estimate, Option<FallEvidence>), EstimateError> {
     c.check()?;
     let scale = track.scale.ok_or(EstimateError::NoScale)?;
     let s = scale.m_per_px;
@@ -364,7 +492,10 @@ fn estimate_from_measured(track: &Track, c: &Conditions) -> Result<Estimate, Est
         c.surface_tilt_deg,
         against_centres_px(&scale, radius),
     )?;
-    let line = choice.line;
+    let line = match &turn {
+        Some(t) => choice.line.turned_about(t.pivot_x, t.tilt.value, t.tilt.se),
+        None => choice.line,
+    };
     let (frame, points) = local_points(track, &measured, &line, &scale);
     let (first, last) = contact_run(&points, choice.no_impact, &line, s)?;
     let (incoming, outgoing) = flights(&points, first, last)?;
@@ -393,6 +524,7 @@ fn estimate_from_measured(track: &Track, c: &Conditions) -> Result<Estimate, Est
     let mut level = LevelErrors::of(&line, &scale, radius, choice.trajectory_share);
     if line.cue == LineCue::Trajectory
         && c.surface_tilt_deg.is_none()
+        && turn.is_none()
         && let Some(g) = &gravity
     {
         level.sigma_theta = unmeasured_tilt(g, &mut notes);
@@ -434,7 +566,36 @@ fn estimate_from_measured(track: &Track, c: &Conditions) -> Result<Estimate, Est
     }
     note_scatter(&fin, &fout, &mut notes);
     let rim_change_px = rim_change(&radius_lines);
-    Ok(Estimate {
+    let found_line = matches!(line.cue, LineCue::Brightness | LineCue::Texture);
+    let fall = match (turn.is_none(), c.fall_se_deg) {
+        (true, Some(fall_se)) if found_line || (line.cue == LineCue::Trajectory && c.surface_tilt_deg.is_none()) => {
+            let v = [vin[0].value, vin[1].value];
+            // The fit's own errors: the level's moves the touch along the fall, not across it.
+            crate::fall::incidence_rad(v, [vin[0].stat, vin[1].stat]).map(|incidence| {
+                let sign = if track.downslope_negative_x { -1.0 } else { 1.0 };
+                let frame_tilt = Measured::new(line.tilt_deg(), level.sigma_theta.to_degrees());
+                // A level mostly from the trajectory is known best at the contact, a line's at its centre.
+                let share = if found_line { choice.trajectory_share } else { 1.0 };
+                FallEvidence {
+                    line: frame_tilt,
+                    measured_line: found_line,
+                    what: if found_line { "the line's" } else { "the image's axes" },
+                    tilt: crate::fall::tilt_from_fall(frame_tilt.value, incidence, c.incline_deg, fall_se, sign),
+                    reversed_tilt_deg: crate::fall::tilt_from_fall(
+                        frame_tilt.value,
+                        incidence,
+                        -c.incline_deg,
+                        fall_se,
+                        sign,
+                    )
+                    .value,
+                    pivot_x: line.x0 + share * (frame.origin_px[0] - line.x0),
+                }
+            })
+        }
+        _ => None,
+    };
+    let estimate = Estimate {
         v_in: vin.map(|v| Measured::new(v.value, v.total)),
         v_out: vout.map(|v| Measured::new(v.value, v.total)),
         cor,
@@ -459,15 +620,18 @@ fn estimate_from_measured(track: &Track, c: &Conditions) -> Result<Estimate, Est
         contact_line: Some(line),
         frame: Some(frame),
         surface_tilt_deg: Some(line)
-            .filter(|l| matches!(l.cue, LineCue::Brightness | LineCue::Texture))
+            .filter(|_| found_line || turn.is_some())
             .map(|l| Measured::new(l.tilt_deg(), l.sigma_tilt_deg)),
+        line_tilt_deg: None,
+        fall_tilt_deg: None,
         trajectory_level_px: choice.trajectory_level_px,
         trajectory_share: choice.trajectory_share,
         gravity,
         rim_change_px,
         flags,
         notes,
-    })
+    };
+    Ok((estimate, fall))
 }
 
 /// The change of the measured radius between the flights (incoming, outgoing), px: mean outgoing − mean
@@ -1183,24 +1347,27 @@ impl TrajectoryView {
                 let tol = 3.0 * m.se.hypot(sep_se) + (0.03 * self.radius_px).max(1.0);
                 m.value.min(m_sep) - tol <= 0.0 && 0.0 <= m.value.max(m_sep) + tol
             });
-        if self.agrees(&m, &line) || between {
-            if between {
-                notes.push(format!(
-                    "the ball's touch puts the contact {:.1} ± {:.1} px from the surface line found ({} cue) and its separation on the line's other side: the trajectory contradicts itself, so the line is used",
-                    m.value,
-                    m.se,
-                    line.cue.name()
-                ));
-            }
-            if between {
-                return ContactChoice {
-                    line,
-                    trajectory_share: 0.0,
-                    trajectory_level_px: Some(m),
-                    notes,
-                    no_impact,
-                };
-            }
+        if between && let Some((_, (sep, sep_se))) = tc.separation {
+            // Such an arc moves the touch and the separation opposite ways, so the trajectory's level is
+            // taken half-way, uncertain by half their difference; it then weighs no more than that allows.
+            let m_sep = m.value + (sep - tc.touch_level.0);
+            let half_way = Measured::new(
+                0.5 * (m.value + m_sep),
+                (0.25 * (m.se * m.se + sep_se * sep_se) + (0.5 * (m.value - m_sep)).powi(2)).sqrt(),
+            );
+            notes.push(format!(
+                "the ball's touch puts the contact {:.1} ± {:.1} px from the surface line found ({} cue) and its separation {:.1} ± {:.1} px, on either side of it within their errors: the trajectory contradicts itself, so its level is taken half-way ({:.1} ± {:.1} px) and weighed with the line's",
+                m.value,
+                m.se,
+                line.cue.name(),
+                m_sep,
+                sep_se,
+                half_way.value,
+                half_way.se
+            ));
+            return self.combined(line, half_way, tc, notes, no_impact, against_centres_px);
+        }
+        if self.agrees(&m, &line) {
             return self.combined(line, m, tc, notes, no_impact, against_centres_px);
         }
         for alt in alternatives.iter().copied() {

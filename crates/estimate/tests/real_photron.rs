@@ -2,7 +2,7 @@
 //! a 2.5 mm glass ball in free fall at 30,000 fps with no impact. The chain tracks it in every frame and says
 //! plainly that the clip holds no impact, with the fall speed.
 
-use bouncelab_estimate::{Conditions, EstimateError, estimate_with_frames};
+use bouncelab_estimate::{Conditions, EstimateError, FALL_SE_DEG, estimate_with_frames};
 use bouncelab_frames::{Clip, ClipOptions};
 use bouncelab_track::{ClipTracking, track_clip};
 use std::path::PathBuf;
@@ -43,6 +43,7 @@ fn a_real_free_fall_is_tracked_in_every_frame_and_has_no_impact() {
         gravity: 9.81,
         ball_diameter_m: 0.0025,
         surface_tilt_deg: None,
+        fall_se_deg: Some(FALL_SE_DEG),
     };
     match estimate_with_frames(&track, &clip, &conditions) {
         Err(EstimateError::NoImpact {

@@ -1,6 +1,6 @@
 //! The estimator on tracks made from the contact model with known outputs, plus tracker-like noise.
 
-use bouncelab_estimate::{Conditions, EstimateError, GravityCheck, estimate};
+use bouncelab_estimate::{Conditions, Estimate, EstimateError, FALL_SE_DEG, GravityCheck, estimate};
 use bouncelab_model::{Ball, Impact, Model, SimOptions, State, simulate};
 use bouncelab_track::{BallFix, LineCue, Scale, Status, SurfaceLine, Track};
 
@@ -87,6 +87,7 @@ fn conditions(incline_deg: f64) -> Conditions {
         gravity: 9.81,
         ball_diameter_m: 2.0 * Ball::TENNIS.radius_m,
         surface_tilt_deg: None,
+        fall_se_deg: Some(FALL_SE_DEG),
     }
 }
 
@@ -433,7 +434,12 @@ fn without_a_surface_line_the_trajectory_tells_the_contact() {
             e.contact_ms.se
         );
         assert!(e.notes.iter().any(|n| n.contains("trajectory")), "{:?}", e.notes);
-        assert!(e.surface_tilt_deg.is_none());
+        // The ball's fall from rest measures the surface's tilt (level here) where no line does.
+        let tilt = e.surface_tilt_deg.expect("the fall's tilt");
+        assert!(
+            tilt.value.abs() < 3.0 * tilt.se && tilt.se < 1.02 * FALL_SE_DEG && e.fall_tilt_deg.is_some(),
+            "{angle}°: tilt {tilt:?}"
+        );
     }
     let rms = (z_level.iter().map(|z| z * z).sum::<f64>() / z_level.len() as f64).sqrt();
     assert!(rms < 2.5, "level RMS(error/σ) {rms} over {z_level:?}");
@@ -514,7 +520,8 @@ fn a_line_the_ball_does_not_land_on_gives_way_to_the_trajectory() {
 }
 
 /// A line the ball does not land on is no evidence of the surface's direction either: a spurious line
-/// tilted by 10° leaves the frame on the image's axes, so COR and μ are those of the level surface.
+/// tilted by 10° leaves the frame on the image's axes (or the tilt the ball's fall gives), so COR and μ are
+/// those of the level surface.
 #[test]
 fn a_rejected_line_lends_the_frame_no_tilt() {
     let model = Model::paper(25_650.0, 14.0, 0.5);
@@ -522,12 +529,23 @@ fn a_rejected_line_lends_the_frame_no_tilt() {
     let line = track.surface.as_mut().unwrap();
     line.y0 -= 40.0;
     line.slope = -(10f64.to_radians().tan());
-    let e = estimate(&track, &conditions(7.5)).unwrap();
+    let not_dropped = Conditions {
+        fall_se_deg: None,
+        ..conditions(7.5)
+    };
+    let e = estimate(&track, &not_dropped).unwrap();
     let used = e.contact_line.unwrap();
     assert_eq!(used.cue, LineCue::Trajectory);
     assert_eq!(used.slope, 0.0, "{used:?}");
     assert!((SURFACE_Y - used.y0).abs() < 1.5, "{used:?}");
     assert!(e.surface_tilt_deg.is_none(), "{:?}", e.surface_tilt_deg);
+    // Dropped from rest: the fall's tilt, near the truth's 0°, never the rejected line's 10°.
+    let dropped = estimate(&track, &conditions(7.5)).unwrap();
+    let tilt = dropped.surface_tilt_deg.expect("the fall's tilt");
+    assert!(
+        tilt.value.abs() < 3.0 * tilt.se && tilt.se < 1.02 * FALL_SE_DEG,
+        "{tilt:?}"
+    );
     assert!((e.cor.value - truth.restitution).abs() < 0.003, "e {}", e.cor.value);
     assert!(
         (e.mu.value - truth.effective_friction).abs() < 0.01,
@@ -555,7 +573,11 @@ fn an_unmeasured_tilt_is_in_the_errors() {
             f.x_px = cx + dx * roll.cos() - dy * roll.sin();
             f.y_px = cy + dx * roll.sin() + dy * roll.cos();
         }
-        let e = estimate(&track, &conditions(0.0)).unwrap();
+        let not_dropped = Conditions {
+            fall_se_deg: None,
+            ..conditions(0.0)
+        };
+        let e = estimate(&track, &not_dropped).unwrap();
         assert_eq!(e.contact_line.unwrap().cue, LineCue::Trajectory);
         let err = e.mu.value - truth.effective_friction;
         assert!(err.abs() > 0.02, "the roll shows in μ: {err}");
@@ -582,6 +604,114 @@ fn an_unmeasured_tilt_is_in_the_errors() {
         covered >= 5,
         "μ's 2σ interval covers the truth on {covered} of {seen} shots"
     );
+}
+
+/// A ball dropped from rest falls along gravity, at the incline from the surface's normal: a camera rolled
+/// by 2° with no line to show it, or a ragged line tilted a degree off, is turned back by the fall, and
+/// μ and COR come out as with the true frame. A fall that does not match (a thrown ball) is not used.
+#[test]
+fn the_fall_of_a_dropped_ball_measures_the_surface_s_tilt() {
+    let model = Model::paper(25_650.0, 14.0, 0.5);
+    let roll = 2f64.to_radians();
+    let (cx, cy) = (255.5, SURFACE_Y);
+    let turn = |track: &mut Track, by: f64| {
+        for f in &mut track.fixes {
+            let (dx, dy) = (f.x_px - cx, f.y_px - cy);
+            f.x_px = cx + dx * by.cos() - dy * by.sin();
+            f.y_px = cy + dx * by.sin() + dy * by.cos();
+        }
+    };
+    for (k, angle) in [0.0, 12.0, 22.0].into_iter().enumerate() {
+        // No line: the image's axes are 2° off the surface.
+        let (mut track, truth) = shot(&model, angle, 0.4, 0.02, 80 + k as u64);
+        track.surface = None;
+        turn(&mut track, roll);
+        let e = estimate(&track, &conditions(angle)).unwrap();
+        let tilt = e.surface_tilt_deg.expect("the fall's tilt");
+        assert!((tilt.value + 2.0).abs() < 0.1 && tilt.se < 0.6, "{angle}°: {tilt:?}");
+        assert!(
+            (e.mu.value - truth.effective_friction).abs() < 0.005,
+            "{angle}°: μ {:?}",
+            e.mu
+        );
+        assert!(
+            (e.cor.value - truth.restitution).abs() < 0.003,
+            "{angle}°: e {:?}",
+            e.cor
+        );
+        assert!(
+            e.notes.iter().any(|n| n.contains("is the ball's fall's")),
+            "{:?}",
+            e.notes
+        );
+        // A ragged line 1° off (± 0.9°): weighed with the fall (± 0.5°), the frame is off by the line's
+        // share of the weight, and μ's error shrinks with it.
+        let (mut track, truth) = shot(&model, angle, 0.4, 0.02, 90 + k as u64);
+        let line = track.surface.as_mut().unwrap();
+        (line.slope, line.sigma_tilt_deg, line.cue) = (-(1f64.to_radians().tan()), 0.9, LineCue::Texture);
+        let e = estimate(&track, &conditions(angle)).unwrap();
+        let (tilt, fall) = (e.surface_tilt_deg.unwrap(), e.fall_tilt_deg.unwrap());
+        assert!(
+            fall.value.abs() < 0.05 && (fall.se - FALL_SE_DEG).abs() < 0.05,
+            "{angle}°: {fall:?}"
+        );
+        let line_share = 0.9f64.powi(-2) / (0.9f64.powi(-2) + fall.se.powi(-2));
+        assert!(
+            (tilt.value - line_share).abs() < 0.05 && tilt.se < 0.45,
+            "{angle}°: {tilt:?}"
+        );
+        assert_eq!(e.line_tilt_deg.map(|t| t.value.round()), Some(1.0));
+        let alone = Conditions {
+            fall_se_deg: None,
+            ..conditions(angle)
+        };
+        let line_alone = estimate(&track, &alone).unwrap();
+        assert_eq!(line_alone.surface_tilt_deg.unwrap().value.round(), 1.0);
+        let err = |e: &Estimate| (e.mu.value - truth.effective_friction).abs();
+        assert!(
+            err(&e) < 0.4 * err(&line_alone),
+            "{angle}°: μ {:?} vs {:?} from the line alone",
+            e.mu,
+            line_alone.mu
+        );
+    }
+    // Thrown 8° off gravity's direction: the fall and the line disagree, the line's tilt is kept.
+    let (mut track, _) = shot(&model, 20.0, 0.4, 0.02, 99);
+    let line = track.surface.as_mut().unwrap();
+    line.sigma_tilt_deg = 0.9;
+    let e = estimate(&track, &conditions(12.0)).unwrap();
+    assert_eq!(e.surface_tilt_deg.unwrap().value, 0.0, "{:?}", e.surface_tilt_deg);
+    assert!(
+        e.notes.iter().any(|n| n.contains("the fall is not used")),
+        "{:?}",
+        e.notes
+    );
+}
+
+/// A trajectory that contradicts itself (its incoming flight read 1.5 px high and its outgoing one 1.5 px
+/// low, as an arc the flights do not follow moves them opposite ways) puts the contact half-way between its
+/// touch and its separation: a ragged line 2 px below the surface is moved most of the way up to it; a
+/// clean line stays where it is.
+#[test]
+fn a_trajectory_contradicting_itself_is_taken_half_way() {
+    let model = Model::paper(25_650.0, 14.0, 0.5);
+    let (mut track, truth) = shot(&model, 10.0, 0.4, 0.02, 12);
+    let d = 1.5;
+    for f in &mut track.fixes {
+        f.y_px += if f.t_s < truth.t_max_compression { -d } else { d };
+    }
+    let line = track.surface.as_mut().unwrap();
+    (line.y0, line.sigma_y0, line.cue) = (SURFACE_Y + 2.0, 3.0, LineCue::Texture);
+    let e = estimate(&track, &conditions(10.0)).unwrap();
+    let err = e.contact_line.unwrap().y0 - SURFACE_Y;
+    assert!(err.abs() < 0.8, "level {err} px off: {:?}", e.notes);
+    assert!(e.notes.iter().any(|n| n.contains("half-way")), "{:?}", e.notes);
+    // The line alone was 2 px off; the touch alone 1.5 px the other way.
+    let clean = track.surface.as_mut().unwrap();
+    (clean.y0, clean.sigma_y0, clean.cue) = (SURFACE_Y, 0.005, LineCue::Brightness);
+    let e = estimate(&track, &conditions(10.0)).unwrap();
+    let err = e.contact_line.unwrap().y0 - SURFACE_Y;
+    assert!(err.abs() < 0.05, "a clean line moved by {err} px");
 }
 
 /// A clip that holds no impact says so, with the speed the ball has at its end.

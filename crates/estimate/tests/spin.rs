@@ -2,7 +2,7 @@
 
 use bouncelab_estimate::{Conditions, estimate_finding_downslope, estimate_with_frames};
 use bouncelab_frames::Clip;
-use bouncelab_render::{Scenario, render};
+use bouncelab_render::{Rendered, Scenario, ShotTruth, render};
 use bouncelab_track::{ClipTracking, Track, track_clip};
 use std::path::Path;
 
@@ -123,6 +123,22 @@ fn spin_is_in_the_local_frame_when_the_image_is_mirrored_and_16_bit() {
     check("downslope = \"-x\"\nbit_depth = 16", true);
 }
 
+/// A shot of a mirrored camera's session: its clip, conditions, and its track as a clip without the
+/// `downslope` key gives it (+x) and as one with it (−x).
+fn mirrored(rendered: &Rendered, shot: &ShotTruth) -> (Clip, Conditions, Track, Track) {
+    let clip = Clip::open(rendered.session_dir.join(&shot.clip)).unwrap();
+    let c = Conditions {
+        incline_deg: shot.angle_deg,
+        ..Conditions::default()
+    };
+    let unset = track_clip(&clip, &ClipTracking::default(), |_, _| {}).unwrap();
+    let set = Track {
+        downslope_negative_x: true,
+        ..unset.clone()
+    };
+    (clip, c, unset, set)
+}
+
 /// A mirrored camera whose `downslope` nobody gave: the flights, long enough to tell gravity's pull along
 /// the incline, set the down-slope, and the shot measures as with the key set; a level shot keeps the default.
 #[test]
@@ -134,17 +150,7 @@ fn an_unset_down_slope_is_taken_from_the_flights() {
     let dir = tempfile::tempdir().unwrap();
     let rendered = render(&s, dir.path()).unwrap();
     for shot in &rendered.shots {
-        let clip = Clip::open(rendered.session_dir.join(&shot.clip)).unwrap();
-        let c = Conditions {
-            incline_deg: shot.angle_deg,
-            ..Conditions::default()
-        };
-        // Tracked as a clip without the key would be (+x), and as one with it.
-        let unset = track_clip(&clip, &ClipTracking::default(), |_, _| {}).unwrap();
-        let set = Track {
-            downslope_negative_x: true,
-            ..unset.clone()
-        };
+        let (clip, c, unset, set) = mirrored(&rendered, shot);
         let found = estimate_finding_downslope(&unset, &clip, &c).unwrap();
         let given = estimate_with_frames(&set, &clip, &c).unwrap();
         let taken = found.notes.iter().any(|n| n.contains("so -x is taken as down-slope"));
@@ -162,4 +168,42 @@ fn an_unset_down_slope_is_taken_from_the_flights() {
         let kept = estimate_with_frames(&unset, &clip, &c).unwrap();
         assert!((kept.mu.value - given.mu.value).abs() > 0.02, "{}", shot.clip);
     }
+}
+
+/// The same mirrored camera with short flights (6 ms each side), too short for gravity's pull along the
+/// incline to tell the down-slope: a ball dropped from rest meets the surface moving down-slope, which its
+/// incoming velocity shows clearly, so the down-slope is taken from that.
+#[test]
+fn an_unset_down_slope_is_taken_from_the_ball_s_fall() {
+    let s = Scenario::parse(&scenario("downslope = \"-x\""), "down-slope test").unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let rendered = render(&s, dir.path()).unwrap();
+    let mut told = 0;
+    for shot in rendered.shots.iter().filter(|s| s.angle_deg != 0.0) {
+        let (clip, c, unset, set) = mirrored(&rendered, shot);
+        let found = estimate_finding_downslope(&unset, &clip, &c).unwrap();
+        let given = estimate_with_frames(&set, &clip, &c).unwrap();
+        assert!(
+            found.notes.iter().any(|n| n.contains("so -x is taken as down-slope")),
+            "{}: {:?}",
+            shot.clip,
+            found.notes
+        );
+        told += found
+            .notes
+            .iter()
+            .filter(|n| n.contains("as a ball dropped onto"))
+            .count();
+        assert!((found.mu.value - given.mu.value).abs() < 1e-9, "{}", shot.clip);
+        // Without the fall's evidence (a ball not dropped from rest) the default stays, with a note.
+        let thrown = Conditions { fall_se_deg: None, ..c };
+        let kept = estimate_finding_downslope(&unset, &clip, &thrown).unwrap();
+        assert!(
+            kept.notes.iter().any(|n| n.contains("do not tell it")),
+            "{}: {:?}",
+            shot.clip,
+            kept.notes
+        );
+    }
+    assert!(told > 0, "no shot's down-slope was told by its fall");
 }

@@ -35,6 +35,8 @@ pub const DIAMETER_RANGE_M: (f64, f64) = (1e-4, 1.0);
 
 /// Largest accepted `|[surface] line_tilt_deg|`, in degrees.
 pub const MAX_LINE_TILT_DEG: f64 = 45.0;
+/// Accepted `[surface] incline_se_deg`, in degrees.
+pub const INCLINE_SE_RANGE_DEG: (f64, f64) = (0.001, 10.0);
 
 /// Which image direction is down the slope (`docs/session.md`, conventions).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -232,6 +234,14 @@ pub struct ClipSettings {
     /// Where the down-slope direction came from, when given.
     #[serde(default)]
     pub downslope_source: Option<SettingSource>,
+    /// How well the ball's fall direction is known, degrees (`[surface] incline_se_deg`: the incline's
+    /// standard error and the release's sideways push); `None`: the estimator's default.
+    #[serde(default)]
+    pub incline_se_deg: Option<f64>,
+    /// Whether the ball was released at rest, so that it falls along gravity (`[surface] dropped_from_rest`);
+    /// `None`: not said, taken as dropped (`clips.csv`'s drop heights say so).
+    #[serde(default)]
+    pub dropped_from_rest: Option<bool>,
 }
 
 impl Default for ClipSettings {
@@ -249,6 +259,8 @@ impl Default for ClipSettings {
             surface_tilt_source: None,
             downslope: None,
             downslope_source: None,
+            incline_se_deg: None,
+            dropped_from_rest: None,
         }
     }
 }
@@ -294,6 +306,8 @@ pub(crate) struct CameraKeys {
     pub roi: Option<Roi>,
     pub contact_line: Option<ContactLine>,
     pub surface_tilt_deg: Option<f64>,
+    pub incline_se_deg: Option<f64>,
+    pub dropped_from_rest: Option<bool>,
 }
 
 /// Reads and parses a TOML file into a table.
@@ -341,6 +355,23 @@ pub(crate) fn check_range(x: f64, (lo, hi): (f64, f64), unit: &str, path: &Path,
             problem: format!("{} is outside the accepted range {lo:e}–{hi:e} {unit}", short_number(x)),
         })
     }
+}
+
+/// The number under `key` in the `[section]` table of the file at `path`, checked against `range`; `None`
+/// when the key is absent.
+fn ranged(
+    path: &Path,
+    table: &toml::Table,
+    section: &str,
+    key: &str,
+    range: (f64, f64),
+    unit: &str,
+) -> Result<Option<f64>> {
+    let field = format!("[{section}] {key}");
+    table
+        .get(key)
+        .map(|v| check_range(number(path, &field, v)?, range, unit, path, &field))
+        .transpose()
 }
 
 fn table<'a>(path: &Path, doc: &'a toml::Table, name: &str) -> Result<Option<&'a toml::Table>> {
@@ -429,43 +460,32 @@ pub(crate) fn camera_keys(path: &Path, doc: &toml::Table) -> Result<CameraKeys> 
                 }
             }),
         };
-        if let Some(v) = camera.get("scale_m_per_px") {
-            let field = "[camera] scale_m_per_px";
-            keys.scale_m_per_px = Some(check_range(
-                number(path, field, v)?,
-                SCALE_RANGE_M_PER_PX,
-                "m/px",
-                path,
-                field,
-            )?);
-        }
+        keys.scale_m_per_px = ranged(path, camera, "camera", "scale_m_per_px", SCALE_RANGE_M_PER_PX, "m/px")?;
         if let Some(v) = camera.get("roi") {
             keys.roi = Some(roi(path, v)?);
         }
     }
-    if let Some(ball) = table(path, doc, "ball")?
-        && let Some(v) = ball.get("diameter_m")
-    {
-        let field = "[ball] diameter_m";
-        keys.diameter_m = Some(check_range(
-            number(path, field, v)?,
-            DIAMETER_RANGE_M,
-            "m",
-            path,
-            field,
-        )?);
+    if let Some(ball) = table(path, doc, "ball")? {
+        keys.diameter_m = ranged(path, ball, "ball", "diameter_m", DIAMETER_RANGE_M, "m")?;
     }
     if let Some(surface) = table(path, doc, "surface")? {
-        if let Some(v) = surface.get("tilt_deg") {
-            let field = "[surface] tilt_deg";
-            keys.surface_tilt_deg = Some(check_range(
-                number(path, field, v)?,
-                (-MAX_LINE_TILT_DEG, MAX_LINE_TILT_DEG),
-                "degrees",
-                path,
-                field,
-            )?);
+        keys.incline_se_deg = ranged(
+            path,
+            surface,
+            "surface",
+            "incline_se_deg",
+            INCLINE_SE_RANGE_DEG,
+            "degrees",
+        )?;
+        if let Some(v) = surface.get("dropped_from_rest") {
+            keys.dropped_from_rest = Some(v.as_bool().ok_or_else(|| FramesError::BadValue {
+                path: path.into(),
+                field: "[surface] dropped_from_rest".into(),
+                problem: format!("must be true or false, not {v}"),
+            })?);
         }
+        let tilt_range = (-MAX_LINE_TILT_DEG, MAX_LINE_TILT_DEG);
+        keys.surface_tilt_deg = ranged(path, surface, "surface", "tilt_deg", tilt_range, "degrees")?;
         let y = surface
             .get("line_y_px")
             .map(|v| number(path, "[surface] line_y_px", v))
@@ -600,6 +620,8 @@ pub(crate) fn choose_settings(
     let line = pick(overrides.contact_line, own, session, |k| k.contact_line);
     let tilt = pick(overrides.surface_tilt_deg, own, session, |k| k.surface_tilt_deg);
     let downslope = pick(None, own, session, |k| k.downslope);
+    let incline_se_deg = pick(None, own, session, |k| k.incline_se_deg).map(|(v, _)| v);
+    let dropped_from_rest = pick(None, own, session, |k| k.dropped_from_rest).map(|(v, _)| v);
     let (ball_diameter_m, ball_diameter_source) = diameter.unwrap_or_else(|| {
         warnings.push(Warning::DefaultDiameter {
             clip: clip.into(),
@@ -631,6 +653,8 @@ pub(crate) fn choose_settings(
         surface_tilt_source,
         downslope,
         downslope_source,
+        incline_se_deg,
+        dropped_from_rest,
     }
 }
 
@@ -674,6 +698,28 @@ mod tests {
 
     fn keys(text: &str) -> Result<CameraKeys> {
         camera_keys(Path::new("x/clip.toml"), &text.parse().unwrap())
+    }
+
+    #[test]
+    fn the_fall_s_keys_parse_and_bad_ones_are_named() {
+        let k = keys("[surface]\nincline_se_deg = 0.2\ndropped_from_rest = false").unwrap();
+        assert_eq!((k.incline_se_deg, k.dropped_from_rest), (Some(0.2), Some(false)));
+        for (text, field) in [
+            ("[surface]\nincline_se_deg = 0", "[surface] incline_se_deg"),
+            ("[surface]\nincline_se_deg = 45", "[surface] incline_se_deg"),
+            ("[surface]\ndropped_from_rest = \"yes\"", "[surface] dropped_from_rest"),
+        ] {
+            match keys(text) {
+                Err(FramesError::BadValue { field: f, path, .. }) => {
+                    assert_eq!(
+                        (f.as_str(), path.as_path()),
+                        (field, Path::new("x/clip.toml")),
+                        "{text}"
+                    )
+                }
+                other => panic!("{text}: {other:?}"),
+            }
+        }
     }
 
     #[test]

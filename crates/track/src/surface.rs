@@ -124,6 +124,19 @@ impl SurfaceLine {
         }
     }
 
+    /// The line turned about its point at column `pivot_x` to the tilt `tilt_deg` (counter-clockwise as
+    /// seen), with that tilt's standard error; its height there, its reference column and everything else
+    /// kept.
+    pub fn turned_about(&self, pivot_x: f64, tilt_deg: f64, sigma_tilt_deg: f64) -> SurfaceLine {
+        let slope = -tilt_deg.to_radians().tan();
+        SurfaceLine {
+            y0: self.y_at(pivot_x) + slope * (self.x0 - pivot_x),
+            slope,
+            sigma_tilt_deg,
+            ..*self
+        }
+    }
+
     /// The standard error of the line's height as a contact level, px: its columns' scatter (`sigma_y0`)
     /// and its edge's definition as the half-width of a uniform (Type-B) term, in quadrature.
     pub fn level_sigma_px(&self) -> f64 {
@@ -542,6 +555,19 @@ mod tests {
             cue,
             ..SurfaceLine::given(255.5, y0, tilt_deg)
         }
+    }
+
+    #[test]
+    fn a_turned_line_keeps_its_height_at_the_pivot() {
+        let l = line(300.0, 0.8, 40, LineCue::Texture);
+        let t = l.turned_about(180.0, -0.4, 0.3);
+        assert!((t.y_at(180.0) - l.y_at(180.0)).abs() < 1e-9);
+        assert!((t.tilt_deg() + 0.4).abs() < 1e-12 && t.sigma_tilt_deg == 0.3);
+        assert_eq!((t.x0, t.columns, t.cue), (l.x0, l.columns, l.cue));
+        // 1.2° of turn over 75.5 px from the pivot to the reference column.
+        let moved = t.y0 - l.y0;
+        let expected = 75.5 * ((0.8f64.to_radians()).tan() + (0.4f64.to_radians()).tan());
+        assert!((moved - expected).abs() < 1e-9, "{moved} vs {expected}");
     }
 
     /// A texture line crossing a better-supported brightness line inside the frame is not an edge of the
