@@ -359,7 +359,8 @@ struct Point {
 /// tracker found, if the ball's trajectory agrees that the contact is there (else the other cue's line, if
 /// it agrees), its level moved towards the trajectory's by their inverse-variance weights
 /// ([`Estimate::trajectory_share`]); the contact level the trajectory gives (see `contact.rs`). The local
-/// frame follows that line's tilt in the image.
+/// frame follows that line's tilt in the image, weighed with the tilt a ball dropped from rest implies where
+/// the two agree (`fall.rs`).
 ///
 /// Frames the tracker did not take for the ball (`ambiguous`) are not used; when the track has
 /// any, a shot that cannot be measured says so with its reason ([`EstimateError::Ambiguous`]: they are the
