@@ -97,8 +97,9 @@ pub(crate) fn session_key(session: &Session) -> String {
 /// against its neighbouring frames' mean rim, and moved onto the limb's silhouette; 25: a lost ball looked
 /// for again frame by frame after a seed, not by its sightings' gap; 26: in noisy frames, a lost ball looked
 /// for by its rim's strength around the prediction; 27: the surface's tilt weighed with the one the ball's
-/// fall from rest implies).
-const MEASUREMENT_REVISION: u32 = 27;
+/// fall from rest implies; 28: a found line the ball passes in front of given up for the next line below,
+/// and the limb learned over the whole flight, before and after the bounce).
+const MEASUREMENT_REVISION: u32 = 28;
 
 /// Everything besides the frame files that changes a shot's track or estimate.
 fn settings_text(entry: &ClipEntry, gravity: f64) -> String {

@@ -100,13 +100,13 @@ fn bench(c: &mut Criterion) {
     g.bench_function("limb_learn_frame", |b| {
         b.iter(|| {
             let mut l = LimbLearner::default();
-            l.add(&Plane::new(&frames[10], 512, 512), circle(10), 128);
+            l.add(&Plane::new(&frames[10], 512, 512), circle(10), 128, None);
             black_box(l.frames())
         })
     });
     let mut limb = LimbLearner::default();
     for (i, f) in frames.iter().enumerate().take(64) {
-        limb.add(&Plane::new(f, 512, 512), circle(i), 128);
+        limb.add(&Plane::new(f, 512, 512), circle(i), 128, None);
     }
     g.bench_function("limb_offset", |b| b.iter(|| black_box(limb.offset())));
     let frame = Plane::new(&frames[10], 512, 512);

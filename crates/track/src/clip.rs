@@ -284,19 +284,60 @@ pub fn track_clip(
         surface: given_line(clip, opts),
     };
     let (early, early_radius) = backward.before_seed(seed, seed_file)?;
-    let mut tracker = Tracker::new(TrackOptions {
-        radius_px: Some(radius),
-        ..opts.tracker.clone()
-    });
     let (a, b) = forward_seed(&early, seed);
-    tracker.seed(a, b);
-    if let Some(r) = early_radius {
-        tracker.expect_radius(r);
+    let seeded = |line: Option<Option<SurfaceLine>>| {
+        let mut tracker = Tracker::new(TrackOptions {
+            radius_px: Some(radius),
+            ..opts.tracker.clone()
+        });
+        tracker.seed(a, b);
+        if let Some(r) = early_radius {
+            tracker.expect_radius(r);
+        }
+        match line {
+            Some(Some(line)) => tracker.set_surface(line),
+            Some(None) => tracker.forgo_surface(),
+            None => {}
+        }
+        tracker
+    };
+    let mut tracker = seeded(given_line(clip, opts).map(Some));
+    let mut forward = track_forward(frames, clip.len(), opts.roi, gain, &mut tracker, &mut progress)?;
+    let mut alternatives = tracker.surface_alternatives().to_vec();
+    if given_line(clip, opts).is_none()
+        && let Some(line) = tracker.surface().copied()
+        && let Some(seen) = ball_in_front(clip, opts, gain, &forward.fixes, &line)?
+    {
+        let mut rest = alternatives.into_iter();
+        let mut surface = None;
+        for alt in rest.by_ref() {
+            if ball_in_front(clip, opts, gain, &forward.fixes, &alt)?.is_none() {
+                surface = Some(alt);
+                break;
+            }
+        }
+        alternatives = rest.collect();
+        warnings.push(format!(
+            "the line found at y = {:.1} px is not the surface: the ball passes in front of it (its rim goes on {:.0} px below it in {} of {} frames searched); {}",
+            line.y0 + roi_origin(opts.roi.as_ref()).1,
+            seen.deepest_px,
+            seen.seen,
+            seen.frames,
+            match &surface {
+                Some(l) => format!("tracked again on the line below it, at y = {:.1} px", l.y0 + roi_origin(opts.roi.as_ref()).1),
+                None => "tracked again without a surface line".to_string(),
+            }
+        ));
+        tracker = seeded(Some(surface));
+        forward = track_forward(
+            clip.frames_with(&opts.read)?,
+            clip.len(),
+            opts.roi,
+            gain,
+            &mut tracker,
+            &mut progress,
+        )?;
     }
-    if let Some(line) = given_line(clip, opts) {
-        tracker.set_surface(line);
-    }
-    let forward = track_forward(frames, clip.len(), opts.roi, gain, &mut tracker, &mut progress)?;
     warnings.extend(tracker.warnings().iter().cloned());
     let mut fixes = forward.fixes;
     for (fix, old) in early.into_iter().zip(fixes.iter_mut()) {
@@ -372,7 +413,7 @@ pub fn track_clip(
     Ok(Track {
         fixes,
         surface: tracker.surface().map(whole),
-        surface_alternatives: tracker.surface_alternatives().iter().map(whole).collect(),
+        surface_alternatives: alternatives.iter().map(whole).collect(),
         scale,
         warnings,
         seconds_waiting: forward.seconds_waiting,
@@ -442,6 +483,30 @@ fn remeasure_on_neighbours(
         }
     }
     Ok(())
+}
+
+/// Whether the forward track's ball is seen in front of `line` ([`crate::in_front`]): the frames where it
+/// reaches deepest below the line are read again and their rims searched round.
+fn ball_in_front(
+    clip: &Clip,
+    opts: &ClipTracking,
+    gain: f32,
+    fixes: &[BallFix],
+    line: &SurfaceLine,
+) -> Result<Option<crate::in_front::InFront>, TrackError> {
+    let search = &opts.tracker.search;
+    crate::in_front::ball_in_front_of(line, fixes, search, |k, f| {
+        let Some(frame) = clip.read(k, opts.read.png_decoder) else {
+            return Ok(None);
+        };
+        let image = in_region(frame?, opts.roi.as_ref());
+        let depth = crate::in_front::band_depth_px(f.r_px);
+        Ok(Some(with_plane(
+            &image.pixels,
+            gain,
+            |p| on_plane!(p, p => crate::refine::rim_about_line(&p, (f.x_px, f.y_px, f.r_px), search, line, depth)),
+        )))
+    })
 }
 
 /// Moves every measured circle onto the limb's silhouette (see [`LimbOffset`](crate::LimbOffset)): its

@@ -19,6 +19,7 @@ mod bounce;
 mod circle_fit;
 mod clip;
 mod hough;
+mod in_front;
 mod level;
 mod limb;
 mod local;

@@ -2,23 +2,27 @@
 //! where that shading meets a backdrop of about its own gray, the steepest change along a ray is the
 //! shading's, inside the silhouette, so the fitted circles are small and off-centre by up to a pixel.
 //!
-//! Measured on the mean radial profile of the full-rim flight frames that teach the rim's shape (clean or
-//! not), each taken along its own fitted circle's rays (the light does not turn with the ball; the felt's
-//! texture averages out): on each ray a limb `a + b·√(R − s) + e·(R − s)` inside the silhouette `R` and a
-//! constant `c` outside, blurred by the pixel's width, the bilinear sampling along the ray and an optical
+//! Measured on the mean radial profile of the full-rim free-flight frames, before the bounce and after it
+//! (clean or not), each taken along its own fitted circle's rays (the light does not turn with the ball;
+//! the felt's texture, a seam turning with the ball and the backdrop passing behind the rim average out
+//! over the flight): on each ray a limb `a + b·√(R − s) + e·(R − s)` inside the silhouette `R` and a
+//! constant `c` outside (or `c + d·(s − R)` where that fits clearly better: a ruler's edge or a fixture
+//! behind the rim), blurred by the pixel's width, the bilinear sampling along the ray and an optical
 //! spread, is fitted by least squares over `R`, on the last 4 px inside the fitted rim and 5 px outside it.
 //! The root is a Lambertian limb's darkening; with the linear term the model also follows a felt's sheen,
 //! which brightens the last pixels of a shaded limb until they cross the backdrop's gray inside the
 //! silhouette (a sheen (1 − n_z)³, with n_z ≈ √(2(R − s)/r), is 1 − 3·n_z + 3·n_z² − … there). The optical
 //! spread is the one of nine (0–1.5 px) whose limbs fit all rays best: the silhouette found moves inwards
 //! by 0.4–1 px per px of spread assumed, so the spread is measured, not assumed. The silhouette's mean `R`
-//! and its first harmonic round the rim are how far the fitted circles' radius and centre lie from it, and
-//! the track moves every circle by them. A limb model is one account of the shading among others (a fuzzy
-//! felt, a seam), so their size stays the standard uncertainty of that correction. Cost: 53 samples per ray
-//! per frame learned (48 µs for 128 rays), and 13 ms once per clip for the fit (the track bench's
-//! `limb_learn_frame` and `limb_offset`).
+//! and its first harmonic round the rim, each ray weighed by how closely its fit pins `R`, are how far the
+//! fitted circles' radius and centre lie from it, and the track moves every circle by them. A limb model
+//! is one account of the shading among others (a fuzzy felt, a seam), so their size stays the standard
+//! uncertainty of that correction. Cost: 53 samples per ray per frame learned (51 µs for 128 rays), and
+//! 30 ms once per clip for the fit (the track bench's `limb_learn_frame` and `limb_offset`).
 
+use crate::circle_fit::weighted_first_harmonic;
 use crate::plane::{Pixel, Plane};
+use crate::surface::SurfaceLine;
 
 /// Sampling step along a ray, px.
 const STEP_PX: f64 = 0.25;
@@ -40,6 +44,14 @@ const BLURS_PX: [f64; 9] = [0.0, 0.125, 0.25, 0.375, 0.5, 0.625, 0.75, 1.0, 1.5]
 const LMS_JITTER: i64 = 3;
 /// The rays' spread about the harmonic taken as at least this, px, so that a clean limb keeps its rays.
 const MIN_SPREAD_PX: f64 = 0.15;
+/// Added in quadrature to each ray's silhouette uncertainty when the rays are weighed, px: what the limb
+/// model itself leaves unsaid (a felt's texture, the seam), so that no ray with a sharp fit outweighs the
+/// rest.
+const SILHOUETTE_FLOOR_PX: f64 = 0.1;
+/// By how much a backdrop sloping across the rim must cut a ray's squared misfit before it is taken over a
+/// constant one: an F test at 10 % with the ≈ 9 independent samples of the 37 fitted (four to a pixel,
+/// blurred), `(gain − 1)·3 > 5.5`.
+const SLOPE_GAIN: f64 = 3.0;
 /// Fewest frames averaged before the offset is told.
 const MIN_FRAMES: usize = 8;
 
@@ -99,9 +111,17 @@ impl LimbLearner {
         self.frames
     }
 
-    /// Adds `img`'s profile along `rays` rays of the circle fitted to it, `(x, y, r)` px (a ray with a sample
-    /// outside the image is skipped in this frame).
-    pub fn add<P: Pixel>(&mut self, img: &Plane<P>, (x, y, r): (f64, f64, f64), rays: usize) {
+    /// Adds `img`'s profile along `rays` rays of the circle fitted to it, `(x, y, r)` px. A ray with a
+    /// sample outside the image, or one reaching the surface band (a point that does not clear it as a
+    /// disc of no radius would, [`SurfaceLine::clears_disc`]: a ball just above the band has the band's
+    /// top in its lower rays' backdrop), is skipped in this frame.
+    pub fn add<P: Pixel>(
+        &mut self,
+        img: &Plane<P>,
+        (x, y, r): (f64, f64, f64),
+        rays: usize,
+        surface: Option<&SurfaceLine>,
+    ) {
         let n = samples();
         if self.rays != rays {
             *self = LimbLearner {
@@ -116,7 +136,11 @@ impl LimbLearner {
             let (s, c) = (std::f64::consts::TAU * i as f64 / rays as f64).sin_cos();
             let inside = (0..n).all(|k| {
                 let d = r + sample_at(k);
-                match img.sample((x + c * d) as f32, (y + s * d) as f32) {
+                let (px, py) = (x + c * d, y + s * d);
+                if surface.is_some_and(|l| !l.clears_disc(px, py, 0.0)) {
+                    return false;
+                }
+                match img.sample(px as f32, py as f32) {
                     Some(v) => {
                         profile[k] = v as f64;
                         true
@@ -152,9 +176,10 @@ impl LimbLearner {
         })
     }
 
-    /// Each ray's silhouette, (angle, px from the fitted rim), under the optical spread whose limbs fit all
-    /// rays' mean profiles best; rays whose best lies at either end of the tried range are left out.
-    fn silhouettes(&self) -> Option<Vec<(f64, f64)>> {
+    /// Each ray's silhouette, (angle, px from the fitted rim, its standard uncertainty px), under the
+    /// optical spread whose limbs fit all rays' mean profiles best; rays whose best lies at either end of
+    /// the tried range are left out.
+    fn silhouettes(&self) -> Option<Vec<(f64, f64, f64)>> {
         let n = samples();
         let from = (0..n).position(|k| sample_at(k) >= FIT_FROM_PX - 1e-9)?;
         let profiles: Vec<(f64, Vec<f64>)> = (0..self.rays)
@@ -173,18 +198,25 @@ impl LimbLearner {
                 (fits.iter().map(|f| f.1.1).sum::<f64>(), fits)
             })
             .min_by(|a, b| a.0.total_cmp(&b.0))?;
-        Some(fits.iter().filter_map(|&(t, (r, _))| r.map(|r| (t, r))).collect())
+        Some(
+            fits.iter()
+                .filter_map(|&(t, (r, _, sd))| r.map(|r| (t, r, sd)))
+                .collect(),
+        )
     }
 }
 
-/// The first harmonic `[mean, cos, sin]` of the silhouettes `edges` (angle, px) round the rim, robust to a
-/// cluster of rays bent away from any limb (a seam, a fixture's edge), towards which a least-squares
-/// harmonic would bend and hide it: first the harmonic through three rays a third of the rim apart with
-/// the least median misfit over all rays (least median of squares), then least squares over the rays within
-/// 3 robust σ of it, or over all rays if that keeps fewer than half of the `rays`. Cost: 49 triples per ray,
+/// The first harmonic `[mean, cos, sin]` of the silhouettes `edges` (angle, px, standard uncertainty px)
+/// round the rim, robust to a cluster of rays bent away from any limb (a seam, a fixture's edge), towards
+/// which a least-squares harmonic would bend and hide it: first the harmonic through three rays a third of
+/// the rim apart with the least median misfit over all rays (least median of squares), then weighted least
+/// squares over the rays within 3 robust σ of it, or over all rays if that keeps fewer than half of the
+/// `rays`. Each ray weighs by its silhouette's uncertainty with [`SILHOUETTE_FLOOR_PX`] added (in
+/// quadrature): a limb of about the backdrop's gray pins its silhouette loosely. Cost: 49 triples per ray,
 /// each with a median over all rays.
-fn robust_harmonic(edges: &[(f64, f64)], rays: usize) -> Option<[f64; 3]> {
-    let edges: Vec<(f64, f64, f64)> = edges.iter().map(|&(t, r)| (t.cos(), t.sin(), r)).collect();
+fn robust_harmonic(edges: &[(f64, f64, f64)], rays: usize) -> Option<[f64; 3]> {
+    let spreads: Vec<f64> = edges.iter().map(|e| e.2).collect();
+    let edges: Vec<(f64, f64, f64)> = edges.iter().map(|&(t, r, _)| (t.cos(), t.sin(), r)).collect();
     let harmonic = |edges: &[(f64, f64, f64)]| crate::circle_fit::first_harmonic(edges.iter().copied());
     let misfit = |fit: &[f64; 3], &(c, s, r): &(f64, f64, f64)| (r - fit[0] - fit[1] * c - fit[2] * s).abs();
     let median_misfit = |fit: &[f64; 3]| {
@@ -211,27 +243,30 @@ fn robust_harmonic(edges: &[(f64, f64)], rays: usize) -> Option<[f64; 3]> {
     }
     let (median, start) = best?;
     let sigma = 1.4826 * (1.0 + 5.0 / (n as f64 - 3.0)) * median;
-    let kept: Vec<(f64, f64, f64)> = edges
+    let weighed =
+        |(&(c, s, r), &sd): (&(f64, f64, f64), &f64)| (c, s, r, 1.0 / (sd * sd + SILHOUETTE_FLOOR_PX.powi(2)));
+    let kept: Vec<(f64, f64, f64, f64)> = edges
         .iter()
-        .copied()
-        .filter(|e| misfit(&start, e) <= 3.0 * sigma.max(MIN_SPREAD_PX))
+        .zip(&spreads)
+        .filter(|(e, _)| misfit(&start, e) <= 3.0 * sigma.max(MIN_SPREAD_PX))
+        .map(weighed)
         .collect();
     if kept.len() * 2 >= rays {
-        harmonic(&kept)
+        weighted_first_harmonic(kept)
     } else {
-        harmonic(&edges)
+        weighted_first_harmonic(edges.iter().zip(&spreads).map(weighed))
     }
 }
 
-/// The blurred limb's three inside shapes (a step, √(R − s) and R − s) sampled at the profile's points, for
-/// every silhouette tried.
+/// The blurred limb's three inside shapes (a step, √(R − s) and R − s) and two outside ones (a step and
+/// s − R) sampled at the profile's points, for every silhouette tried.
 struct LimbModel {
     shapes: Vec<Silhouette>,
 }
 
-/// One silhouette tried: R, the four columns of the fit over the fitted samples (step, root and linear
-/// inside, step outside) and their Gram matrix, which does not depend on the profile.
-type Silhouette = (f64, [Vec<f64>; 4], [[f64; 4]; 4]);
+/// One silhouette tried: R, the five columns of the fit over the fitted samples (step, root and linear
+/// inside, step and linear outside) and their Gram matrix, which does not depend on the profile.
+type Silhouette = (f64, [Vec<f64>; 5], [[f64; 5]; 5]);
 
 impl LimbModel {
     /// The shapes blurred by the pixel's width and an optical spread of `blur_px` (Gaussian σ), over the
@@ -261,9 +296,9 @@ impl LimbModel {
             grid(R_FROM_PX + FIT_FROM_PX.min(0.0) - OUTER_PX) - half,
             grid(R_TO_PX + INNER_PX) + half,
         );
-        let blurred: Vec<[f64; 3]> = (lo..=hi)
+        let blurred: Vec<[f64; 4]> = (lo..=hi)
             .map(|d| {
-                let mut acc = [0.0; 3];
+                let mut acc = [0.0; 4];
                 for (t, w) in kernel.iter().enumerate() {
                     let steps_in = d - (t as i64 - half);
                     let depth = steps_in as f64 * dt;
@@ -272,6 +307,8 @@ impl LimbModel {
                     if steps_in > 0 {
                         acc[1] += w / norm * depth.sqrt();
                         acc[2] += w / norm * depth;
+                    } else {
+                        acc[3] -= w / norm * depth;
                     }
                 }
                 acc
@@ -282,16 +319,16 @@ impl LimbModel {
         let shapes = (0..=steps)
             .map(|j| {
                 let r = R_FROM_PX + j as f64 * R_STEP_PX;
-                let mut cols: [Vec<f64>; 4] = Default::default();
+                let mut cols: [Vec<f64>; 5] = Default::default();
                 for k in from..samples() {
-                    let [step, root, linear] = at(r - sample_at(k));
-                    for (col, v) in cols.iter_mut().zip([step, root, linear, 1.0 - step]) {
+                    let [step, root, linear, outside] = at(r - sample_at(k));
+                    for (col, v) in cols.iter_mut().zip([step, root, linear, 1.0 - step, outside]) {
                         col.push(v);
                     }
                 }
-                let mut ata = [[0.0f64; 4]; 4];
-                for p in 0..4 {
-                    for q in 0..4 {
+                let mut ata = [[0.0f64; 5]; 5];
+                for p in 0..5 {
+                    for q in 0..5 {
                         ata[p][q] = cols[p].iter().zip(&cols[q]).map(|(a, b)| a * b).sum();
                     }
                 }
@@ -302,25 +339,53 @@ impl LimbModel {
     }
 
     /// The silhouette, px from the fitted rim, whose limb fits `y` (the samples from the model's `from` on)
-    /// best (`None` at either end of the tried range), and that fit's sum of squared residuals.
-    fn best_silhouette(&self, y: &[f64]) -> (Option<f64>, f64) {
+    /// best (`None` at either end of the tried range), that fit's sum of squared residuals, and the
+    /// silhouette's standard uncertainty, px: half the range of silhouettes whose fit lies within one unit
+    /// of χ² of the best (the noise taken from the best fit's residuals). The backdrop outside is a
+    /// constant, or a straight line across the rim where that fits clearly better ([`SLOPE_GAIN`]): a
+    /// ruler's edge or a fixture behind the rim.
+    fn best_silhouette(&self, y: &[f64]) -> (Option<f64>, f64, f64) {
         let yy: f64 = y.iter().map(|v| v * v).sum();
-        let mut best = (f64::INFINITY, 0usize);
-        for (j, (_, cols, ata)) in self.shapes.iter().enumerate() {
-            let atb = cols
-                .each_ref()
-                .map(|c| c.iter().zip(y).map(|(a, b)| a * b).sum::<f64>());
-            let Some(c) = solve_spd(*ata, atb) else {
-                continue;
-            };
-            let sse = yy - (0..4).map(|p| c[p] * atb[p]).sum::<f64>();
-            if sse < best.0 {
-                best = (sse, j);
-            }
-        }
-        let j = best.1;
-        let inside = best.0.is_finite() && j > 0 && j + 1 < self.shapes.len();
-        (inside.then(|| self.shapes[j].0), best.0)
+        let (constant, sloped): (Vec<f64>, Vec<f64>) = self
+            .shapes
+            .iter()
+            .map(|(_, cols, ata)| {
+                let atb = cols
+                    .each_ref()
+                    .map(|c| c.iter().zip(y).map(|(a, b)| a * b).sum::<f64>());
+                let sloped =
+                    solve_spd(*ata, atb).map_or(f64::INFINITY, |c| yy - (0..5).map(|p| c[p] * atb[p]).sum::<f64>());
+                let a4: [[f64; 4]; 4] = std::array::from_fn(|p| std::array::from_fn(|q| ata[p][q]));
+                let b4: [f64; 4] = std::array::from_fn(|p| atb[p]);
+                let constant =
+                    solve_spd(a4, b4).map_or(f64::INFINITY, |c| yy - (0..4).map(|p| c[p] * b4[p]).sum::<f64>());
+                (constant, sloped)
+            })
+            .unzip();
+        let least = |v: &[f64]| v.iter().copied().fold(f64::INFINITY, f64::min);
+        let sses = if least(&constant) > SLOPE_GAIN * least(&sloped) {
+            sloped
+        } else {
+            constant
+        };
+        let (j, best) = sses
+            .iter()
+            .copied()
+            .enumerate()
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .unwrap_or((0, f64::INFINITY));
+        let inside = best.is_finite() && j > 0 && j + 1 < self.shapes.len();
+        let var = (best / (y.len() as f64 - 5.0).max(1.0)).max(1e-12);
+        let within: Vec<f64> = sses
+            .iter()
+            .zip(&self.shapes)
+            .filter(|(s, _)| (*s - best) / var <= 1.0)
+            .map(|(_, sh)| sh.0)
+            .collect();
+        let lo = within.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = within.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let spread = (0.5 * (hi - lo)).max(0.5 * R_STEP_PX);
+        (inside.then(|| self.shapes[j].0), best, spread)
     }
 }
 
@@ -405,7 +470,7 @@ mod tests {
         let img = Plane::new(px, w, w);
         let mut learner = LimbLearner::default();
         for _ in 0..MIN_FRAMES {
-            learner.add(&img, fit, 64);
+            learner.add(&img, fit, 64, None);
         }
         learner.offset()
     }
@@ -459,6 +524,30 @@ mod tests {
         };
         let px = drawn(128, cx, cy, r, seam, 100.0);
         let o = offset_of(&px, 128, (cx + 0.3, cy - 0.4, r - 0.5)).expect("a limb on most rays");
+        assert_told(&o, 0.5, (-0.3, 0.4));
+    }
+
+    /// A backdrop whose gray rises away from the lower third of the rim by 6 DN a pixel (the blurred mean of
+    /// a ruler's edges passing behind it over the flight): a constant backdrop puts those rays' silhouettes
+    /// off and pulls the centre; a backdrop sloping across the rim, taken where it fits clearly better, does
+    /// not.
+    #[test]
+    fn a_backdrop_sloping_across_the_rim_does_not_pull_the_offset() {
+        let (w, cx, cy, r) = (128, 64.4, 63.7, 50.0);
+        let limb = |_: f64, _: f64, n_z: f64| 70.0 + 60.0 * n_z;
+        let mut px = drawn(w, cx, cy, r, limb, 100.0);
+        let sharp = drawn(w, cx, cy, r, limb, 0.0);
+        for (k, v) in px.iter_mut().enumerate() {
+            let (x, y) = ((k % w) as f64 + 0.5, (k / w) as f64 + 0.5);
+            // Where the backdrop shows (the part of the pixel outside the ball): the ball's own gray is the
+            // same in both drawings.
+            let outside = (*v - sharp[k]) / 100.0;
+            let (dx, dy) = (x - cx, y - cy);
+            if dy > 0.5 * dx.hypot(dy) {
+                *v += outside * (6.0 * (dx.hypot(dy) - r).max(0.0)) as f32;
+            }
+        }
+        let o = offset_of(&px, w, (cx + 0.3, cy - 0.4, r - 0.5)).expect("a limb on most rays");
         assert_told(&o, 0.5, (-0.3, 0.4));
     }
 
@@ -519,7 +608,7 @@ mod tests {
         let img = Plane::new(&px, 96, 96);
         let fit = (48.0, 48.0, 25.0);
         let mut learner = LimbLearner::default();
-        learner.add(&img, fit, 64);
+        learner.add(&img, fit, 64, None);
         assert_eq!(learner.offset(), None);
     }
 }

@@ -667,6 +667,79 @@ fn rim_edges<P: Pixel>(
     edges
 }
 
+/// How far an edge may lie from the circle for its ray to count as seeing the rim, px: the edge search's
+/// own scatter on a soft, noisy rim is a few tenths of a pixel, and a circle fitted to the arc above a
+/// line extrapolates its bottom to a fraction of one, while a ray on something else finds its strongest
+/// step anywhere in the ±4 px window (within 0.75 px of the circle one time in five).
+const RIM_SEEN_PX: f64 = 0.75;
+
+/// What the rays of a circle saw of its rim in a band just below a line, against what they saw above it.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub(crate) struct RimAboutLine {
+    /// Rays whose rim point lies in the band below the line (past the line's margin, `depth_px` deep).
+    pub below: usize,
+    /// Of those, the rays whose edge lies within [`RIM_SEEN_PX`] of the circle.
+    pub below_seen: usize,
+    /// Rays whose rim point lies above the line's margin.
+    pub above: usize,
+    /// Of those, the rays whose edge lies within [`RIM_SEEN_PX`] of the circle.
+    pub above_seen: usize,
+}
+
+impl RimAboutLine {
+    /// Whether the rim goes on below the line as it runs above it: at least 6 rays below, half of them
+    /// seeing the rim, and seeing it at least 0.6 times as often as the rays above. A surface's band hides
+    /// the ball's rim below its top, or replaces it with its own texture, whose strongest steps fall on the
+    /// circle by chance only (about one ray in four).
+    pub fn rim_goes_on(&self) -> bool {
+        let share = |seen: usize, of: usize| seen as f64 / of.max(1) as f64;
+        self.below >= 6
+            && 2 * self.below_seen >= self.below
+            && share(self.below_seen, self.below) >= 0.6 * share(self.above_seen, self.above)
+    }
+}
+
+/// The rim of circle (x, y, r) searched on every ray, the surface ignored, and counted against `line`: the
+/// rays whose rim point lies below the line by more than its margin (`search.surface_margin` and the line's
+/// ragged reach, within which [`refine_circle`] hides a ray either way) and at most `depth_px` more, and the
+/// rays above it by more than the margin, each with how many
+/// found their edge on the circle. Tells a line the ball passes in front of (a ruler's edge, a shelf) from
+/// the surface it lands on. Cost: one edge search round the rim (≈ 10 µs).
+pub(crate) fn rim_about_line<P: Pixel>(
+    img: &Plane<P>,
+    (x, y, r): (f64, f64, f64),
+    search: &EdgeSearch,
+    line: &SurfaceLine,
+    depth_px: f64,
+) -> RimAboutLine {
+    let mut raw = Vec::new();
+    let plain = EdgeSearch {
+        rim_shape: None,
+        ..search.clone()
+    };
+    rim_edges(img, (x, y, r), &plain, plain.half_width, None, Some(&mut raw));
+    let n = plain.rays.max(8);
+    let margin = plain.surface_margin + line.ragged_reach_px();
+    let mut seen = vec![false; n];
+    for &(ray, [px, py]) in &raw {
+        seen[ray] = ((px - x).hypot(py - y) - r).abs() <= RIM_SEEN_PX;
+    }
+    let mut about = RimAboutLine::default();
+    for (ray, &on_rim) in seen.iter().enumerate() {
+        let (s, c) = (std::f64::consts::TAU * ray as f64 / n as f64).sin_cos();
+        let (rx, ry) = (x + r * c, y + r * s);
+        let below = ry - line.y_at(rx);
+        if below <= -margin {
+            about.above += 1;
+            about.above_seen += usize::from(on_rim);
+        } else if below > margin && below <= margin + depth_px {
+            about.below += 1;
+            about.below_seen += usize::from(on_rim);
+        }
+    }
+    about
+}
+
 /// Neighbouring rays see overlapping texture, so their edge errors are correlated and the fit's σ (which
 /// assumes independent points) is optimistic: σ is inflated by the AR(1) factor √((1+ρ)/(1−ρ)), with ρ the
 /// lag-1 correlation of the residuals around the rim (points are in ray order), measured on this frame.
@@ -1121,5 +1194,44 @@ mod tests {
             .map(|(i, o)| o * (std::f64::consts::TAU * i as f64 / n).cos())
             .sum();
         assert!(mean.abs() < 1e-12 && c1.abs() < 1e-12, "{mean} {c1}");
+    }
+
+    /// A ball in front of a dark strip whose lower edge is the line: its rim goes on below the line as it
+    /// runs above it. The same ball behind a grainy band whose top is the line: the rays below it find
+    /// the grains' steps, on the circle by chance only.
+    #[test]
+    fn the_rim_goes_on_below_a_line_behind_the_ball_not_below_a_band_in_front() {
+        let (cx, cy, r, line_y) = (110.4, 100.7, 50.0, 135.0);
+        let disc = lit_ball(cx, cy, r, None);
+        let behind: Vec<u8> = disc
+            .iter()
+            .enumerate()
+            .map(|(k, &v)| {
+                let (x, y) = ((k % SIZE) as f64, (k / SIZE) as f64);
+                let outside = (x - cx).hypot(y - cy) > r + 1.0;
+                if outside && (120.0..line_y).contains(&y) { 10 } else { v }
+            })
+            .collect();
+        let grain = |k: usize| ((k * 7919) % 97) as u8;
+        let in_front: Vec<u8> = disc
+            .iter()
+            .enumerate()
+            .map(|(k, &v)| if (k / SIZE) as f64 >= line_y { 70 + grain(k) } else { v })
+            .collect();
+        let search = EdgeSearch::default();
+        let about = |img: &[u8]| {
+            rim_about_line(
+                &Plane::new(img, SIZE, SIZE),
+                (cx, cy, r),
+                &search,
+                &line_at(line_y),
+                12.5,
+            )
+        };
+        let seen = about(&behind);
+        assert!(seen.below >= 6 && seen.rim_goes_on(), "{seen:?}");
+        let hidden = about(&in_front);
+        assert!(hidden.below >= 6 && !hidden.rim_goes_on(), "{hidden:?}");
+        assert_eq!((seen.below, seen.above), (hidden.below, hidden.above));
     }
 }

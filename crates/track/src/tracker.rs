@@ -194,8 +194,8 @@ pub struct Tracker {
     /// the shape they give is not applied, only its RMS taken for the rim's errors when no clean frame
     /// taught one (see [`Tracker::rim_shape_rms_px`]).
     rim_doubtful: RimShapeLearner,
-    /// The mean radial profile of the same full-rim free-flight frames, clean or not: where the limb's
-    /// silhouette lies against the fitted circles (see [`Tracker::limb_offset`]).
+    /// The mean radial profile of the full-rim free-flight frames, before the bounce and after it, clean or
+    /// not: where the limb's silhouette lies against the fitted circles (see [`Tracker::limb_offset`]).
     limb: LimbLearner,
     rim_frozen: bool,
     /// The edge points `(ray, [x, y])` of this frame's search around the prediction while the rim's shape
@@ -241,6 +241,9 @@ const EDGE_SAMPLES: usize = 64;
 /// Full-rim free-flight frames the rim's shape is learned from (at most), and before it is used (at least).
 const RIM_SAMPLES: usize = 64;
 const RIM_MIN_SAMPLES: usize = 16;
+/// Most full-rim free-flight frames whose profiles teach the limb ([`LimbOffset`]): a drop clip's whole
+/// flight at 10,000 frames/s. Cost: 48 µs a frame learned.
+const LIMB_SAMPLES: usize = 256;
 
 /// Quality of a clean circle: about 85 % of the rays kept at full contrast (a ball's rim refines to near
 /// 1; a seam or a texture ghost does not).
@@ -372,6 +375,14 @@ impl Tracker {
         self.surface_stack = Vec::new();
     }
 
+    /// No surface line, and none looked for in the frames (the one found was not the surface).
+    pub fn forgo_surface(&mut self) {
+        self.surface = None;
+        self.surface_alternatives.clear();
+        self.surface_tries = SURFACE_TRIES;
+        self.surface_stack = Vec::new();
+    }
+
     /// The surface line, once found.
     pub fn surface(&self) -> Option<&SurfaceLine> {
         self.surface.as_ref()
@@ -398,8 +409,8 @@ impl Tracker {
         *e.select_nth_unstable_by(mid, f64::total_cmp).1
     }
 
-    /// How far the limb's silhouette lies from the circles fitted in free flight, measured on the full-rim
-    /// free-flight frames that teach the rim's shape (see [`LimbOffset`]); `None` before 8 of them.
+    /// How far the limb's silhouette lies from the circles fitted in free flight, measured on up to
+    /// [`LIMB_SAMPLES`] full-rim free-flight frames (see [`LimbOffset`]); `None` before 8 of them.
     pub fn limb_offset(&self) -> Option<LimbOffset> {
         self.limb.offset()
     }
@@ -1143,6 +1154,17 @@ impl Tracker {
                 self.qualities.remove(0);
             }
         }
+        // Every full-rim flight frame, before the bounce and after it, teaches the limb: the felt's texture,
+        // a seam turning with the ball and the backdrop behind the rim average out of its mean profile.
+        if status == Status::Ok
+            && clear
+            && f.rays_hidden == 0
+            && f.rays_outside == 0
+            && self.limb.frames() < LIMB_SAMPLES
+        {
+            let rays = self.opts.search.rays.max(8);
+            self.limb.add(img, (fit.x, fit.y, fit.r), rays, self.surface.as_ref());
+        }
         if status == Status::Ok && clear && f.rays_hidden == 0 {
             self.flight_radii.push(fit.r);
             if self.flight_radii.len() > 64 {
@@ -1167,7 +1189,6 @@ impl Tracker {
                     residuals_about(&fit, &self.rim_rays)
                 };
                 let rays = self.opts.search.rays.max(8);
-                self.limb.add(img, (fit.x, fit.y, fit.r), rays);
                 if clean {
                     self.rim.add(rays, &res);
                     if self.rim.frames() >= RIM_MIN_SAMPLES {
