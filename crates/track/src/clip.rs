@@ -276,16 +276,17 @@ pub fn track_clip(
     }
     // A ball first seen after the clip's first frames is followed back to its start from there: the
     // forward track then begins from where it was, not from its sightings extrapolated back.
+    let given = given_line(clip, opts);
     let mut backward = Backward {
         clip,
         opts,
         gain,
         radius,
-        surface: given_line(clip, opts),
+        surface: given,
     };
     let (early, early_radius) = backward.before_seed(seed, seed_file)?;
     let (a, b) = forward_seed(&early, seed);
-    let seeded = |line: Option<Option<SurfaceLine>>| {
+    let seeded = || {
         let mut tracker = Tracker::new(TrackOptions {
             radius_px: Some(radius),
             ..opts.tracker.clone()
@@ -294,17 +295,15 @@ pub fn track_clip(
         if let Some(r) = early_radius {
             tracker.expect_radius(r);
         }
-        match line {
-            Some(Some(line)) => tracker.set_surface(line),
-            Some(None) => tracker.forgo_surface(),
-            None => {}
-        }
         tracker
     };
-    let mut tracker = seeded(given_line(clip, opts).map(Some));
+    let mut tracker = seeded();
+    if let Some(line) = given {
+        tracker.set_surface(line);
+    }
     let mut forward = track_forward(frames, clip.len(), opts.roi, gain, &mut tracker, &mut progress)?;
     let mut alternatives = tracker.surface_alternatives().to_vec();
-    if given_line(clip, opts).is_none()
+    if given.is_none()
         && let Some(line) = tracker.surface().copied()
         && let Some(seen) = ball_in_front(clip, opts, gain, &forward.fixes, &line)?
     {
@@ -328,7 +327,11 @@ pub fn track_clip(
                 None => "tracked again without a surface line".to_string(),
             }
         ));
-        tracker = seeded(Some(surface));
+        tracker = seeded();
+        match surface {
+            Some(line) => tracker.set_surface(line),
+            None => tracker.forgo_surface(),
+        }
         forward = track_forward(
             clip.frames_with(&opts.read)?,
             clip.len(),

@@ -70,7 +70,7 @@ pub(crate) fn ball_in_front_of<E>(
         let Some(about) = rim_about(k, &fixes[k])? else {
             continue;
         };
-        if about.below >= 6 {
+        if about.tells() {
             frames += 1;
             seen += usize::from(about.rim_goes_on());
         }

@@ -687,13 +687,18 @@ pub(crate) struct RimAboutLine {
 }
 
 impl RimAboutLine {
-    /// Whether the rim goes on below the line as it runs above it: at least 6 rays below, half of them
-    /// seeing the rim, and seeing it at least 0.6 times as often as the rays above. A surface's band hides
-    /// the ball's rim below its top, or replaces it with its own texture, whose strongest steps fall on the
-    /// circle by chance only (about one ray in four).
+    /// Whether enough rays lie below the line to tell anything: at least 6.
+    pub fn tells(&self) -> bool {
+        self.below >= 6
+    }
+
+    /// Whether the rim goes on below the line as it runs above it: rays enough below it ([`Self::tells`]),
+    /// half of them seeing the rim, and seeing it at least 0.6 times as often as the rays above. A surface's
+    /// band hides the ball's rim below its top, or replaces it with its own texture, whose strongest steps
+    /// fall on the circle by chance only (about one ray in four or five).
     pub fn rim_goes_on(&self) -> bool {
         let share = |seen: usize, of: usize| seen as f64 / of.max(1) as f64;
-        self.below >= 6
+        self.tells()
             && 2 * self.below_seen >= self.below
             && share(self.below_seen, self.below) >= 0.6 * share(self.above_seen, self.above)
     }
@@ -1229,9 +1234,9 @@ mod tests {
             )
         };
         let seen = about(&behind);
-        assert!(seen.below >= 6 && seen.rim_goes_on(), "{seen:?}");
+        assert!(seen.tells() && seen.rim_goes_on(), "{seen:?}");
         let hidden = about(&in_front);
-        assert!(hidden.below >= 6 && !hidden.rim_goes_on(), "{hidden:?}");
+        assert!(hidden.tells() && !hidden.rim_goes_on(), "{hidden:?}");
         assert_eq!((seen.below, seen.above), (hidden.below, hidden.above));
     }
 }
