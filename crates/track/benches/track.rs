@@ -7,7 +7,8 @@
 //! clip's start, frames 0–32 from a fresh tracker: the cold start, then the frames while the surface line is
 //! looked for in the mean of the first 2 (the ball is known from the second frame), 8 and 32 frames. "cold_start_first_frame": the first frame of a
 //! clip without a track (Hough, refined candidates). "surface_line": one surface line search.
-//! "surface_level_by_mean_gray": the found line's level measured again from the band's mean gray.
+//! "surface_level_by_mean_gray": the found line's level measured again from the band's mean gray;
+//! "surface_level_by_textured_share": the same from the share of each row's pixels the backdrop cannot explain.
 //! "detect_full_frame": the Hough transform alone. "limb_learn_frame": one frame's radial profiles added to the
 //! limb's mean (128 rays); "limb_offset": the limb model fitted to the mean of 64 frames, once per clip.
 //! "rim_evidence": whether one fix's rim stands out of the noise (128 rays), once per accepted fix.
@@ -15,7 +16,7 @@
 use bouncelab_track::testutil::{Scene, render};
 use bouncelab_track::{
     CircleDetection, LimbLearner, Plane, TrackOptions, Tracker, detect_circles, find_surface_lines, mean_gray_level,
-    rim_evidence,
+    rim_evidence, textured_share_level,
 };
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
@@ -85,6 +86,9 @@ fn bench(c: &mut Criterion) {
     if let Some(lines) = find_surface_lines(&plane, ball) {
         g.bench_function("surface_level_by_mean_gray", |b| {
             b.iter(|| black_box(mean_gray_level(&plane, &lines.line, None)))
+        });
+        g.bench_function("surface_level_by_textured_share", |b| {
+            b.iter(|| black_box(textured_share_level(&plane, &lines.line, None)))
         });
     }
     let det = CircleDetection {

@@ -1,14 +1,24 @@
-//! The level of a found surface line measured again from the band's mean gray: where, along the line, the
-//! mean brightness is half-way between the backdrop's and the band's.
+//! The level of a found surface line measured again from how much of each row parallel to it the band
+//! covers: where, along the line, a row's pixels are half-way between the backdrop's and the band's.
 //!
 //! Both cues place a ragged edge's line above its middle: a column's strongest step, or its rise in texture
 //! energy, comes where the first grains reach, and the boundary between grains and backdrop adds texture of
-//! its own. The mean gray of a row parallel to the line is instead linear in how much of it the band covers,
-//! so in each block of columns the row where it is half-way between its levels well above and well below the
-//! line is where half the block's columns are covered: the median of the block's edge, whatever its
-//! roughness (a lip, a strip along the band's top brighter or darker than the band, still moves it). That
-//! needs a band whose mean gray differs from the backdrop's; on a band as gray as the backdrop the line is
-//! kept as found. Cost: one pass over the pixels within ±16 px of the line.
+//! its own. A statistic of a row's raw pixels that is linear in how much of the row the band covers does
+//! not: in each block of columns the row where it is half-way between its levels well above and well below
+//! the line is where half the block's columns are covered, the median of the block's edge, whatever its
+//! roughness (a lip, a strip along the band's top brighter or darker than the band, still moves it). Two
+//! such statistics are used:
+//! - the **mean gray**, where the band's differs from the backdrop's: the more precise;
+//! - else the **share of the row's pixels the backdrop cannot explain**: further from the backdrop's gray
+//!   (a straight-line trend fitted to the rows above the line, carried into the rows below) than three of
+//!   the backdrop's own standard deviations about that trend. A covered pixel lies out there with some
+//!   probability set by the band's texture and mean gray, an uncovered one with 0.3 %, so the share is
+//!   linear in the row's cover whatever the band's mean gray; each pixel counts once, so a screw head or a
+//!   grain far brighter than the rest weighs no more than any other covered pixel. It tells the level of
+//!   a granular or woven band as gray as the backdrop.
+//!
+//! On a band with neither a step in mean gray nor texture the line is kept as found. Cost: two passes over
+//! the pixels within ±16 px of the line.
 
 use crate::plane::{Pixel, Plane, median};
 use crate::surface::SurfaceLine;
@@ -27,6 +37,19 @@ const MIN_STEP_SE: f64 = 8.0;
 /// Fewest blocks with a crossing for the level to be measured again.
 const MIN_BLOCKS: usize = 5;
 
+/// How far from the backdrop's gray a pixel must lie to count as the band's, in the backdrop's own
+/// standard deviations about its trend: the conventional three, which noise alone passes 0.3 % of the time.
+const OUTLIER_SD: f64 = 3.0;
+
+/// What each row of a block is summarised by (see the module's description).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RowStatistic {
+    /// The row's mean gray.
+    MeanGray,
+    /// The share of the row's pixels further from the backdrop's gray than its noise allows.
+    TexturedShare,
+}
+
 /// How far the line's level moves and its standard error, px.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LevelShift {
@@ -36,6 +59,8 @@ pub struct LevelShift {
     pub sigma_px: f64,
     /// Blocks whose crossing was used.
     pub blocks: usize,
+    /// What the rows were summarised by.
+    pub statistic: RowStatistic,
 }
 
 /// Sum, sum of squares and count of the pixels in one 1 px bin of distance from the line, and the sum of
@@ -49,6 +74,12 @@ struct Bin {
 }
 
 impl Bin {
+    fn add(&mut self, v: f64, d: f64) {
+        self.sum += v;
+        self.sum_sq += v * v;
+        self.n += 1;
+        self.sum_d += d;
+    }
     fn distance(&self) -> f64 {
         self.sum_d / self.n as f64
     }
@@ -67,16 +98,37 @@ impl Bin {
 /// backdrop (large grains, shading within it) is not one whose mean gray tells its edge. Columns in `skip`
 /// (x from, x to, px) are left out: the ball, where it comes near the line. Cost: O(width × 34).
 pub fn mean_gray_level<P: Pixel>(img: &Plane<P>, line: &SurfaceLine, skip: Option<(f64, f64)>) -> Option<LevelShift> {
+    row_statistic_level(img, line, skip, RowStatistic::MeanGray)
+}
+
+/// The same as [`mean_gray_level`] from the share of each row's pixels further from the backdrop's gray than
+/// three of its standard deviations (see the module's description): the level of a band whose mean gray
+/// may equal the backdrop's but whose texture does not. Cost: O(width × 34 × 2).
+pub fn textured_share_level<P: Pixel>(
+    img: &Plane<P>,
+    line: &SurfaceLine,
+    skip: Option<(f64, f64)>,
+) -> Option<LevelShift> {
+    row_statistic_level(img, line, skip, RowStatistic::TexturedShare)
+}
+
+fn row_statistic_level<P: Pixel>(
+    img: &Plane<P>,
+    line: &SurfaceLine,
+    skip: Option<(f64, f64)>,
+    statistic: RowStatistic,
+) -> Option<LevelShift> {
     let span = SPAN_PX;
     let nbins = (2 * span + 1) as usize;
     let mut offsets = Vec::new();
     let mut looked = 0usize;
+    let mut samples: Vec<(usize, f64, f64)> = Vec::with_capacity(BLOCK_PX * nbins);
     for x_lo in (0..img.width.saturating_sub(BLOCK_PX - 1)).step_by(BLOCK_PX) {
         let x_hi = x_lo + BLOCK_PX - 1;
         if skip.is_some_and(|(a, b)| (x_lo as f64) <= b && (x_hi as f64) >= a) {
             continue;
         }
-        let mut bins = vec![Bin::default(); nbins];
+        samples.clear();
         for x in x_lo..=x_hi {
             let yl = line.y_at(x as f64);
             let (top, bottom) = ((yl - span as f64 - 0.5).ceil(), (yl + span as f64 + 0.5).floor());
@@ -87,17 +139,31 @@ pub fn mean_gray_level<P: Pixel>(img: &Plane<P>, line: &SurfaceLine, skip: Optio
                 let d = y as f64 - yl;
                 let k = d.round() as i32 + span;
                 if (0..nbins as i32).contains(&k) {
-                    let v = img.at(x, y) as f64;
-                    let b = &mut bins[k as usize];
-                    b.sum += v;
-                    b.sum_sq += v * v;
-                    b.n += 1;
-                    b.sum_d += d;
+                    samples.push((k as usize, d, img.at(x, y) as f64));
                 }
             }
         }
+        let mut bins = vec![Bin::default(); nbins];
+        for &(k, d, v) in &samples {
+            bins[k].add(v, d);
+        }
         if bins.iter().any(|b| b.n < BLOCK_PX / 2) {
             continue;
+        }
+        if statistic == RowStatistic::TexturedShare {
+            let rows = LEVEL_ROWS as usize;
+            let backdrop = backdrop_trend(&bins[..rows]);
+            let (sq, n) = samples
+                .iter()
+                .filter(|s| s.0 < rows)
+                .fold((0.0, 0usize), |(a, n), &(_, d, v)| {
+                    (a + (v - backdrop(d)).powi(2), n + 1)
+                });
+            let threshold = OUTLIER_SD * OUTLIER_SD * (sq / n.max(1) as f64);
+            bins = vec![Bin::default(); nbins];
+            for &(k, d, v) in &samples {
+                bins[k].add(f64::from(u8::from((v - backdrop(d)).powi(2) > threshold)), d);
+            }
         }
         looked += 1;
         if let Some(off) = block_crossing(&bins) {
@@ -116,7 +182,23 @@ pub fn mean_gray_level<P: Pixel>(img: &Plane<P>, line: &SurfaceLine, skip: Optio
         offset_px: mid,
         sigma_px: sigma,
         blocks: n,
+        statistic,
     })
+}
+
+/// The backdrop's gray as a straight line in the distance from the surface line, fitted to the means of the
+/// rows above the line (`above`): a lighting gradient or vignetting carried into the rows the band covers.
+fn backdrop_trend(above: &[Bin]) -> impl Fn(f64) -> f64 + use<> {
+    let k = above.len() as f64;
+    let (md, mv) = above
+        .iter()
+        .fold((0.0, 0.0), |(a, b), bin| (a + bin.distance() / k, b + bin.mean() / k));
+    let (sdv, sdd) = above.iter().fold((0.0, 0.0), |(a, b), bin| {
+        let dd = bin.distance() - md;
+        (a + dd * (bin.mean() - mv), b + dd * dd)
+    });
+    let slope = if sdd > 0.0 { sdv / sdd } else { 0.0 };
+    move |d| mv + slope * (d - md)
 }
 
 /// One block's half-way row relative to the line, px: the levels are the means of the outermost `LEVEL_ROWS`
@@ -158,11 +240,12 @@ pub fn ball_columns(line: &SurfaceLine, (x, y, r): (f64, f64, f64), span: (f64, 
     (!clear).then_some((span.0 - r - 4.0, span.1 + r + 4.0))
 }
 
-/// `line` with its level measured again ([`mean_gray_level`]) where that can be done: `y0` moved by the
-/// shift, `sigma_y0` the shift's standard error, the shift kept in `level_shift_px` (the band's grains still
-/// reach where the cue found them: see [`SurfaceLine::top_at`]). Otherwise `line` as it was.
+/// `line` with its level measured again where that can be done ([`mean_gray_level`], else
+/// [`textured_share_level`]): `y0` moved by the shift, `sigma_y0` the shift's standard error, the shift kept in
+/// `level_shift_px` (the band's grains still reach where the cue found them: see [`SurfaceLine::top_at`]).
+/// Otherwise `line` as it was.
 pub fn remeasured<P: Pixel>(img: &Plane<P>, line: SurfaceLine, skip: Option<(f64, f64)>) -> SurfaceLine {
-    match mean_gray_level(img, &line, skip) {
+    match mean_gray_level(img, &line, skip).or_else(|| textured_share_level(img, &line, skip)) {
         Some(s) => SurfaceLine {
             y0: line.y0 + s.offset_px,
             sigma_y0: s.sigma_px,
@@ -219,14 +302,64 @@ mod tests {
         }
     }
 
-    /// A band as gray as the backdrop has no step in mean gray: its line is kept as found.
+    /// A band as gray as the backdrop has no step in mean gray; its texture tells its level instead, to the
+    /// drawn edge's mean within the stated error, wherever the cue put the line.
     #[test]
-    fn a_band_as_gray_as_the_backdrop_keeps_its_line() {
-        let px = band(170.3, 0.0, (95.0, 30.0), 3.0, 3.0, 5);
+    fn a_band_as_gray_as_the_backdrop_has_its_level_from_its_texture() {
+        for (seed, rough, texture) in [(5u64, 3.0, 30.0), (6, 6.0, 24.0), (7, 0.0, 20.0), (8, 4.0, 24.0)] {
+            let drawn = scene(170.3, 0.0, (95.0, texture), rough, 3.0, seed);
+            let px = render(&drawn);
+            let img = Plane::new(&px, 256, 256);
+            let found = find_surface_lines(&img, None).expect("a texture line").line;
+            assert!(mean_gray_level(&img, &found, None).is_none());
+            let s = textured_share_level(&img, &found, None)
+                .unwrap_or_else(|| panic!("seed {seed}: no clear step in texture about {found:?}"));
+            assert_eq!(s.statistic, RowStatistic::TexturedShare);
+            let truth = band_edge_mean(&drawn);
+            let err = found.y0 + s.offset_px - truth;
+            assert!(
+                err.abs() < 3.0 * s.sigma_px + 0.1,
+                "seed {seed} rough {rough} texture {texture}: found {:.2}, remeasured error {err:.3} ± {:.3}",
+                found.y0 - truth,
+                s.sigma_px
+            );
+            assert_eq!(remeasured(&img, found, None).y0, found.y0 + s.offset_px);
+        }
+    }
+
+    /// A band with neither a step in mean gray nor texture of its own keeps its line.
+    #[test]
+    fn a_band_like_the_backdrop_keeps_its_line() {
+        let px = band(170.3, 0.0, (95.0, 0.0), 3.0, 3.0, 5);
         let img = Plane::new(&px, 256, 256);
-        let found = find_surface_lines(&img, None).expect("a texture line").line;
-        assert!(mean_gray_level(&img, &found, None).is_none());
-        assert_eq!(remeasured(&img, found, None), found);
+        let line = SurfaceLine::given(127.5, 170.3, 0.0);
+        assert!(mean_gray_level(&img, &line, None).is_none());
+        assert!(textured_share_level(&img, &line, None).is_none());
+        assert_eq!(remeasured(&img, line, None), line);
+    }
+
+    /// Under a lighting gradient the backdrop's gray is followed into the band's rows: the level stays at
+    /// the edge's mean, not where the backdrop has drifted out of its noise.
+    #[test]
+    fn a_lighting_gradient_does_not_move_the_textured_level() {
+        let drawn = Scene {
+            backdrop: (100.0, 100.0),
+            ..scene(170.3, 0.0, (100.0, 20.0), 3.0, 2.0, 11)
+        };
+        let mut px = render(&drawn);
+        // Light falling from 40 at the top to 160 at the bottom, on the backdrop and the band alike.
+        for y in 0..256 {
+            let shade = -60.0 + 120.0 * y as f64 / 255.0;
+            for x in 0..256 {
+                px[y * 256 + x] = (px[y * 256 + x] as f64 + shade).round().clamp(0.0, 255.0) as u8;
+            }
+        }
+        let img = Plane::new(&px, 256, 256);
+        let truth = band_edge_mean(&drawn);
+        let line = SurfaceLine::given(127.5, truth - 2.0, 0.0);
+        let s = textured_share_level(&img, &line, None).expect("a clear step in texture");
+        let err = line.y0 + s.offset_px - truth;
+        assert!(err.abs() < 3.0 * s.sigma_px + 0.1, "error {err:.3} ± {:.3}", s.sigma_px);
     }
 
     /// A band darker than the backdrop in fewer than half of its columns (large grains, shading) does not have

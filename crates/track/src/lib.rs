@@ -39,7 +39,7 @@ mod trajectory;
 pub use circle_fit::{CircleFit, fit_circle};
 pub use clip::{ClipTracking, Scale, Track, TrackError, track_clip};
 pub use hough::{Circle, CircleDetection, detect_circles, outermost, radius_bands};
-pub use level::{LevelShift, ball_columns, mean_gray_level, remeasured};
+pub use level::{LevelShift, RowStatistic, ball_columns, mean_gray_level, remeasured, textured_share_level};
 pub use limb::{LimbLearner, LimbOffset};
 pub use local::SurfaceFrame;
 pub use plane::{Pixel, Plane};

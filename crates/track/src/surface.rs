@@ -22,8 +22,9 @@
 //! statistic sees it.
 //!
 //! The tracker looks for the line in the mean of a clip's first frames (`Tracker`), where the noise is
-//! smaller than in any one frame, and measures the found line's level again from the band's mean gray
-//! ([`crate::level`]): both cues put a ragged edge's line at its first grains, above its middle.
+//! smaller than in any one frame, and measures the found line's level again where half of each row is
+//! covered by the band, from its mean gray or its texture ([`crate::level`]): both cues put a ragged edge's
+//! line at its first grains, above its middle.
 
 use crate::plane::{Pixel, Plane, parabola_offset};
 
@@ -58,7 +59,7 @@ pub struct SurfaceLine {
     #[serde(default)]
     pub cue: LineCue,
     /// How far the line's level was moved from where its cue found the band's edge, px (+ down): measured
-    /// again from the band's mean gray ([`crate::mean_gray_level`]). 0 for a line kept where it was found.
+    /// again from the band's mean gray or texture ([`crate::remeasured`]). 0 for a line kept where it was found.
     #[serde(default)]
     pub level_shift_px: f64,
 }

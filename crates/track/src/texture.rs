@@ -353,7 +353,7 @@ fn fine_edges(fine: &FineMap, line: &SurfaceLine, seen: &dyn Fn(usize) -> bool) 
 /// ([`fine_edges`]) of the rows it can reach, about its own height at its reference column, with that fit's
 /// tilt error (counting the edges' correlation over the same 64 px as the sampled columns'). Only the tilt:
 /// where the fine map puts a ragged edge's height differs from the coarse box's by up to a pixel (the box's
-/// three rows and the brightness step it also sees), and the level's later measures (the band's mean gray,
+/// three rows and the brightness step it also sees), and the level's later measures (the band's gray or texture,
 /// the ball's touch) and their stated errors are made for the coarse one. The line as it was when fewer
 /// than one column in eight gives an edge (a band that only the coarse box tells apart).
 fn refit_on_fine_edges<P: Pixel>(img: &Plane<P>, line: SurfaceLine, seen: &dyn Fn(usize) -> bool) -> SurfaceLine {
