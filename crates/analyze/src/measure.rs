@@ -99,8 +99,8 @@ pub(crate) fn session_key(session: &Session) -> String {
 /// for by its rim's strength around the prediction; 27: the surface's tilt weighed with the one the ball's
 /// fall from rest implies; 28: a found line the ball passes in front of given up for the next line below,
 /// and the limb learned over the whole flight, before and after the bounce; 29: a line's level measured
-/// again from the share of each row's pixels the backdrop cannot explain where the band's mean gray does not
-/// tell it).
+/// again, on a ragged edge, from the share of each row's pixels the backdrop cannot explain where the band's
+/// mean gray does not tell it).
 const MEASUREMENT_REVISION: u32 = 29;
 
 /// Everything besides the frame files that changes a shot's track or estimate.
