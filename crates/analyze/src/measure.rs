@@ -100,8 +100,9 @@ pub(crate) fn session_key(session: &Session) -> String {
 /// fall from rest implies; 28: a found line the ball passes in front of given up for the next line below,
 /// and the limb learned over the whole flight, before and after the bounce; 29: a line's level measured
 /// again, on a ragged edge, from the share of each row's pixels the backdrop cannot explain where the band's
-/// mean gray does not tell it).
-const MEASUREMENT_REVISION: u32 = 29;
+/// mean gray does not tell it; 30: a ball that moves too little in one sighting gap sighted over two or
+/// four).
+const MEASUREMENT_REVISION: u32 = 30;
 
 /// Everything besides the frame files that changes a shot's track or estimate.
 fn settings_text(entry: &ClipEntry, gravity: f64) -> String {

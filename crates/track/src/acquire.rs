@@ -6,7 +6,8 @@
 //! cast no votes, then measured on the frame itself; one whose rim does not stand out of the frame's noise
 //! is no sighting (in heavy noise circles of noise, and a seam's arcs on the ball, refine as clearly as the
 //! ball, see `rim_evidence`). A circle counts as the ball when it moved between two frames 1 ms apart (ten
-//! at 10,000 fps, see `SIGHTING_GAP_S`), is found again half-way between where its path puts it, and did
+//! at 10,000 fps, see `SIGHTING_GAP_S`; 2 or 4 ms for a ball that moves too little in one, before smaller
+//! circles are tried), is found again half-way between where its path puts it, and did
 //! not stay put: its rim's pixels changed between the two frames by more than their noise (a still circle
 //! the other frame's search missed is still all the same). When the difference holds no such circle (a
 //! ball too large or slow for the median to forget it), the frames themselves are searched the same way.
@@ -151,7 +152,7 @@ pub(crate) fn acquire_in(
                     votes,
                     voters,
                 };
-                if let Some(found) = search.through_clip(&pass)? {
+                if let Some(found) = search.through_clip_at_longer_gaps(&pass)? {
                     return Ok(found);
                 }
             }
@@ -229,6 +230,24 @@ impl PairSearch<'_> {
             k += gap;
         }
         Ok(None)
+    }
+
+    /// [`Self::through_clip`] with the sighting gap, then with [`LONGER_GAPS`] times it: a small ball falling
+    /// slowly moves less than [`MIN_PAIR_MOVE_PX`] in one gap (1.2 px at 23 px radius and 1.8 m/s), and
+    /// smaller circles on it, which jitter by more, would be taken for it. Its files at the longer gaps are
+    /// mostly those already searched (multiples of the gap), so a longer gap costs little beyond matching.
+    fn through_clip_at_longer_gaps(&mut self, pass: &Pass) -> Result<Option<Acquired>, TrackError> {
+        let gap = self.gap;
+        let mut found = None;
+        for times in LONGER_GAPS {
+            self.gap = times * gap;
+            found = self.through_clip(pass)?;
+            if found.is_some() {
+                break;
+            }
+        }
+        self.gap = gap;
+        Ok(found)
     }
 
     /// The doubtful pass, after the clean ones found nothing: in each radius band of `bands`, the earliest
@@ -647,6 +666,10 @@ const STILL_RING_SIGMAS: f64 = 3.0;
 /// How much clearer (in quality) a moving circle inside a doubtful one must be to take its place (see
 /// [`PairSearch::clearer_inside`]): more than the ±0.04 or so that refining the same rim from two starts gives.
 const CLEARER_BY: f64 = 0.05;
+
+/// The multiples of the sighting gap a clean pass tries in turn (see [`PairSearch::through_clip_at_longer_gaps`]):
+/// up to 4 ms at 10,000 fps, enough for a ball falling at 0.5 m/s seen at 1.5 mm/px to move [`MIN_PAIR_MOVE_PX`].
+const LONGER_GAPS: [usize; 3] = [1, 2, 4];
 
 /// The least distance between a pair's two sightings for it to count as moving, px.
 const MIN_PAIR_MOVE_PX: f64 = 1.5;
@@ -1315,21 +1338,27 @@ mod tests {
     use super::*;
     use crate::testutil::{Scene, render};
 
-    /// Searched from the clip's end, the ball is sighted in its last frames: the later sighting first, at
-    /// negated times, and `file` the clip's file of that sighting; searched from its start, in its first.
-    #[test]
-    fn the_ball_is_found_from_the_clip_s_end_in_negated_time() {
+    /// A folder of `frames` 256×256 PNG frames of a ball of radius `r` at `at(i)` in frame `i`.
+    fn moving_ball_clip(frames: usize, at: impl Fn(usize) -> (f64, f64), r: f64) -> tempfile::TempDir {
         let dir = tempfile::tempdir().unwrap();
-        let at = |i: usize| (60.0 + 2.5 * i as f64, 70.0 + 1.5 * i as f64);
-        for i in 0..40 {
+        for i in 0..frames {
             let s = Scene {
-                ball: (at(i).0, at(i).1, 40.0),
+                ball: (at(i).0, at(i).1, r),
                 seed: i as u64,
                 ..Scene::default()
             };
             let img = image::GrayImage::from_raw(256, 256, render(&s)).unwrap();
             img.save(dir.path().join(format!("f{i:04}.png"))).unwrap();
         }
+        dir
+    }
+
+    /// Searched from the clip's end, the ball is sighted in its last frames: the later sighting first, at
+    /// negated times, and `file` the clip's file of that sighting; searched from its start, in its first.
+    #[test]
+    fn the_ball_is_found_from_the_clip_s_end_in_negated_time() {
+        let at = |i: usize| (60.0 + 2.5 * i as f64, 70.0 + 1.5 * i as f64);
+        let dir = moving_ball_clip(40, at, 40.0);
         let clip = Clip::open(dir.path()).unwrap();
         let opts = ClipTracking::default();
         let near = |s: Sighting, i: usize| (s.1 - at(i).0).hypot(s.2 - at(i).1) < 1.0;
@@ -1346,6 +1375,22 @@ mod tests {
         assert!(near(back.seed.0, 39) && near(back.seed.1, 29), "{:?}", back.seed);
         assert_eq!((back.seed.0.0, back.seed.1.0), (-clip.time_of(39), -clip.time_of(29)));
         assert!((back.radius.0..=back.radius.1).contains(&40.0), "{:?}", back.radius);
+    }
+
+    /// A small ball falling slowly, 1 px per sighting gap (less than [`MIN_PAIR_MOVE_PX`]), is acquired over
+    /// a longer gap at its own radius.
+    #[test]
+    fn a_ball_moving_less_than_a_pair_s_least_move_in_one_gap_is_sighted_over_a_longer_one() {
+        let at = |i: usize| (120.0 + 0.03 * i as f64, 90.0 + 0.1 * i as f64);
+        let dir = moving_ball_clip(60, at, 23.0);
+        let clip = Clip::open(dir.path()).unwrap();
+        let found = acquire(&clip, &ClipTracking::default(), 1.0, 2.0).unwrap();
+        let ((t0, x0, y0), (t1, x1, y1)) = found.seed;
+        let (i0, i1) = ((t0 * 10_000.0).round() as usize, (t1 * 10_000.0).round() as usize);
+        assert!(i1 - i0 > 10, "sighted {} frames apart", i1 - i0);
+        assert!((x0 - at(i0).0).hypot(y0 - at(i0).1) < 0.5, "{:?}", found.seed);
+        assert!((x1 - at(i1).0).hypot(y1 - at(i1).1) < 0.5, "{:?}", found.seed);
+        assert!((found.radius.0..=found.radius.1).contains(&23.0), "{:?}", found.radius);
     }
 
     fn look_of(scene: &Scene, c: (f64, f64, f64)) -> Vec<f32> {
