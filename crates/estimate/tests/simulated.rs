@@ -675,17 +675,36 @@ fn the_fall_of_a_dropped_ball_measures_the_surface_s_tilt() {
             line_alone.mu
         );
     }
-    // Thrown 8° off gravity's direction: the fall and the line disagree, the line's tilt is kept.
+    // Thrown 8° off gravity's direction: the fall and the line disagree, the line's tilt is kept, with an
+    // error that covers the fall's (either may be the wrong one), and COR and μ with errors to match.
     let (mut track, _) = shot(&model, 20.0, 0.4, 0.02, 99);
     let line = track.surface.as_mut().unwrap();
     line.sigma_tilt_deg = 0.9;
     let e = estimate(&track, &conditions(12.0)).unwrap();
-    assert_eq!(e.surface_tilt_deg.unwrap().value, 0.0, "{:?}", e.surface_tilt_deg);
+    let (tilt, fall) = (e.surface_tilt_deg.unwrap(), e.fall_tilt_deg.unwrap());
+    assert!(tilt.value.abs() < 1e-9, "{tilt:?}");
+    assert!(
+        tilt.se >= (tilt.value - fall.value).abs(),
+        "{tilt:?} against the fall's {fall:?}"
+    );
     assert!(
         e.notes.iter().any(|n| n.contains("the fall is not used")),
         "{:?}",
         e.notes
     );
+    let alone = Conditions {
+        fall_se_deg: None,
+        ..conditions(12.0)
+    };
+    let line_alone = estimate(&track, &alone).unwrap();
+    assert!(
+        (e.mu.value - line_alone.mu.value).abs() < 1e-9,
+        "{:?} vs {:?}",
+        e.mu,
+        line_alone.mu
+    );
+    assert!(e.mu.se > 3.0 * line_alone.mu.se, "{:?} vs {:?}", e.mu, line_alone.mu);
+    assert!(e.cor.se > line_alone.cor.se, "{:?} vs {:?}", e.cor, line_alone.cor);
 }
 
 /// A trajectory that contradicts itself (its incoming flight read 1.5 px high and its outgoing one 1.5 px
