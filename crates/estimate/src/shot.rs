@@ -436,27 +436,23 @@ fn estimate_from_measured(track: &Track, c: &Conditions) -> Result<Estimate, Est
             Ok(e)
         }
         Err(z) => {
-            let mut e = if fall.measured_line {
-                widened_to_the_fall(track, c, &fall).unwrap_or(first)
-            } else {
-                first
-            };
-            e.notes.push(format!(
-                "the ball's fall onto the {incline}° incline puts the surface's tilt in the image at {:.2} ± {:.2}°, {:.1} standard errors from {} ({:.2} ± {:.2}°): a ball not dropped from rest, another incline, or a line that is not the surface's; the fall is not used{}",
-                fall.tilt.value,
-                fall.tilt.se,
-                z.abs(),
-                fall.what,
-                fall.line.value,
-                fall.line.se,
-                if fall.measured_line {
+            let (mut e, kept) = match fall
+                .measured_line
+                .then(|| widened_to_the_fall(track, c, &fall))
+                .flatten()
+            {
+                Some((e, tilt)) => (
+                    e,
                     format!(
                         ", and the line's tilt is kept with a standard error of {:.2}° that covers the fall's, since either may be the wrong one",
-                        widened_tilt(&fall).se
-                    )
-                } else {
-                    String::new()
-                }
+                        tilt.se
+                    ),
+                ),
+                None => (first, String::new()),
+            };
+            e.notes.push(format!(
+                "the ball's fall onto the {incline}° incline puts the surface's tilt in the image at {:.2} ± {:.2}°, {:.1} standard errors from {} ({:.2} ± {:.2}°): a ball not dropped from rest, another incline, or a line that is not the surface's; the fall is not used{kept}",
+                fall.tilt.value, fall.tilt.se, z.abs(), fall.what, fall.line.value, fall.line.se
             ));
             e.line_tilt_deg = fall.measured_line.then_some(fall.line);
             e.fall_tilt_deg = Some(fall.tilt);
@@ -465,25 +461,21 @@ fn estimate_from_measured(track: &Track, c: &Conditions) -> Result<Estimate, Est
     }
 }
 
-/// The line's tilt with a standard error that covers its difference from the fall's: when the two disagree
-/// beyond [`crate::fall::AGREE_SIGMAS`], one of them is wrong (a line drawn by the band's grains or a fixture
-/// on it, a ball not dropped from rest) and the shot alone cannot tell which, so the line's is kept without
-/// claiming its own precision.
-fn widened_tilt(fall: &FallEvidence) -> Measured {
-    Measured {
+/// The shot measured again along its line's own tilt with a standard error that covers the tilt's difference
+/// from the fall's, and that tilt; `None` if it then cannot be measured. When the two disagree beyond
+/// [`crate::fall::AGREE_SIGMAS`], one of them is wrong (a line drawn by the band's grains or a fixture on it,
+/// a ball not dropped from rest) and the shot alone cannot tell which, so the line's is kept without claiming
+/// its own precision.
+fn widened_to_the_fall(track: &Track, c: &Conditions, fall: &FallEvidence) -> Option<(Estimate, Measured)> {
+    let tilt = Measured {
         value: fall.line.value,
         se: fall.line.se.hypot(fall.line.value - fall.tilt.value),
-    }
-}
-
-/// The shot measured again along its line's own tilt with [`widened_tilt`]'s error, or `None` if it then
-/// cannot be measured.
-fn widened_to_the_fall(track: &Track, c: &Conditions, fall: &FallEvidence) -> Option<Estimate> {
+    };
     let turn = Turn {
         pivot_x: fall.pivot_x,
-        tilt: widened_tilt(fall),
+        tilt,
     };
-    measure(track, c, Some(turn)).ok().map(|(e, _)| e)
+    measure(track, c, Some(turn)).ok().map(|(e, _)| (e, tilt))
 }
 
 /// A turn of the contact line to a tilt measured with the fall: about `pivot_x`, px, to `tilt`, degrees.

@@ -238,16 +238,16 @@ impl PairSearch<'_> {
     /// mostly those already searched (multiples of the gap), so a longer gap costs little beyond matching.
     fn through_clip_at_longer_gaps(&mut self, pass: &Pass) -> Result<Option<Acquired>, TrackError> {
         let gap = self.gap;
-        let mut found = None;
+        let mut found = Ok(None);
         for times in LONGER_GAPS {
             self.gap = times * gap;
-            found = self.through_clip(pass)?;
-            if found.is_some() {
+            found = self.through_clip(pass);
+            if !matches!(found, Ok(None)) {
                 break;
             }
         }
         self.gap = gap;
-        Ok(found)
+        found
     }
 
     /// The doubtful pass, after the clean ones found nothing: in each radius band of `bands`, the earliest
