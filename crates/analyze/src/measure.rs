@@ -101,8 +101,10 @@ pub(crate) fn session_key(session: &Session) -> String {
 /// and the limb learned over the whole flight, before and after the bounce; 29: a line's level measured
 /// again, on a ragged edge, from the share of each row's pixels the backdrop cannot explain where the band's
 /// mean gray does not tell it; 30: a ball that moves too little in one sighting gap sighted over two or
-/// four, and a line's tilt the ball's fall contradicts kept with an error that covers the fall's).
-const MEASUREMENT_REVISION: u32 = 30;
+/// four, and a line's tilt the ball's fall contradicts kept with an error that covers the fall's; 31: the
+/// limb's centre fitted again over its last 3 px, and taken where the deeper fit disagrees, else the two
+/// averaged).
+const MEASUREMENT_REVISION: u32 = 31;
 
 /// Everything besides the frame files that changes a shot's track or estimate.
 fn settings_text(entry: &ClipEntry, gravity: f64) -> String {

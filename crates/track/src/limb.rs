@@ -15,10 +15,15 @@
 //! spread is the one of nine (0–1.5 px) whose limbs fit all rays best: the silhouette found moves inwards
 //! by 0.4–1 px per px of spread assumed, so the spread is measured, not assumed. The silhouette's mean `R`
 //! and its first harmonic round the rim, each ray weighed by how closely its fit pins `R`, are how far the
-//! fitted circles' radius and centre lie from it, and the track moves every circle by them. A limb model
+//! fitted circles' radius and centre lie from it, and the track moves every circle by them. The centre is
+//! fitted again on the last 3 px inside: a ball lit from high above has its shadowed side's terminator
+//! 3–4 px inside the rim, whose step bends the deeper fit's rays there. Where the two centres disagree
+//! beyond 3σ (χ² on their standard errors, from the rays' scatter about the harmonic with neighbouring
+//! rays' correlation counted) the shallower is taken; else their mean, as each has its own model error
+//! (the deeper the texture's bend, the shallower fewer samples). A limb model
 //! is one account of the shading among others (a fuzzy felt, a seam), so their size stays the standard
 //! uncertainty of that correction. Cost: 53 samples per ray per frame learned (51 µs for 128 rays), and
-//! 30 ms once per clip for the fit (the track bench's `limb_learn_frame` and `limb_offset`).
+//! 66 ms once per clip for the two fits (the track bench's `limb_learn_frame` and `limb_offset`).
 
 use crate::circle_fit::weighted_first_harmonic;
 use crate::plane::{Pixel, Plane};
@@ -30,8 +35,13 @@ const STEP_PX: f64 = 0.25;
 const INNER_PX: f64 = 8.0;
 const OUTER_PX: f64 = 5.0;
 /// The limb model is fitted from this far inside the fitted rim, px: deeper, the terminator and the felt's
-/// texture bend the profile more than the model's three terms follow.
-const FIT_FROM_PX: f64 = -4.0;
+/// texture bend the profile more than the model's three terms follow; shallower, the terms trade the
+/// silhouette's radius against the limb's slope (`paper`'s radius 0.03 px large from 3 px).
+const DEEP_FIT_FROM_PX: f64 = -4.0;
+/// The centre is fitted from here too, px: a ball lit from high above has its shadowed side's terminator
+/// 3–4 px inside the rim, which bends the deeper fit's rays there and moves its centre (0.5 px on one
+/// `looks` clip).
+const SHALLOW_FIT_FROM_PX: f64 = -3.0;
 /// Silhouettes tried, px from the fitted rim: a ray whose best lies at either end is not a limb.
 const R_FROM_PX: f64 = -3.0;
 const R_TO_PX: f64 = 2.0;
@@ -40,6 +50,9 @@ const R_STEP_PX: f64 = 0.05;
 /// limbs fit the rays' profiles best is taken (a fixed 0.5 px put a sharp disc's silhouette 0.26 px inside
 /// it).
 const BLURS_PX: [f64; 9] = [0.0, 0.125, 0.25, 0.375, 0.5, 0.625, 0.75, 1.0, 1.5];
+/// Beyond this χ² (2 degrees of freedom, the 0.27 % tail: 3σ) the deeper and the shallower fits' centres
+/// disagree, and the deeper is taken as bent by a terminator.
+const CENTRES_APART_CHI2: f64 = 11.8;
 /// Rays either side of a third of the rim tried in the least-median harmonic (see [`robust_harmonic`]).
 const LMS_JITTER: i64 = 3;
 /// The rays' spread about the harmonic taken as at least this, px, so that a clean limb keeps its rays.
@@ -164,24 +177,40 @@ impl LimbLearner {
         if self.frames < MIN_FRAMES || self.rays < 8 {
             return None;
         }
-        let edges = self.silhouettes()?;
-        if edges.len() * 2 < self.rays {
-            return None;
-        }
-        let [m, a, b] = robust_harmonic(&edges, self.rays)?;
+        let harmonic = |fit_from_px: f64| {
+            let edges = self.silhouettes(fit_from_px)?;
+            if edges.len() * 2 < self.rays {
+                return None;
+            }
+            Some((robust_harmonic(&edges, self.rays)?, edges.len()))
+        };
+        let ((deep, deep_se), rays) = harmonic(DEEP_FIT_FROM_PX)?;
+        let centre_px = match harmonic(SHALLOW_FIT_FROM_PX) {
+            Some(((shallow, shallow_se), _)) => {
+                let apart: f64 = (1..3)
+                    .map(|j| (shallow[j] - deep[j]).powi(2) / (deep_se[j].powi(2) + shallow_se[j].powi(2)))
+                    .sum();
+                if apart > CENTRES_APART_CHI2 {
+                    (shallow[1], shallow[2])
+                } else {
+                    (0.5 * (deep[1] + shallow[1]), 0.5 * (deep[2] + shallow[2]))
+                }
+            }
+            None => (deep[1], deep[2]),
+        };
         Some(LimbOffset {
-            radius_px: m,
-            centre_px: (a, b),
-            rays: edges.len(),
+            radius_px: deep[0],
+            centre_px,
+            rays,
         })
     }
 
-    /// Each ray's silhouette, (angle, px from the fitted rim, its standard uncertainty px), under the
-    /// optical spread whose limbs fit all rays' mean profiles best; rays whose best lies at either end of
-    /// the tried range are left out.
-    fn silhouettes(&self) -> Option<Vec<(f64, f64, f64)>> {
+    /// Each ray's silhouette, (angle, px from the fitted rim, its standard uncertainty px), with the limb
+    /// fitted from `fit_from_px` (negative: inside the fitted rim) under the optical spread whose limbs fit
+    /// all rays' mean profiles best; rays whose best lies at either end of the tried range are left out.
+    fn silhouettes(&self, fit_from_px: f64) -> Option<Vec<(f64, f64, f64)>> {
         let n = samples();
-        let from = (0..n).position(|k| sample_at(k) >= FIT_FROM_PX - 1e-9)?;
+        let from = (0..n).position(|k| sample_at(k) >= fit_from_px - 1e-9)?;
         let profiles: Vec<(f64, Vec<f64>)> = (0..self.rays)
             .filter(|&i| self.count[i] as usize * 2 >= self.frames)
             .map(|i| {
@@ -214,7 +243,7 @@ impl LimbLearner {
 /// `rays`. Each ray weighs by its silhouette's uncertainty with [`SILHOUETTE_FLOOR_PX`] added (in
 /// quadrature): a limb of about the backdrop's gray pins its silhouette loosely. Cost: 49 triples per ray,
 /// each with a median over all rays.
-fn robust_harmonic(edges: &[(f64, f64, f64)], rays: usize) -> Option<[f64; 3]> {
+fn robust_harmonic(edges: &[(f64, f64, f64)], rays: usize) -> Option<([f64; 3], [f64; 3])> {
     let spreads: Vec<f64> = edges.iter().map(|e| e.2).collect();
     let edges: Vec<(f64, f64, f64)> = edges.iter().map(|&(t, r, _)| (t.cos(), t.sin(), r)).collect();
     let harmonic = |edges: &[(f64, f64, f64)]| crate::circle_fit::first_harmonic(edges.iter().copied());
@@ -252,10 +281,44 @@ fn robust_harmonic(edges: &[(f64, f64, f64)], rays: usize) -> Option<[f64; 3]> {
         .map(weighed)
         .collect();
     if kept.len() * 2 >= rays {
-        weighted_first_harmonic(kept)
+        harmonic_with_errors(&kept)
     } else {
-        weighted_first_harmonic(edges.iter().zip(&spreads).map(weighed))
+        harmonic_with_errors(&edges.iter().zip(&spreads).map(weighed).collect::<Vec<_>>())
     }
+}
+
+/// The weighted first harmonic `[mean, cos, sin]` of `points` (cos θ, sin θ, value, weight) and each
+/// term's standard error, the weights taken as relative and their scale from the residuals (s² = Σ w·res²
+/// / (n − 3)): the rays scatter about the harmonic by far more than their fits' own uncertainties say (a
+/// felt's texture, the backdrop behind the rim). Neighbouring rays share that scatter, so the variance is
+/// widened by (1 + ρ)/(1 − ρ), ρ the residuals' correlation from one ray to the next (0–0.95): 0.2–0.7 on
+/// `looks` clips.
+fn harmonic_with_errors(points: &[(f64, f64, f64, f64)]) -> Option<([f64; 3], [f64; 3])> {
+    let fit = weighted_first_harmonic(points.iter().copied())?;
+    let mut ata = [[0.0f64; 3]; 3];
+    let mut weighed_squares = 0.0;
+    let mut residuals = Vec::with_capacity(points.len());
+    for &(c, s, v, w) in points {
+        let row = [1.0, c, s];
+        for (j, rj) in row.iter().enumerate() {
+            for (k, rk) in row.iter().enumerate() {
+                ata[j][k] += w * rj * rk;
+            }
+        }
+        let res = v - fit[0] - fit[1] * c - fit[2] * s;
+        weighed_squares += w * res * res;
+        residuals.push(res * w.sqrt());
+    }
+    let inv = crate::circle_fit::invert3(&ata)?;
+    let s2 = weighed_squares / (points.len() as f64 - 3.0).max(1.0);
+    let lag1: f64 = residuals
+        .iter()
+        .zip(residuals.iter().cycle().skip(1))
+        .map(|(a, b)| a * b)
+        .sum::<f64>();
+    let rho = (lag1 / residuals.iter().map(|r| r * r).sum::<f64>().max(1e-300)).clamp(0.0, 0.95);
+    let inflation = (1.0 + rho) / (1.0 - rho);
+    Some((fit, [0, 1, 2].map(|j| (s2 * inflation * inv[j][j]).sqrt())))
 }
 
 /// The blurred limb's three inside shapes (a step, √(R − s) and R − s) and two outside ones (a step and
@@ -293,7 +356,7 @@ impl LimbModel {
         // depth the silhouettes and samples reach.
         let grid = |v: f64| (v / dt).round() as i64;
         let (lo, hi) = (
-            grid(R_FROM_PX + FIT_FROM_PX.min(0.0) - OUTER_PX) - half,
+            grid(R_FROM_PX + DEEP_FIT_FROM_PX.min(SHALLOW_FIT_FROM_PX).min(0.0) - OUTER_PX) - half,
             grid(R_TO_PX + INNER_PX) + half,
         );
         let blurred: Vec<[f64; 4]> = (lo..=hi)
