@@ -614,6 +614,34 @@ mod tests {
         assert_told(&o, 0.5, (-0.3, 0.4));
     }
 
+    /// The harmonic's errors come from the rays' scatter about it, widened where neighbouring rays share
+    /// it: the same residuals in a slow wave round the rim (ρ near 1) give a larger error than alternating
+    /// ones (ρ < 0, taken as 0), and the fit itself is the plain weighted harmonic.
+    #[test]
+    fn the_harmonic_s_errors_grow_with_rays_sharing_their_scatter() {
+        let rays = 64;
+        let at = |i: usize, res: f64| {
+            let t = std::f64::consts::TAU * i as f64 / rays as f64;
+            (t.cos(), t.sin(), 0.5 + 0.2 * t.cos() - 0.1 * t.sin() + res, 1.0)
+        };
+        let alternating: Vec<_> = (0..rays).map(|i| at(i, if i % 2 == 0 { 0.1 } else { -0.1 })).collect();
+        let wave: Vec<_> = (0..rays)
+            .map(|i| at(i, 0.1 * (std::f64::consts::TAU * 5.0 * i as f64 / rays as f64).sin()))
+            .collect();
+        let (fit, independent) = harmonic_with_errors(&alternating).unwrap();
+        assert!((fit[0] - 0.5).abs() < 1e-9 && (fit[1] - 0.2).abs() < 1e-9 && (fit[2] + 0.1).abs() < 1e-9);
+        // Alternating ±0.1 over 64 rays: s ≈ 0.1, the cos term's error ≈ 0.1·√(2/64).
+        assert!(
+            (independent[1] - 0.1 * (2.0f64 / 64.0).sqrt()).abs() < 0.003,
+            "{independent:?}"
+        );
+        // The wave's RMS is 0.1/√2: unwidened, its error would be 0.1/√2·√(2/64); ρ = cos(2π·5/64) ≈ 0.88
+        // widens it ≈ 4×.
+        let (_, shared) = harmonic_with_errors(&wave).unwrap();
+        let unwidened = 0.1 / 2.0f64.sqrt() * (2.0f64 / 64.0).sqrt();
+        assert!(shared[1] > 3.0 * unwidened, "{shared:?} against {unwidened}");
+    }
+
     /// Cholesky's solution satisfies its system; a singular matrix gives none.
     #[test]
     fn a_positive_definite_system_is_solved() {
