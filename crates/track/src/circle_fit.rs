@@ -122,6 +122,14 @@ pub(crate) fn first_harmonic(points: impl IntoIterator<Item = (f64, f64, f64)>) 
 
 /// [`first_harmonic`] weighted: over `(cos θ, sin θ, v, weight)`.
 pub(crate) fn weighted_first_harmonic(points: impl IntoIterator<Item = (f64, f64, f64, f64)>) -> Option<[f64; 3]> {
+    weighted_first_harmonic_with_inverse(points).map(|(fit, _)| fit)
+}
+
+/// [`weighted_first_harmonic`] and the inverse of its normal matrix `(AᵀWA)⁻¹`, from which the terms'
+/// covariance follows once the residuals' scale is known.
+pub(crate) fn weighted_first_harmonic_with_inverse(
+    points: impl IntoIterator<Item = (f64, f64, f64, f64)>,
+) -> Option<([f64; 3], [[f64; 3]; 3])> {
     let mut ata = [[0.0f64; 3]; 3];
     let mut atb = [0.0f64; 3];
     for (c, s, v, w) in points {
@@ -134,7 +142,7 @@ pub(crate) fn weighted_first_harmonic(points: impl IntoIterator<Item = (f64, f64
         }
     }
     let inv = invert3(&ata)?;
-    Some([0, 1, 2].map(|j| (0..3).map(|k| inv[j][k] * atb[k]).sum()))
+    Some(([0, 1, 2].map(|j| (0..3).map(|k| inv[j][k] * atb[k]).sum()), inv))
 }
 
 /// Inverse of a symmetric positive-definite 3×3 matrix; `None` when (nearly) singular.

@@ -25,7 +25,7 @@
 //! uncertainty of that correction. Cost: 53 samples per ray per frame learned (51 µs for 128 rays), and
 //! 66 ms once per clip for the two fits (the track bench's `limb_learn_frame` and `limb_offset`).
 
-use crate::circle_fit::weighted_first_harmonic;
+use crate::circle_fit::weighted_first_harmonic_with_inverse;
 use crate::plane::{Pixel, Plane};
 use crate::surface::SurfaceLine;
 
@@ -294,29 +294,20 @@ fn robust_harmonic(edges: &[(f64, f64, f64)], rays: usize) -> Option<([f64; 3], 
 /// widened by (1 + ρ)/(1 − ρ), ρ the residuals' correlation from one ray to the next (0–0.95): 0.2–0.7 on
 /// `looks` clips.
 fn harmonic_with_errors(points: &[(f64, f64, f64, f64)]) -> Option<([f64; 3], [f64; 3])> {
-    let fit = weighted_first_harmonic(points.iter().copied())?;
-    let mut ata = [[0.0f64; 3]; 3];
-    let mut weighed_squares = 0.0;
-    let mut residuals = Vec::with_capacity(points.len());
-    for &(c, s, v, w) in points {
-        let row = [1.0, c, s];
-        for (j, rj) in row.iter().enumerate() {
-            for (k, rk) in row.iter().enumerate() {
-                ata[j][k] += w * rj * rk;
-            }
-        }
-        let res = v - fit[0] - fit[1] * c - fit[2] * s;
-        weighed_squares += w * res * res;
-        residuals.push(res * w.sqrt());
-    }
-    let inv = crate::circle_fit::invert3(&ata)?;
+    let (fit, inv) = weighted_first_harmonic_with_inverse(points.iter().copied())?;
+    // Each residual scaled by √w, so that their squares sum to the weighed squares.
+    let residuals: Vec<f64> = points
+        .iter()
+        .map(|&(c, s, v, w)| (v - fit[0] - fit[1] * c - fit[2] * s) * w.sqrt())
+        .collect();
+    let weighed_squares: f64 = residuals.iter().map(|r| r * r).sum();
     let s2 = weighed_squares / (points.len() as f64 - 3.0).max(1.0);
     let lag1: f64 = residuals
         .iter()
         .zip(residuals.iter().cycle().skip(1))
         .map(|(a, b)| a * b)
         .sum::<f64>();
-    let rho = (lag1 / residuals.iter().map(|r| r * r).sum::<f64>().max(1e-300)).clamp(0.0, 0.95);
+    let rho = (lag1 / weighed_squares.max(1e-300)).clamp(0.0, 0.95);
     let inflation = (1.0 + rho) / (1.0 - rho);
     Some((fit, [0, 1, 2].map(|j| (s2 * inflation * inv[j][j]).sqrt())))
 }
