@@ -8,7 +8,9 @@
 //! the line is where half the block's columns are covered, the median of the block's edge, whatever its
 //! roughness (a lip, a strip along the band's top brighter or darker than the band, still moves it). Two
 //! such statistics are used:
-//! - the **mean gray**, where the band's differs from the backdrop's: the more precise;
+//! - the **mean gray**, where the band's differs from the backdrop's: the more precise; but not where the
+//!   blocks' mean profile goes beyond the backdrop's gray away from the band's (a bright lip along a darker
+//!   band, or a glow on the backdrop above it, which the mean gray cannot tell apart);
 //! - else, on a ragged edge, the **share of the row's pixels the backdrop cannot explain**: further from
 //!   the backdrop's gray (a straight-line trend fitted to the rows above the line, carried into the rows
 //!   below) than three of the backdrop's own standard deviations about that trend, and than three
@@ -103,8 +105,10 @@ impl Bin {
 /// The shift of `line`'s level to the half-way row of the band's mean gray (see the module's description), or
 /// `None` unless at least five blocks of 16 columns, and half of those whose pixels reach ±16 px of the line
 /// inside the image, show a clear step in mean gray across it: a band only here and there darker than the
-/// backdrop (large grains, shading within it) is not one whose mean gray tells its edge. Columns in `skip`
-/// (x from, x to, px) are left out: the ball, where it comes near the line. Cost: O(width × 34).
+/// backdrop (large grains, shading within it) is not one whose mean gray tells its edge. `None` too where
+/// the blocks' profiles, averaged, go beyond the backdrop's gray away from the band's ([`beyond_the_backdrop`]).
+/// Columns in `skip` (x from, x to, px) are left out: the ball, where it comes near the line. Cost:
+/// O(width × 34).
 pub fn mean_gray_level<P: Pixel>(img: &Plane<P>, line: &SurfaceLine, skip: Option<(f64, f64)>) -> Option<LevelShift> {
     row_statistic_level(img, line, skip, RowStatistic::MeanGray)
 }
@@ -130,6 +134,7 @@ fn row_statistic_level<P: Pixel>(
     let span = SPAN_PX;
     let nbins = (2 * span + 1) as usize;
     let mut offsets = Vec::new();
+    let mut between = Vec::new();
     let mut looked = 0usize;
     let mut samples: Vec<(usize, f64, f64)> = Vec::with_capacity(BLOCK_PX * nbins);
     for x_lo in (0..img.width.saturating_sub(BLOCK_PX - 1)).step_by(BLOCK_PX) {
@@ -184,11 +189,15 @@ fn row_statistic_level<P: Pixel>(
             }
         }
         looked += 1;
-        if let Some(off) = block_crossing(&bins) {
+        let Some(step) = BlockStep::of(&bins) else { continue };
+        if statistic == RowStatistic::MeanGray {
+            between.push(step.transition_shares(&bins, backdrop_trend(&bins[..LEVEL_ROWS as usize])));
+        }
+        if let Some(off) = step.crossing(&bins) {
             offsets.push(off);
         }
     }
-    if offsets.len() < MIN_BLOCKS.max(looked.div_ceil(2)) {
+    if offsets.len() < MIN_BLOCKS.max(looked.div_ceil(2)) || beyond_the_backdrop(&between) {
         return None;
     }
     let n = offsets.len();
@@ -219,34 +228,79 @@ fn backdrop_trend(above: &[Bin]) -> impl Fn(f64) -> f64 + use<> {
     move |d| mv + slope * (d - md)
 }
 
-/// One block's half-way row relative to the line, px: the levels are the means of the outermost `LEVEL_ROWS`
-/// bins on either side, the step must be `MIN_STEP_SE` standard errors, and of the places where the profile
-/// crosses half-way the one nearest the line is taken, linearly interpolated between the bins' mean
-/// distances. `None` when the step is unclear or the profile does not cross.
-fn block_crossing(bins: &[Bin]) -> Option<f64> {
-    let rows = LEVEL_ROWS as usize;
-    // A level's variance: its pixels' scatter, or its rows' when coarse grains make neighbouring pixels alike.
-    let level = |part: &[Bin]| {
-        let k = part.len() as f64;
-        let m = part.iter().map(Bin::mean).sum::<f64>() / k;
-        let within = part.iter().map(Bin::var_of_mean).sum::<f64>() / (k * k);
-        let between = part.iter().map(|b| (b.mean() - m).powi(2)).sum::<f64>() / ((k - 1.0) * k);
-        (m, within.max(between))
-    };
-    let (above, va) = level(&bins[..rows]);
-    let (below, vb) = level(&bins[bins.len() - rows..]);
-    let step = below - above;
-    if step.abs() < MIN_STEP_SE * (va + vb).sqrt() {
-        return None;
+/// A block's two levels: the means of its outermost `LEVEL_ROWS` bins on either side of the line.
+struct BlockStep {
+    above: f64,
+    below: f64,
+}
+
+impl BlockStep {
+    /// The block's levels when they differ by `MIN_STEP_SE` standard errors, else `None`.
+    fn of(bins: &[Bin]) -> Option<BlockStep> {
+        let rows = LEVEL_ROWS as usize;
+        // A level's variance: its pixels' scatter, or its rows' when coarse grains make neighbouring pixels alike.
+        let level = |part: &[Bin]| {
+            let k = part.len() as f64;
+            let m = part.iter().map(Bin::mean).sum::<f64>() / k;
+            let within = part.iter().map(Bin::var_of_mean).sum::<f64>() / (k * k);
+            let between = part.iter().map(|b| (b.mean() - m).powi(2)).sum::<f64>() / ((k - 1.0) * k);
+            (m, within.max(between))
+        };
+        let (above, va) = level(&bins[..rows]);
+        let (below, vb) = level(&bins[bins.len() - rows..]);
+        ((below - above).abs() >= MIN_STEP_SE * (va + vb).sqrt()).then_some(BlockStep { above, below })
     }
-    let f = |k: usize| (bins[k].mean() - above) / step - 0.5;
-    (0..bins.len() - 1)
-        .filter(|&k| f(k) * f(k + 1) <= 0.0 && f(k) != f(k + 1))
-        .map(|k| {
-            let (d0, d1) = (bins[k].distance(), bins[k + 1].distance());
-            d0 + (d1 - d0) * f(k) / (f(k) - f(k + 1))
-        })
-        .min_by(|a, b| a.abs().total_cmp(&b.abs()))
+
+    /// How far each bin between the two levels has gone from the upper side's gray (`upper`, a trend in the
+    /// distance from the line: lighting and vignetting go on across it) towards the lower level, as a share
+    /// of the step between the levels: 0 on the upper side, about 1 at the lower level.
+    fn transition_shares(&self, bins: &[Bin], upper: impl Fn(f64) -> f64) -> Vec<f64> {
+        let rows = LEVEL_ROWS as usize;
+        bins[rows..bins.len() - rows]
+            .iter()
+            .map(|b| (b.mean() - upper(b.distance())) / (self.below - self.above))
+            .collect()
+    }
+
+    /// The block's half-way row relative to the line, px: of the places where the profile crosses half-way
+    /// between the levels the one nearest the line, linearly interpolated between the bins' mean distances.
+    /// `None` when the profile does not cross.
+    fn crossing(&self, bins: &[Bin]) -> Option<f64> {
+        let f = |k: usize| (bins[k].mean() - self.above) / (self.below - self.above) - 0.5;
+        (0..bins.len() - 1)
+            .filter(|&k| f(k) * f(k + 1) <= 0.0 && f(k) != f(k + 1))
+            .map(|k| {
+                let (d0, d1) = (bins[k].distance(), bins[k + 1].distance());
+                d0 + (d1 - d0) * f(k) / (f(k) - f(k + 1))
+            })
+            .min_by(|a, b| a.abs().total_cmp(&b.abs()))
+    }
+}
+
+/// How far beyond the upper level, away from the lower, the blocks' mean profile between them may reach
+/// before [`beyond_the_backdrop`] holds, as a share of the step: a tenth, where it starts to move the
+/// half-way row by a fair part of the strip's width.
+const BEYOND_SHARE: f64 = 0.1;
+/// The same in standard errors of that mean (from the blocks' scatter): the conventional three.
+const BEYOND_SE: f64 = 3.0;
+
+/// Whether the blocks' profiles between their levels (`shares`, [`BlockStep::transition_shares`]), averaged
+/// row by row, go beyond the backdrop's gray away from the band's: a strip brighter than the backdrop along
+/// a darker band's top, or the reverse. A lip catching the light on the band's top and a glow on the
+/// backdrop just above it make the same profile, yet the half-way row lies below the edge by up to the
+/// strip's width in the first case and at it in the second: the mean gray cannot tell where the edge is.
+/// Averaged over blocks, since within one block of 16 columns a woven or granular band's own texture
+/// hides such a strip.
+fn beyond_the_backdrop(shares: &[Vec<f64>]) -> bool {
+    let n = shares.len();
+    if n < 3 {
+        return false;
+    }
+    (0..shares[0].len()).any(|k| {
+        let mean = shares.iter().map(|s| s[k]).sum::<f64>() / n as f64;
+        let var = shares.iter().map(|s| (s[k] - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
+        mean < -BEYOND_SHARE && mean + BEYOND_SE * (var / n as f64).sqrt() < 0.0
+    })
 }
 
 /// The columns to leave out of [`mean_gray_level`] for a ball of radius `r` px whose centre's x spanned
@@ -369,6 +423,26 @@ mod tests {
             }
         }
         assert_textured_level_at_edge_mean(&px, &drawn, -1.5);
+    }
+
+    /// A darker band whose top 2 px catch the light, brighter than the backdrop, has no level from its mean
+    /// gray (whose half-way row lies below the lip); without the lip it has, at the edge. The test is made
+    /// on the blocks' mean profile, since one block's texture hides the lip.
+    #[test]
+    fn a_lip_brighter_than_the_backdrop_along_a_darker_band_gives_no_mean_gray_level() {
+        let drawn = scene(170.3, 0.0, (75.0, 15.0), 0.0, 2.0, 13);
+        let mut px = render(&drawn);
+        let line = SurfaceLine::given(127.5, 170.3, 0.0);
+        let plain = mean_gray_level(&Plane::new(&px, 256, 256), &line, None).expect("a clear step");
+        assert!(plain.offset_px.abs() < 0.3, "{plain:?}");
+        for (x, edge) in crate::testutil::band_edge(&drawn).into_iter().enumerate() {
+            for y in edge.ceil() as usize..(edge + 2.0).ceil() as usize {
+                px[y * 256 + x] = px[y * 256 + x].saturating_add(28);
+            }
+        }
+        let img = Plane::new(&px, 256, 256);
+        assert!(mean_gray_level(&img, &line, None).is_none());
+        assert_eq!(remeasured(&img, line, None), line);
     }
 
     /// Starting `start` px from the drawn edge's mean, the textured share puts the level there within three
