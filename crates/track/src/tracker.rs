@@ -291,7 +291,8 @@ const QUALITY_FIXES: usize = 16;
 /// A fix whose visible rim's quality falls below this fraction of the track's recent median is not the
 /// rim the track has been measuring (a seam, texture or another object near the prediction), and the frame
 /// is not `ok`. A ball passing behind a thin ruler keeps most of its rim, and one sinking into the surface
-/// or leaving the frame loses rays that are not counted against it.
+/// or leaving the frame loses rays that are not counted against it; a pressed ball found at its prediction
+/// is not held to it at all ([`pressed_at`]).
 const QUALITY_DROP: f64 = 0.6;
 
 impl Tracker {
@@ -785,7 +786,7 @@ impl Tracker {
         if let Some((found, px, py, r)) = found
             && self.plausible(&found, px, py, r, max_jump)
             && (half_width <= CONFIDENT_HALF_WIDTH || !self.coarse_frames() || self.of_flight_size(&found))
-            && self.same_rim(&found)
+            && (self.same_rim(&found) || pressed_at(&found, (px, py)))
             && self.continues_on_rim(frame, img, &found)
         {
             self.last_innovation = (found.fit.x - px).hypot(found.fit.y - py);
@@ -1220,6 +1221,18 @@ impl Tracker {
             status,
         }
     }
+}
+
+/// Whether `f` is the ball pressed into the surface where the track predicts it, at `prediction` (px): part
+/// of its rim hidden by the surface line and its centre within the narrow window of the prediction. Its
+/// visible rim is then less clear than in flight (its lowest rays run along the band, the press and the
+/// band's shade darken it) and is not held to the flight's clarity ([`Tracker::same_rim`]); it must still
+/// stand out of the noise ([`Tracker::continues_on_rim`]). On a copy of `looks --seed 17` with 4 DN more
+/// noise, gamma 0.8 and vignetting, S014's pressed rim (a 99 px ball) read 0.18–0.57 against its flight's
+/// 0.76; refused, the frame was searched whole and a lit cap's edge 4.4 px inside the ball was taken for
+/// it (`tests/shading.rs`: the noise alone does it).
+fn pressed_at(f: &Refined, (px, py): (f64, f64)) -> bool {
+    f.rays_hidden > 0 && (f.fit.x - px).hypot(f.fit.y - py) <= CONFIDENT_HALF_WIDTH
 }
 
 /// Whether a circle of radius `r` px can be the ball measured at `expected` px: within 6 % and a pixel, room
