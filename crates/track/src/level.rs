@@ -134,7 +134,7 @@ fn row_statistic_level<P: Pixel>(
     let span = SPAN_PX;
     let nbins = (2 * span + 1) as usize;
     let mut offsets = Vec::new();
-    let mut between = Vec::new();
+    let mut shares = Vec::new();
     let mut looked = 0usize;
     let mut samples: Vec<(usize, f64, f64)> = Vec::with_capacity(BLOCK_PX * nbins);
     for x_lo in (0..img.width.saturating_sub(BLOCK_PX - 1)).step_by(BLOCK_PX) {
@@ -191,13 +191,13 @@ fn row_statistic_level<P: Pixel>(
         looked += 1;
         let Some(step) = BlockStep::of(&bins) else { continue };
         if statistic == RowStatistic::MeanGray {
-            between.push(step.transition_shares(&bins, backdrop_trend(&bins[..LEVEL_ROWS as usize])));
+            shares.push(step.transition_shares(&bins, backdrop_trend(&bins[..LEVEL_ROWS as usize])));
         }
         if let Some(off) = step.crossing(&bins) {
             offsets.push(off);
         }
     }
-    if offsets.len() < MIN_BLOCKS.max(looked.div_ceil(2)) || beyond_the_backdrop(&between) {
+    if offsets.len() < MIN_BLOCKS.max(looked.div_ceil(2)) || beyond_the_backdrop(&shares) {
         return None;
     }
     let n = offsets.len();
