@@ -38,7 +38,7 @@ pub struct ClipResult {
     /// Contact line used (its cue), its level error at the truth's column, px (measured − truth, + down), and
     /// the line's part of the contact level's standard error as the estimator takes it, px
     /// (`SurfaceLine::level_sigma_px`, times √(1 − the trajectory's share) for a level moved towards the
-    /// trajectory's, `Estimate::trajectory_share`).
+    /// trajectory's, `Estimate::trajectory_share`, and by `Estimate::level_se_scale` where the two disagree).
     pub level: Option<(String, f64, f64)>,
     /// COR and μ: (estimate, SE, truth).
     pub cor: Option<(f64, f64, f64)>,
@@ -234,8 +234,9 @@ fn evaluate_clip(
                 // The truth's surface line is given at the image's centre column.
                 let xc = (clip.dimensions().0 as f64 - 1.0) / 2.0;
                 let err = line.y_at(xc) - num(truth, "surface_y_px");
-                // A level partly from the trajectory has the line's variance times the line's weight.
-                let sigma = line.level_sigma_px() * (1.0 - e.trajectory_share).sqrt();
+                // A level partly from the trajectory has the line's variance times the line's weight,
+                // widened where the two disagree.
+                let sigma = line.level_sigma_px() * (1.0 - e.trajectory_share).sqrt() * e.level_se_scale;
                 result.level = Some((line.cue.name().to_string(), err, sigma));
             }
             result.cor = Some((e.cor.value, e.cor.se, num(truth, "cor")));

@@ -1039,6 +1039,12 @@ fn contact_source(e: &bouncelab_estimate::Estimate) -> Option<String> {
             100.0 * e.trajectory_share
         );
     }
+    if e.level_se_scale > 1.005 {
+        text += &format!(
+            ", its error widened {:.1}-fold as the line and the ball's trajectory lie further apart than their errors allow",
+            e.level_se_scale
+        );
+    }
     if let Some(t) = e.surface_tilt_deg {
         text += &format!(", tilt {:+.3} ± {:.3}°", t.value, t.se).replace('-', "\u{2212}");
         let same = |a: bouncelab_estimate::Measured| (a.value - t.value).abs() < 1e-6 && (a.se - t.se).abs() < 1e-6;

@@ -174,6 +174,13 @@ pub struct Estimate {
     /// the trajectory alone, and estimates stored before it.
     #[serde(default)]
     pub trajectory_share: f64,
+    /// How far the contact level's standard error is widened, ≥ 1: where a line found in the image and
+    /// the ball's trajectory put the contact further apart than their errors allow (`|Δ| / √(σ_line² +
+    /// σ_trajectory²)` > 1, the Birge ratio of the two), at least one of those errors is too small, and
+    /// which cannot be told, so the combined level's error is widened by that ratio. 1 for a level from one
+    /// source, and estimates stored before it.
+    #[serde(default = "unwidened")]
+    pub level_se_scale: f64,
     /// The flights' acceleration, m/s² in the local frame (free fits of both arcs, weighted), against gravity's.
     #[serde(default)]
     pub gravity: Option<GravityCheck>,
@@ -188,6 +195,11 @@ pub struct Estimate {
     pub flags: Vec<String>,
     /// Things a person should know.
     pub notes: Vec<String>,
+}
+
+/// [`Estimate::level_se_scale`] of estimates stored before it existed.
+fn unwidened() -> f64 {
+    1.0
 }
 
 /// Does the ball fall like a ball? The free-flight arcs fitted with their acceleration free.
@@ -552,7 +564,7 @@ fn measure(
     let free_arcs = [arc_in, arc_out];
     let gravity = gravity_check(&[fall_in, fall_out], a, c.gravity);
     let mut notes = choice.notes;
-    let mut level = LevelErrors::of(&line, &scale, radius, choice.trajectory_share);
+    let mut level = LevelErrors::of(&line, &scale, radius, choice.trajectory_share, choice.level_se_scale);
     if line.cue == LineCue::Trajectory
         && c.surface_tilt_deg.is_none()
         && turn.is_none()
@@ -657,6 +669,7 @@ fn measure(
         fall_tilt_deg: None,
         trajectory_level_px: choice.trajectory_level_px,
         trajectory_share: choice.trajectory_share,
+        level_se_scale: choice.level_se_scale,
         gravity,
         rim_change_px,
         flags,
@@ -906,8 +919,9 @@ struct LevelErrors {
 
 impl LevelErrors {
     /// The errors for a contact `line`, at the clip's `scale`, for a ball of `radius` m, with `share` of
-    /// its level taken from the trajectory ([`Estimate::trajectory_share`]).
-    fn of(line: &SurfaceLine, scale: &bouncelab_track::Scale, radius: f64, share: f64) -> Self {
+    /// its level taken from the trajectory ([`Estimate::trajectory_share`]) and its error widened by
+    /// `widened` ([`Estimate::level_se_scale`]).
+    fn of(line: &SurfaceLine, scale: &bouncelab_track::Scale, radius: f64, share: f64, widened: f64) -> Self {
         let s = scale.m_per_px;
         // A level taken from the trajectory is where the centre was at the touch, one radius above a line put
         // one radius below it: the scale's error in that radius cancels, and so does an offset of the centre.
@@ -919,7 +933,8 @@ impl LevelErrors {
             0.0
         };
         // Inverse-variance weights: the combined variance is the line's times its own weight, 1 − share.
-        let sigma = line.level_sigma_px().hypot(against_centres) * s * (1.0 - share).clamp(0.0, 1.0).sqrt();
+        let sigma =
+            line.level_sigma_px().hypot(against_centres) * s * (1.0 - share).clamp(0.0, 1.0).sqrt() * widened.max(1.0);
         let scatter_scale = (scale.sigma_m_per_px.powi(2) - scale.sigma_shape_m_per_px().powi(2))
             .max(0.0)
             .sqrt();
@@ -1188,6 +1203,8 @@ struct ContactChoice {
     line: SurfaceLine,
     /// The share of the line's level taken from the trajectory (see [`Estimate::trajectory_share`]).
     trajectory_share: f64,
+    /// See [`Estimate::level_se_scale`].
+    level_se_scale: f64,
     trajectory_level_px: Option<Measured>,
     notes: Vec<String>,
     /// The trajectory's [`EstimateError::NoImpact`], when it holds no impact.
@@ -1237,6 +1254,7 @@ fn contact_line(
         return Ok(ContactChoice {
             line,
             trajectory_share: 0.0,
+            level_se_scale: 1.0,
             trajectory_level_px,
             notes,
             no_impact,
@@ -1255,6 +1273,7 @@ fn contact_line(
                 Ok(tc) => ContactChoice {
                     line: across.level_line(tc),
                     trajectory_share: 0.0,
+                    level_se_scale: 1.0,
                     trajectory_level_px: Some(Measured::new(0.0, tc.level_se_px)),
                     notes: [
                         choice.notes,
@@ -1269,6 +1288,7 @@ fn contact_line(
         (Some(line), Err(_)) => Ok(ContactChoice {
             line,
             trajectory_share: 0.0,
+            level_se_scale: 1.0,
             trajectory_level_px: None,
             notes,
             no_impact,
@@ -1282,6 +1302,7 @@ fn contact_line(
             Ok(ContactChoice {
                 line: view.level_line(tc),
                 trajectory_share: 0.0,
+                level_se_scale: 1.0,
                 trajectory_level_px: Some(Measured::new(0.0, tc.level_se_px)),
                 notes,
                 no_impact,
@@ -1429,6 +1450,7 @@ impl TrajectoryView {
                 ..self.level_line(tc)
             },
             trajectory_share: 0.0,
+            level_se_scale: 1.0,
             trajectory_level_px: Some(Measured::new(0.0, tc.level_se_px)),
             notes,
             no_impact,
@@ -1444,7 +1466,7 @@ impl TrajectoryView {
         line: SurfaceLine,
         m: Measured,
         tc: &TrajectoryContact,
-        notes: Vec<String>,
+        mut notes: Vec<String>,
         no_impact: Option<EstimateError>,
         against_centres_px: f64,
     ) -> ContactChoice {
@@ -1454,6 +1476,20 @@ impl TrajectoryView {
         } else {
             0.0
         };
+        // Two measures of one level further apart than their errors allow: one of the errors is too small,
+        // and which cannot be told, so the mean's is widened by how far (the Birge ratio, one degree of
+        // freedom).
+        let apart = m.value.abs() / (var_line + m.se * m.se).sqrt();
+        let level_se_scale = if apart.is_finite() { apart.max(1.0) } else { 1.0 };
+        if level_se_scale >= NOTED_WIDENING {
+            notes.push(format!(
+                "the surface line ({} cue) and the ball's trajectory put the contact {:.1} px apart, {:.1} times their combined error: the contact level's error is widened {:.1}-fold",
+                line.cue.name(),
+                m.value.abs(),
+                apart,
+                level_se_scale
+            ));
+        }
         let line = SurfaceLine {
             y0: line.y0 - share * m.value * (1.0 + line.slope * line.slope).sqrt(),
             ..line
@@ -1461,12 +1497,17 @@ impl TrajectoryView {
         ContactChoice {
             line,
             trajectory_share: share,
+            level_se_scale,
             trajectory_level_px: Some(self.relative(tc, &line)),
             notes,
             no_impact,
         }
     }
 }
+
+/// A widening of the contact level's error ([`Estimate::level_se_scale`]) from which a note says so: below
+/// it, two measures about one standard error apart, as one pair in three is by chance.
+const NOTED_WIDENING: f64 = 2.0;
 
 /// The surface's direction when nothing in the image shows it: a line through the middle column the fixes
 /// suggest, at the tilt given, else along the image's own axes.

@@ -934,3 +934,50 @@ fn a_rim_read_differently_in_flight_is_not_a_wrong_fall() {
     let e = estimate(&track, &conditions(0.0)).unwrap();
     assert!(e.flags.iter().any(|f| f.contains("frame rate")), "{:?}", e.flags);
 }
+
+/// A line found 3 px above the true surface but said to be within 0.25 px, and a trajectory that puts the
+/// contact within 0.84 px: the two lie further apart than their errors allow, so one error is too small and
+/// the contact level's error is widened by their Birge ratio, 2.7 (a note says so). The line, the more
+/// precise, still takes most of the weight, so the widening cannot make the contact time's error honest
+/// (that takes σ_line ≥ σ_trajectory), only less far off in its errors: 4.4 SE here, 11.7 without the
+/// widening. The same line at the surface is not widened.
+#[test]
+fn a_line_and_a_touch_further_apart_than_their_errors_widen_the_level_s_error() {
+    let model = Model::paper(25_650.0, 14.0, 0.5);
+    let (angle, drop) = (0.0, 0.2);
+    let (track, truth) = shot(&model, angle, drop, 0.02, 11);
+    let with_line = |offset: f64| {
+        let mut track = track.clone();
+        let line = track.surface.as_mut().unwrap();
+        line.y0 -= offset;
+        line.sigma_y0 = 0.25;
+        estimate(&track, &conditions(angle)).unwrap()
+    };
+    let (right, off) = (with_line(0.0), with_line(3.0));
+    let z = |e: &bouncelab_estimate::Estimate| (e.contact_ms.value - truth.contact_time() * 1e3) / e.contact_ms.se;
+    println!(
+        "{angle}°: widened {:.2} (at the surface {:.2}), contact time error/SE {:.2}",
+        off.level_se_scale,
+        right.level_se_scale,
+        z(&off)
+    );
+    assert!(right.level_se_scale < 1.5, "{angle}°: widened {}", right.level_se_scale);
+    assert!(
+        !right.notes.iter().any(|n| n.contains("error is widened")),
+        "{:?}",
+        right.notes
+    );
+    assert!(off.level_se_scale > 2.0, "{angle}°: widened {}", off.level_se_scale);
+    assert!(
+        off.notes.iter().any(|n| n.contains("error is widened")),
+        "{:?}",
+        off.notes
+    );
+    assert!(
+        off.contact_ms.se > 1.5 * right.contact_ms.se,
+        "{:?} {:?}",
+        off.contact_ms,
+        right.contact_ms
+    );
+    assert!(z(&off).abs() < 6.0, "{angle}°: contact time error/SE {}", z(&off));
+}
