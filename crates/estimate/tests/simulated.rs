@@ -935,8 +935,8 @@ fn a_rim_read_differently_in_flight_is_not_a_wrong_fall() {
     assert!(e.flags.iter().any(|f| f.contains("frame rate")), "{:?}", e.flags);
 }
 
-/// A line found 3 px above the true surface but said to be within 0.25 px, and a trajectory that puts the
-/// contact within 0.84 px: the two lie further apart than their errors allow, so one error is too small and
+/// A line found 3 px above the true surface but said to be within 0.25 px, and a trajectory whose level is
+/// uncertain by 0.84 px: the two lie further apart than their errors allow, so one error is too small and
 /// the contact level's error is widened by their Birge ratio, 2.7 (a note says so). The line, the more
 /// precise, still takes most of the weight, so the widening cannot make the contact time's error honest
 /// (that takes σ_line ≥ σ_trajectory), only less far off in its errors: 4.4 SE here, 11.7 without the
