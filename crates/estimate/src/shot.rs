@@ -1211,6 +1211,26 @@ struct ContactChoice {
     no_impact: Option<EstimateError>,
 }
 
+impl ContactChoice {
+    /// `line` taken whole: none of its level from the trajectory and its error not widened (as when the
+    /// line is given, or only one of the line and the trajectory is there).
+    fn taken(
+        line: SurfaceLine,
+        trajectory_level_px: Option<Measured>,
+        notes: Vec<String>,
+        no_impact: Option<EstimateError>,
+    ) -> ContactChoice {
+        ContactChoice {
+            line,
+            trajectory_share: 0.0,
+            level_se_scale: 1.0,
+            trajectory_level_px,
+            notes,
+            no_impact,
+        }
+    }
+}
+
 /// Chooses the contact line (see [`estimate`]); `a_px` is gravity along the normal, px/s² (negative).
 fn contact_line(
     track: &Track,
@@ -1251,14 +1271,7 @@ fn contact_line(
                 m.value, m.se
             ));
         }
-        return Ok(ContactChoice {
-            line,
-            trajectory_share: 0.0,
-            level_se_scale: 1.0,
-            trajectory_level_px,
-            notes,
-            no_impact,
-        });
+        return Ok(ContactChoice::taken(line, trajectory_level_px, notes, no_impact));
     }
     match (found, &view.trajectory) {
         (Some(line), Ok(tc)) => {
@@ -1270,43 +1283,32 @@ fn contact_line(
             // level is taken as when no line is found.
             let across = TrajectoryView::along(unseen, track, measured, radius_px, a_px);
             Ok(match &across.trajectory {
-                Ok(tc) => ContactChoice {
-                    line: across.level_line(tc),
-                    trajectory_share: 0.0,
-                    level_se_scale: 1.0,
-                    trajectory_level_px: Some(Measured::new(0.0, tc.level_se_px)),
-                    notes: [
+                Ok(tc) => ContactChoice::taken(
+                    across.level_line(tc),
+                    Some(Measured::new(0.0, tc.level_se_px)),
+                    [
                         choice.notes,
                         vec![format!("the rejected line's tilt is not used: {unseen_text}")],
                     ]
                     .concat(),
-                    ..choice
-                },
+                    choice.no_impact,
+                ),
                 Err(_) => choice,
             })
         }
-        (Some(line), Err(_)) => Ok(ContactChoice {
-            line,
-            trajectory_share: 0.0,
-            level_se_scale: 1.0,
-            trajectory_level_px: None,
-            notes,
-            no_impact,
-        }),
+        (Some(line), Err(_)) => Ok(ContactChoice::taken(line, None, notes, no_impact)),
         (None, Ok(tc)) => {
             notes.push(format!(
                 "no surface line found: the contact level comes from the ball's trajectory (± {:.2} px); {unseen_text}",
                 tc.level_se_px
             ));
             notes.extend(tc.notes.iter().cloned());
-            Ok(ContactChoice {
-                line: view.level_line(tc),
-                trajectory_share: 0.0,
-                level_se_scale: 1.0,
-                trajectory_level_px: Some(Measured::new(0.0, tc.level_se_px)),
+            Ok(ContactChoice::taken(
+                view.level_line(tc),
+                Some(Measured::new(0.0, tc.level_se_px)),
                 notes,
                 no_impact,
-            })
+            ))
         }
         (None, Err(e)) => Err(no_impact.unwrap_or_else(|| EstimateError::NoSurface { why: e.to_string() })),
     }
@@ -1444,17 +1446,15 @@ impl TrajectoryView {
             tc.level_se_px
         ));
         notes.extend(tc.notes.iter().cloned());
-        ContactChoice {
-            line: SurfaceLine {
+        ContactChoice::taken(
+            SurfaceLine {
                 sigma_tilt_deg: line.sigma_tilt_deg,
                 ..self.level_line(tc)
             },
-            trajectory_share: 0.0,
-            level_se_scale: 1.0,
-            trajectory_level_px: Some(Measured::new(0.0, tc.level_se_px)),
+            Some(Measured::new(0.0, tc.level_se_px)),
             notes,
             no_impact,
-        }
+        )
     }
 
     /// A `line` seen in the image that the trajectory agrees with (`m`: the trajectory's level above it), its
