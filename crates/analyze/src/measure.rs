@@ -105,8 +105,10 @@ pub(crate) fn session_key(session: &Session) -> String {
 /// limb's centre fitted again over its last 3 px, and taken where the deeper fit disagrees, else the two
 /// averaged; 32: no level from the band's mean gray where a strip along its top lies beyond the backdrop's
 /// gray; 33: a pressed ball's rim at its prediction kept however less clear than in flight; 34: the contact
-/// level's error widened where the line and the ball's trajectory lie further apart than their errors allow).
-const MEASUREMENT_REVISION: u32 = 34;
+/// level's error widened where the line and the ball's trajectory lie further apart than their errors allow;
+/// 35: a backward fix after the bounce clearly further from the ball's size than the forward one does not
+/// replace it).
+const MEASUREMENT_REVISION: u32 = 35;
 
 /// Everything besides the frame files that changes a shot's track or estimate.
 fn settings_text(entry: &ClipEntry, gravity: f64) -> String {

@@ -1273,7 +1273,8 @@ struct Retracked {
 /// ([`crate::bounce::after_bounce`]), measured again backward in time from the clean flight after them by
 /// a fresh tracker that reads the rim as `forward` does ([`Tracker::fresh_on_same_rim`]), seeded by that
 /// flight's first two fixes; `measure(back, k, frame, −t)` measures file `k`. Where the two passes disagree
-/// a frame takes the backward fix as [`crate::bounce::back_replaces`] says. `None` when there is nothing to
+/// a frame takes the backward fix as [`crate::bounce::back_replaces`] says, for the ball's radius `forward`
+/// measured in free flight. `None` when there is nothing to
 /// measure again (no line, no bounce, or a bounce the forward track held cleanly).
 fn retrack_bounce(
     fixes: &mut [BallFix],
@@ -1288,6 +1289,7 @@ fn retrack_bounce(
     };
     let (lowest, settled) = (span.lowest, span.settled);
     let mut back = forward.fresh_on_same_rim();
+    let ball_r_px = forward.known_radius();
     let (a, b) = (fixes[settled + 1], fixes[settled]);
     back.seed((-a.t_s, a.x_px, a.y_px), (-b.t_s, b.x_px, b.y_px));
     let mut unmeasured = 0;
@@ -1298,7 +1300,7 @@ fn retrack_bounce(
         settled - lowest,
         |tr, k, frame, t| measure(tr, lowest + k, frame, t),
         |back, forward| {
-            let takes = crate::bounce::back_replaces(line, back, forward);
+            let takes = crate::bounce::back_replaces(line, back, forward, ball_r_px);
             if takes && forward.status.measured() {
                 moved_px = moved_px.max((back.x_px - forward.x_px).hypot(back.y_px - forward.y_px));
             } else if takes {

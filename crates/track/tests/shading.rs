@@ -1,35 +1,12 @@
 //! The tracker on clips drawn by `bouncelab-render`'s `looks` preset whose lighting shades the ball unevenly:
 //! its centres are the silhouette's, not the shading's, in flight and pressed into the surface.
 
-use bouncelab_frames::Clip;
-use bouncelab_render::{Pixels, RenderedFrame, Scenario, ShotPlan, Visibility, encode};
-use bouncelab_testkit::Rng;
-use bouncelab_track::{ClipTracking, Status, Track, track_clip};
+mod common;
 
-/// Shot `index` of `looks --seed seed` (named `clip`, checked), rendered in memory, each frame passed
-/// through `alter`, written to a temporary folder in the camera's format and tracked as `analyze` would.
-fn tracked_looks_shot(
-    seed: u64,
-    index: usize,
-    clip: &str,
-    mut alter: impl FnMut(&mut RenderedFrame),
-) -> (ShotPlan, Track) {
-    let mut scenario = Scenario::preset("looks").unwrap();
-    scenario.seed = seed;
-    let plan = ShotPlan::new(&scenario, index).unwrap();
-    assert_eq!(plan.truth.clip, clip, "the preset's draws changed");
-    let dir = tempfile::tempdir().unwrap();
-    let (renderer, camera) = (plan.renderer(), plan.camera());
-    for i in 0..plan.frames.len() {
-        let mut frame = renderer.frame(i);
-        alter(&mut frame);
-        let bytes = encode(&frame, camera.format).unwrap();
-        std::fs::write(dir.path().join(camera.frame_name(i)), bytes).unwrap();
-    }
-    let clip = Clip::open(dir.path()).unwrap();
-    let track = track_clip(&clip, &ClipTracking::default(), |_, _| {}).unwrap();
-    (plan, track)
-}
+use bouncelab_render::{Pixels, Visibility};
+use bouncelab_testkit::Rng;
+use bouncelab_track::Status;
+use common::{frames_over_1px_off, tracked_looks_shot};
 
 /// `looks --seed 11`'s S045: a 27.2 px plain ball lit from 59.5° above, 8-bit, 4 DN of noise. Its lower
 /// limb's terminator lies ≈ 3.6 px inside the silhouette and its rim-brightened edge meets the backdrop at
@@ -73,14 +50,7 @@ fn a_pressed_rim_less_clear_than_in_flight_stays_the_ball_s() {
             .iter_mut()
             .for_each(|p| *p = (*p as f64 + 4.0 * 257.0 * rng.normal()).round().clamp(0.0, 65535.0) as u16),
     });
-    let off: Vec<usize> = track
-        .fixes
-        .iter()
-        .zip(&plan.frames)
-        .filter(|(f, _)| f.status.measured())
-        .filter(|(f, t)| (f.x_px - t.x_px).hypot(f.y_px - t.y_px) > 1.0)
-        .map(|(f, _)| f.frame)
-        .collect();
+    let off = frames_over_1px_off(&plan, &track);
     let measured = track.fixes.iter().filter(|f| f.status.measured()).count();
     println!("{measured} frames measured, {} more than 1 px off: {off:?}", off.len());
     assert!(
