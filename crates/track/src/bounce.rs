@@ -245,7 +245,7 @@ mod tests {
             "without the ball's size, the clearer wins"
         );
         assert!(!back_replaces(&line, &shrunk, &forward, r));
-        // Within 3 σ of the forward fix's nearness to the ball's size the test does not decide.
+        // Only 0.3 px smaller, within 3 of the radii's combined σ (0.43 px): the size does not decide.
         let near = BallFix {
             r_px: forward.r_px - 0.3,
             ..shrunk

@@ -1274,8 +1274,8 @@ struct Retracked {
 /// a fresh tracker that reads the rim as `forward` does ([`Tracker::fresh_on_same_rim`]), seeded by that
 /// flight's first two fixes; `measure(back, k, frame, −t)` measures file `k`. Where the two passes disagree
 /// a frame takes the backward fix as [`crate::bounce::back_replaces`] says, for the ball's radius `forward`
-/// measured in free flight. `None` when there is nothing to
-/// measure again (no line, no bounce, or a bounce the forward track held cleanly).
+/// measured in free flight. `None` when there is nothing to measure again (no line, no bounce, or a bounce
+/// the forward track held cleanly).
 fn retrack_bounce(
     fixes: &mut [BallFix],
     forward: &Tracker,
