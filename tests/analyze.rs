@@ -186,6 +186,13 @@ fn report_figures_hold_the_csv_numbers(out: &Path) {
             (num(shown_speed) - v).abs() <= half_digit(shown_speed),
             "speed {shown_speed} vs {v}"
         );
+        // The contact level's widening: at least 1, and said in the report when there is one.
+        let widened = num(&row["level_se_scale"]);
+        assert!(widened >= 1.0, "{}: level_se_scale {widened}", row["clip"]);
+        if widened > 1.005 {
+            let said = format!("its error widened {widened:.1}-fold");
+            assert!(html.contains(&said), "{}: the report does not say {said}", row["clip"]);
+        }
     }
     // The curve table lists points of model_curves.csv (four significant digits).
     let curves = read_csv(&out.join("model_curves.csv"));

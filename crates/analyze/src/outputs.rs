@@ -10,11 +10,11 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// The columns of `estimates.csv`, in order. Every name ends in its unit (`_m_s`, `_ms`, `_mm`, `_deg`,
-/// `_rad_s`, `_m_s2`, `_s`, `_m`); `cor`, `mu_eff`, their `_se`, `chi2_red_flight` and `trajectory_share` are
-/// dimensionless. A standard error is `<quantity>_se_<unit>` (see `docs/outputs.md`). The measured quantities'
+/// `_rad_s`, `_m_s2`, `_s`, `_m`); `cor`, `mu_eff`, their `_se`, `chi2_red_flight`, `trajectory_share` and
+/// `level_se_scale` are dimensionless. A standard error is `<quantity>_se_<unit>` (see `docs/outputs.md`). The measured quantities'
 /// columns are the store's `estimates` columns ([`Q`], `bouncelab_store::ESTIMATE_QUANTITIES`), so the file
 /// and the table name them alike.
-pub const ESTIMATE_COLUMNS: [&str; 48] = [
+pub const ESTIMATE_COLUMNS: [&str; 49] = [
     "clip",
     "surface",
     "angle_deg",
@@ -54,6 +54,7 @@ pub const ESTIMATE_COLUMNS: [&str; 48] = [
     "chi2_red_flight",
     "contact_line",
     "trajectory_share",
+    "level_se_scale",
     "surface_tilt_deg",
     "surface_tilt_se_deg",
     "line_tilt_deg",
@@ -216,6 +217,7 @@ fn estimate_cells(s: &ShotData, ball_mass_kg: f64, gravity: f64, files: &Traject
     cells.push(num(worst_chi2));
     cells.push(e.contact_line.map_or(String::new(), |l| l.cue.name().to_string()));
     cells.push(num(e.trajectory_share));
+    cells.push(num(e.level_se_scale));
     for tilt in [e.surface_tilt_deg, e.line_tilt_deg, e.fall_tilt_deg] {
         cells.extend(value_se_cells(tilt.map(|t| (t.value, Some(t.se)))));
     }
@@ -798,6 +800,7 @@ mod tests {
             "chi2_red_flight",
             "contact_line",
             "trajectory_share",
+            "level_se_scale",
             "flags",
             "trajectory_file",
             "phase",
