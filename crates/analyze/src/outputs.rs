@@ -11,9 +11,9 @@ use std::path::{Path, PathBuf};
 
 /// The columns of `estimates.csv`, in order. Every name ends in its unit (`_m_s`, `_ms`, `_mm`, `_deg`,
 /// `_rad_s`, `_m_s2`, `_s`, `_m`); `cor`, `mu_eff`, their `_se`, `chi2_red_flight`, `trajectory_share` and
-/// `level_se_scale` are dimensionless. A standard error is `<quantity>_se_<unit>` (see `docs/outputs.md`). The measured quantities'
-/// columns are the store's `estimates` columns ([`Q`], `bouncelab_store::ESTIMATE_QUANTITIES`), so the file
-/// and the table name them alike.
+/// `level_se_scale` are dimensionless. A standard error is `<quantity>_se_<unit>` (see `docs/outputs.md`).
+/// The measured quantities' columns are the store's `estimates` columns ([`Q`],
+/// `bouncelab_store::ESTIMATE_QUANTITIES`), so the file and the table name them alike.
 pub const ESTIMATE_COLUMNS: [&str; 49] = [
     "clip",
     "surface",
